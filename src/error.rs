@@ -1,0 +1,126 @@
+//! One error type for the whole crate. Every variant names what was wrong
+//! (argument, vertex, face or edge ids) so a CAD user can find it in the model.
+
+use std::fmt;
+
+/// Lists at most this many offending ids in a message; the rest are counted.
+const MAX_IDS_SHOWN: usize = 8;
+
+/// Everything that can go wrong before or during a solve.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// An argument is invalid (empty, wrong length, NaN, out of range, ...).
+    InvalidArgument { name: &'static str, reason: String },
+    /// The mesh has no vertices or no faces.
+    EmptyMesh,
+    /// A face refers to a vertex index `>= n_vertices`.
+    IndexOutOfRange { face: usize, index: u64, n_vertices: usize },
+    /// An anchored (support) id is `>= n_vertices` or repeated.
+    InvalidAnchor { index: u64, reason: &'static str },
+    /// A vertex has a NaN or infinite coordinate.
+    NonFiniteCoordinate { vertex: usize },
+    /// A face lists the same vertex twice.
+    RepeatedVertexInFace { face: usize },
+    /// Two faces have the same three vertices.
+    DuplicateFace { face: usize, first: usize },
+    /// Faces whose plan (x, y) projection has (near) zero area.
+    DegenerateFaces { faces: Vec<usize> },
+    /// An edge shared by more than two faces.
+    NonManifoldEdge { edge: [usize; 2], faces: Vec<usize> },
+    /// A vertex whose faces do not form a single fan (bow-tie).
+    NonManifoldVertex { vertex: usize },
+    /// Two faces traverse their shared edge in the same direction.
+    InconsistentOrientation { edge: [usize; 2], faces: [usize; 2] },
+    /// Faces whose plan orientation is opposite to the majority: the plan folds over itself.
+    FlippedFaces { faces: Vec<usize> },
+    /// Interior vertices whose plan angles do not sum to 2π: the plan wraps around them.
+    OverlappingPlan { vertices: Vec<usize> },
+    /// A connected component of the mesh has no anchored vertex.
+    UnsupportedComponent { component: usize, vertices: Vec<usize> },
+    /// No vertex is anchored at all.
+    NoSupports,
+    /// A hole could not be joined to its component's outer boundary through interior vertices.
+    HoleNotCuttable { hole: usize, vertex: usize },
+    /// A numerical failure inside a solver (not a property of the input).
+    Numerical { what: String },
+    /// A file could not be read or written.
+    Io { path: String, reason: String },
+    /// A file could be read but its content is malformed.
+    Parse { path: String, line: usize, reason: String },
+}
+
+fn ids(list: &[usize]) -> String {
+    let mut s: Vec<String> = list.iter().take(MAX_IDS_SHOWN).map(|i| i.to_string()).collect();
+    if list.len() > MAX_IDS_SHOWN {
+        s.push(format!("... ({} in all)", list.len()));
+    }
+    s.join(", ")
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use Error::*;
+        match self {
+            InvalidArgument { name, reason } => write!(f, "invalid argument `{name}`: {reason}"),
+            EmptyMesh => write!(f, "empty mesh: it needs at least one vertex and one face"),
+            IndexOutOfRange { face, index, n_vertices } => write!(
+                f,
+                "face {face} refers to vertex {index}, but there are only {n_vertices} vertices"
+            ),
+            InvalidAnchor { index, reason } => write!(f, "anchored vertex {index}: {reason}"),
+            NonFiniteCoordinate { vertex } => {
+                write!(f, "vertex {vertex} has a NaN or infinite coordinate")
+            }
+            RepeatedVertexInFace { face } => write!(f, "face {face} repeats a vertex"),
+            DuplicateFace { face, first } => {
+                write!(f, "face {face} has the same vertices as face {first}")
+            }
+            DegenerateFaces { faces } => {
+                write!(f, "faces with zero plan area: {}", ids(faces))
+            }
+            NonManifoldEdge { edge, faces } => write!(
+                f,
+                "non-manifold edge ({}, {}) is shared by faces {}",
+                edge[0],
+                edge[1],
+                ids(faces)
+            ),
+            NonManifoldVertex { vertex } => {
+                write!(f, "non-manifold vertex {vertex}: its faces do not form one fan")
+            }
+            InconsistentOrientation { edge, faces } => write!(
+                f,
+                "inconsistent orientation: faces {} and {} traverse edge ({}, {}) in the same direction",
+                faces[0], faces[1], edge[0], edge[1]
+            ),
+            FlippedFaces { faces } => write!(
+                f,
+                "the plan overlaps itself: faces flipped against the majority: {}",
+                ids(faces)
+            ),
+            OverlappingPlan { vertices } => write!(
+                f,
+                "the plan overlaps itself around interior vertices {}",
+                ids(vertices)
+            ),
+            UnsupportedComponent { component, vertices } => write!(
+                f,
+                "connected component {component} has no anchored vertex (it contains vertices {})",
+                ids(vertices)
+            ),
+            NoSupports => write!(f, "no vertex is anchored: a vault needs supports"),
+            HoleNotCuttable { hole, vertex } => write!(
+                f,
+                "hole {hole} (at vertex {vertex}) cannot be joined to the outer boundary through interior vertices"
+            ),
+            Numerical { what } => write!(f, "numerical failure: {what}"),
+            Io { path, reason } => write!(f, "{path}: {reason}"),
+            Parse { path, line, reason } => write!(f, "{path}:{line}: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Shorthand used across the crate.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,179 @@
+//! Generated vaults for tests, benchmarks and examples: plan domains with holes meshed by
+//! spade's refined constrained Delaunay triangulation, heights from analytic functions.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+
+/// A plan domain: an outer polygon and hole polygons (any orientation).
+#[derive(Debug, Clone, Default)]
+pub struct Domain {
+    pub outer: Vec<[f64; 2]>,
+    pub holes: Vec<Vec<[f64; 2]>>,
+}
+
+/// `n` points on a circle.
+pub fn circle(centre: [f64; 2], radius: f64, n: usize) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|k| {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+            [centre[0] + radius * a.cos(), centre[1] + radius * a.sin()]
+        })
+        .collect()
+}
+
+/// Axis-aligned rectangle [x0, x1] × [y0, y1] with `nx` × `ny` segments on its sides.
+pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64, nx: usize, ny: usize) -> Vec<[f64; 2]> {
+    let mut p = Vec::new();
+    for k in 0..nx {
+        p.push([x0 + (x1 - x0) * k as f64 / nx as f64, y0]);
+    }
+    for k in 0..ny {
+        p.push([x1, y0 + (y1 - y0) * k as f64 / ny as f64]);
+    }
+    for k in 0..nx {
+        p.push([x1 - (x1 - x0) * k as f64 / nx as f64, y1]);
+    }
+    for k in 0..ny {
+        p.push([x0, y1 - (y1 - y0) * k as f64 / ny as f64]);
+    }
+    p
+}
+
+/// Plan points and triangles of `domain`, refined until no triangle is larger than `max_area`
+/// (angles at least 25° away from constraints).
+pub fn triangulate(domain: &Domain, max_area: f64) -> Result<(Vec<[f64; 2]>, Vec<[u32; 3]>)> {
+    let bad = |reason: String| Error::InvalidArgument { name: "domain", reason };
+    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+    for poly in std::iter::once(&domain.outer).chain(&domain.holes) {
+        let mut handles = Vec::with_capacity(poly.len());
+        for p in poly {
+            handles.push(cdt.insert(Point2::new(p[0], p[1])).map_err(|e| bad(format!("{e:?}")))?);
+        }
+        for k in 0..handles.len() {
+            cdt.add_constraint(handles[k], handles[(k + 1) % handles.len()]);
+        }
+    }
+    let params = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .with_max_allowed_area(max_area)
+        .with_angle_limit(AngleLimit::from_deg(25.0))
+        .with_max_additional_vertices(2_000_000);
+    let refined = cdt.refine(params);
+    let excluded: std::collections::HashSet<_> = refined.excluded_faces.iter().map(|f| f.index()).collect();
+    let points = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+    let triangles = cdt
+        .inner_faces()
+        .filter(|f| !excluded.contains(&f.fix().index()))
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect();
+    Ok((points, triangles))
+}
+
+/// Height of a spherical cap over a disk of `radius` whose tangent at the rim rises at `angle`
+/// radians (π/2: a hemisphere), at plan distance `r` from the centre.
+pub fn spherical_cap(radius: f64, angle: f64, r: f64) -> f64 {
+    let sphere = radius / angle.sin();
+    (sphere * sphere - r * r).max(0.0).sqrt() - sphere * angle.cos()
+}
+
+/// Builds a validated mesh from plan points and triangles, lifting each point by `height` and
+/// anchoring the vertices where `anchor(point, on_outer_boundary)` holds. Triangles keep
+/// spade's vertex ids; points referenced by no triangle are dropped.
+pub fn lift(
+    points: &[[f64; 2]],
+    triangles: &[[u32; 3]],
+    height: impl Fn([f64; 2]) -> f64,
+    anchor: impl Fn([f64; 2], bool) -> bool,
+) -> Result<Mesh> {
+    let mut used = vec![u32::MAX; points.len()];
+    let mut positions = Vec::new();
+    let faces: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                if used[v as usize] == u32::MAX {
+                    used[v as usize] = positions.len() as u32;
+                    let p = points[v as usize];
+                    positions.push([p[0], p[1], height(p)]);
+                }
+                used[v as usize]
+            })
+        })
+        .collect();
+    // Anchoring needs boundary information: build once without supports being checked by
+    // anchoring everything, then rebuild with the real supports.
+    let all: Vec<u32> = (0..positions.len() as u32).collect();
+    let probe = Mesh::new(positions.clone(), faces.clone(), &all)?;
+    let mut outer = vec![false; positions.len()];
+    for lp in probe.loops.iter().filter(|l| l.is_outer) {
+        lp.vertices.iter().for_each(|&v| outer[v as usize] = true);
+    }
+    let anchored: Vec<u32> = (0..positions.len())
+        .filter(|&v| anchor([positions[v][0], positions[v][1]], outer[v]))
+        .map(|v| v as u32)
+        .collect();
+    Mesh::new(positions, faces, &anchored)
+}
+
+/// A spherical cap over the unit disk (rim anchored) with about `n` vertices.
+pub fn cap_dome(angle: f64, n: usize) -> Result<Mesh> {
+    let segments = ((n as f64).sqrt() * 3.5) as usize;
+    let area = std::f64::consts::PI / (2.0 * n as f64);
+    let (p, t) = triangulate(&Domain { outer: circle([0.0, 0.0], 1.0, segments.max(12)), holes: vec![] }, area)?;
+    lift(&p, &t, |u| spherical_cap(1.0, angle, u[0].hypot(u[1])), |_, outer| outer)
+}
+
+/// A structured disk of radius 1: a centre vertex and `rings` concentric rings, ring k with
+/// 6k vertices, consecutive rings zipped together by angle. Edges follow the radial and hoop
+/// directions, the principal stress directions of a dome of revolution.
+pub fn polar_disk(rings: usize) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+    let mut points = vec![[0.0, 0.0]];
+    let mut ring_start = vec![0usize];
+    let mut ring_len = vec![1usize];
+    for k in 1..=rings {
+        ring_start.push(points.len());
+        ring_len.push(6 * k);
+        let r = k as f64 / rings as f64;
+        for m in 0..6 * k {
+            // Odd rings are rotated by half a step so that the zipper alternates.
+            let a = 2.0 * std::f64::consts::PI * (m as f64 + 0.5 * (k % 2) as f64) / (6 * k) as f64;
+            points.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    let angle = |p: [f64; 2]| p[1].atan2(p[0]).rem_euclid(2.0 * std::f64::consts::PI);
+    let mut tris = Vec::new();
+    for k in 1..=rings {
+        let (is, il) = (ring_start[k - 1], ring_len[k - 1]);
+        let (os, ol) = (ring_start[k], ring_len[k]);
+        if il == 1 {
+            for m in 0..ol {
+                tris.push([0, (os + m) as u32, (os + (m + 1) % ol) as u32]);
+            }
+            continue;
+        }
+        // Zip the two rings counter-clockwise starting from angle 0.
+        let key = |start: usize, len: usize, m: usize| {
+            let a = angle(points[start + m % len]);
+            a + 2.0 * std::f64::consts::PI * (m / len) as f64
+        };
+        let (mut i, mut o) = (0, 0);
+        let first_i = (0..il).min_by(|&a, &b| angle(points[is + a]).total_cmp(&angle(points[is + b]))).unwrap();
+        let first_o = (0..ol).min_by(|&a, &b| angle(points[os + a]).total_cmp(&angle(points[os + b]))).unwrap();
+        while i < il || o < ol {
+            let vi = (is + (first_i + i) % il) as u32;
+            let vo = (os + (first_o + o) % ol) as u32;
+            let next_i = key(is, il, first_i + i + 1);
+            let next_o = key(os, ol, first_o + o + 1);
+            let adv_inner = o >= ol || (i < il && next_i <= next_o);
+            if adv_inner {
+                tris.push([vi, vo, (is + (first_i + i + 1) % il) as u32]);
+                i += 1;
+            } else {
+                tris.push([vi, vo, (os + (first_o + o + 1) % ol) as u32]);
+                o += 1;
+            }
+        }
+    }
+    (points, tris)
+}

@@ -1,0 +1,110 @@
+//! Vertical loads per vertex (MATH §7): a share of each face's weight plus point loads.
+
+use crate::mesh::Mesh;
+
+/// How a face's weight is shared among its three vertices.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LoadRule {
+    /// One third of the 3-D triangle area each (the paper's and VHWP12's rule).
+    #[default]
+    Barycentric,
+    /// Mixed Voronoi area of the 3-D triangle (Meyer et al.): smoother on irregular meshes.
+    Voronoi,
+    /// One third of the plan (projected) area each: a load given per unit of plan.
+    PlanArea,
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Area shares of the three corners of triangle (a, b, c) under `rule`.
+fn corner_shares(rule: LoadRule, p: [[f64; 3]; 3]) -> [f64; 3] {
+    match rule {
+        LoadRule::Barycentric => {
+            let n = cross3(sub3(p[1], p[0]), sub3(p[2], p[0]));
+            [dot3(n, n).sqrt() / 6.0; 3]
+        }
+        LoadRule::PlanArea => {
+            let a = ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]))
+                .abs();
+            [a / 6.0; 3]
+        }
+        LoadRule::Voronoi => {
+            let n = cross3(sub3(p[1], p[0]), sub3(p[2], p[0]));
+            let area = dot3(n, n).sqrt() / 2.0;
+            let mut out = [0.0; 3];
+            // Corner k, its edges to the next (i) and previous (j) corner.
+            let corner_dot = |k: usize| {
+                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+                dot3(sub3(p[i], p[k]), sub3(p[j], p[k]))
+            };
+            if let Some(obtuse) = (0..3).find(|&k| corner_dot(k) < 0.0) {
+                for (k, share) in out.iter_mut().enumerate() {
+                    *share = if k == obtuse { area / 2.0 } else { area / 4.0 };
+                }
+                return out;
+            }
+            let cot = |k: usize| corner_dot(k) / (2.0 * area);
+            for k in 0..3 {
+                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+                let lij = |a: usize, b: usize| dot3(sub3(p[a], p[b]), sub3(p[a], p[b]));
+                // Voronoi area at k: |k i|² cot(j) + |k j|² cot(i), over 8.
+                out[k] = (lij(k, i) * cot(j) + lij(k, j) * cot(i)) / 8.0;
+            }
+            out
+        }
+    }
+}
+
+/// Loads p_i = Σ_t ρ_t · share_i(t) + extra_i. `density` is per face, `extra` per vertex.
+pub fn vertex_loads(
+    mesh: &Mesh,
+    positions: &[[f64; 3]],
+    rule: LoadRule,
+    density: &[f64],
+    extra: &[f64],
+) -> Vec<f64> {
+    let mut p = extra.to_vec();
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let shares = corner_shares(rule, f.map(|i| positions[i as usize]));
+        for k in 0..3 {
+            p[f[k] as usize] += density[t] * shares[k];
+        }
+    }
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn voronoi_shares_sum_to_area_for_acute_and_obtuse() {
+        for tri in [
+            [[0.0, 0.0, 0.0], [1.0, 0.1, 0.3], [0.4, 0.9, -0.2]],
+            [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [1.0, 0.2, 0.1]],
+        ] {
+            let n = cross3(sub3(tri[1], tri[0]), sub3(tri[2], tri[0]));
+            let area = dot3(n, n).sqrt() / 2.0;
+            let s = corner_shares(LoadRule::Voronoi, tri);
+            assert!((s.iter().sum::<f64>() - area).abs() < 1e-14, "{s:?} vs {area}");
+            assert!(s.iter().all(|&x| x > 0.0));
+        }
+    }
+
+    #[test]
+    fn plan_share_ignores_height() {
+        let s = corner_shares(LoadRule::PlanArea, [[0.0, 0.0, 5.0], [2.0, 0.0, -1.0], [0.0, 3.0, 2.0]]);
+        assert_eq!(s, [1.0; 3]);
+    }
+}

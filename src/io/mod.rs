@@ -1,0 +1,43 @@
+//! Files for the examples, tests and benchmarks: Wavefront OBJ meshes and a JSON sidecar
+//! listing the anchored (support) vertices.
+//!
+//! ```no_run
+//! use std::path::Path;
+//! let mesh = voussoir::io::load_model(
+//!     Path::new("models/hex.obj"),
+//!     Path::new("models/hex.json"),
+//! )?;
+//! println!("{} vertices, {} holes", mesh.n_vertices(), mesh.holes().count());
+//! # Ok::<(), voussoir::Error>(())
+//! ```
+
+mod obj;
+mod supports;
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+use crate::{Mesh, Result};
+
+pub use obj::{parse_obj, read_obj, write_obj};
+pub use supports::{parse_supports, read_supports};
+
+/// Vertex positions (x, y plan; z height) and triangles (0-based vertex ids), as read from a
+/// file, before validation by [`Mesh::new`].
+pub type RawMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// Reads an OBJ mesh and its JSON supports file, and validates them with [`Mesh::new`].
+pub fn load_model(obj: &Path, supports: &Path) -> Result<Mesh> {
+    let (positions, faces) = read_obj(obj)?;
+    let anchored = read_supports(supports)?;
+    Mesh::new(positions, faces, &anchored)
+}
+
+/// The `Error::Io` for `path`.
+fn io_error(path: &Path, err: &std::io::Error) -> crate::Error {
+    crate::Error::Io {
+        path: path.display().to_string(),
+        reason: err.to_string(),
+    }
+}

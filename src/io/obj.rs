@@ -1,0 +1,178 @@
+//! Wavefront OBJ: `v x y z` vertices and `f` faces (triangulated as a fan).
+
+use std::fs;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::{io_error, RawMesh};
+use crate::{Error, Result};
+
+/// Reads the vertices and faces of an OBJ file (see [`parse_obj`]). Bytes that are not
+/// UTF-8 are replaced (they can only occur in comments or malformed lines).
+pub fn read_obj(path: &Path) -> Result<RawMesh> {
+    let bytes = fs::read(path).map_err(|e| io_error(path, &e))?;
+    parse_obj(
+        &String::from_utf8_lossy(&bytes),
+        &path.display().to_string(),
+    )
+}
+
+/// Parses OBJ text: `v x y z` lines give vertices (extra values such as `w` or colours are
+/// ignored), `f` lines give faces with 1-based indices, in any of the forms `i`, `i/t`,
+/// `i//n`, `i/t/n`; negative indices count back from the last vertex read so far. Polygons
+/// are split into a fan of triangles `(p0, p[i], p[i+1])`. Comments (`#`) and every other
+/// statement (`vn`, `vt`, `g`, `o`, `s`, `usemtl`, `l`, ...) are ignored.
+///
+/// Errors are [`Error::Parse`] with `path_label` and the 1-based line: a vertex with fewer
+/// than 3 coordinates or a bad number, a face with fewer than 3 vertices, an index that is
+/// not an integer, is 0, or refers past the last vertex of the file (or, when negative,
+/// before the first vertex).
+pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
+    let err = |line: usize, reason: String| Error::Parse {
+        path: path_label.to_string(),
+        line,
+        reason,
+    };
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    // Faces referring to vertices not yet read: (line, largest 0-based index), checked at the end.
+    let mut forward_refs: Vec<(usize, u64)> = Vec::new();
+    let mut polygon: Vec<u32> = Vec::new();
+
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let content = raw.split('#').next().unwrap_or("");
+        let mut tokens = content.split_whitespace();
+        match tokens.next() {
+            Some("v") => {
+                let mut p = [0.0; 3];
+                for (k, c) in p.iter_mut().enumerate() {
+                    let Some(tok) = tokens.next() else {
+                        return Err(err(
+                            line,
+                            format!("vertex has {k} coordinates, 3 are needed (v x y z)"),
+                        ));
+                    };
+                    *c = tok
+                        .parse::<f64>()
+                        .map_err(|_| err(line, format!("bad number `{tok}` in vertex")))?;
+                }
+                positions.push(p);
+            }
+            Some("f") => {
+                polygon.clear();
+                let mut largest = 0u64;
+                for tok in tokens {
+                    let index = resolve_index(tok, positions.len()).map_err(|r| err(line, r))?;
+                    largest = largest.max(u64::from(index));
+                    polygon.push(index);
+                }
+                if polygon.len() < 3 {
+                    return Err(err(
+                        line,
+                        format!("face has {} vertices, at least 3 are needed", polygon.len()),
+                    ));
+                }
+                if largest >= positions.len() as u64 {
+                    forward_refs.push((line, largest));
+                }
+                for k in 1..polygon.len() - 1 {
+                    faces.push([polygon[0], polygon[k], polygon[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    let n = positions.len() as u64;
+    if let Some(&(line, index)) = forward_refs.iter().find(|(_, index)| *index >= n) {
+        return Err(err(
+            line,
+            format!(
+                "face refers to vertex {}, but the file has only {n} vertices",
+                index + 1
+            ),
+        ));
+    }
+    Ok((positions, faces))
+}
+
+/// The 0-based vertex index of one face token (`i`, `i/t`, `i//n`, `i/t/n`), given the
+/// number of vertices read so far (for negative, relative indices).
+fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, String> {
+    let text = token.split('/').next().unwrap_or("");
+    let value: i64 = text
+        .parse()
+        .map_err(|_| format!("bad vertex index `{token}` in face"))?;
+    let index = match value {
+        0 => return Err("vertex index 0 in face (OBJ indices start at 1)".to_string()),
+        v if v > 0 => v - 1,
+        v => {
+            let resolved = n_so_far as i64 + v;
+            if resolved < 0 {
+                return Err(format!(
+                    "relative vertex index {v} in face, but only {n_so_far} vertices are read so far"
+                ));
+            }
+            resolved
+        }
+    };
+    u32::try_from(index).map_err(|_| format!("vertex index {value} in face is too large"))
+}
+
+/// Writes vertices and faces (1-based) as OBJ. Coordinates are written with Rust's shortest
+/// round-trip formatting, so [`read_obj`] gives back the same bits. The file is written to a
+/// temporary file in the same folder and renamed over `path`, so a failure never leaves a
+/// half-written file. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
+pub fn write_obj(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Result<()> {
+    let n = positions.len();
+    if let Some((t, &i)) = faces
+        .iter()
+        .enumerate()
+        .find_map(|(t, f)| f.iter().find(|&&i| i as usize >= n).map(|i| (t, i)))
+    {
+        return Err(Error::InvalidArgument {
+            name: "faces",
+            reason: format!("face {t} refers to vertex {i}, but there are only {n} positions"),
+        });
+    }
+    let tmp = temp_path(path)?;
+    let written = write_to(&tmp, positions, faces).and_then(|()| fs::rename(&tmp, path));
+    if let Err(e) = written {
+        // Best effort: the temporary file may not exist if creating it failed.
+        let _ = fs::remove_file(&tmp);
+        return Err(io_error(path, &e));
+    }
+    Ok(())
+}
+
+fn write_to(tmp: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> std::io::Result<()> {
+    let file = fs::File::create(tmp)?;
+    let mut out = BufWriter::new(file);
+    writeln!(out, "# {} vertices, {} faces", positions.len(), faces.len())?;
+    for p in positions {
+        writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+    }
+    for f in faces {
+        let [a, b, c] = f.map(|i| u64::from(i) + 1);
+        writeln!(out, "f {a} {b} {c}")?;
+    }
+    let file = out.into_inner().map_err(|e| e.into_error())?;
+    file.sync_all()
+}
+
+/// `.NAME.PID.COUNTER.tmp` next to `path`.
+fn temp_path(path: &Path) -> Result<PathBuf> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let Some(name) = path.file_name() else {
+        return Err(Error::Io {
+            path: path.display().to_string(),
+            reason: "not a file path".to_string(),
+        });
+    };
+    let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".{}.{unique}.tmp", std::process::id()));
+    Ok(path.with_file_name(tmp_name))
+}

@@ -1,0 +1,17 @@
+//! Voussoir: self-supporting masonry shapes (de Goes et al. 2013).
+#![deny(unsafe_code)]
+
+pub mod error;
+pub mod generate;
+pub mod geometry;
+pub mod io;
+pub mod mesh;
+pub mod problem;
+pub mod stress;
+
+pub use error::{Error, Result};
+pub use geometry::loads::LoadRule;
+pub use mesh::Mesh;
+pub use problem::Problem;
+pub use stress::airy::HoleMode;
+pub use stress::{analyse, EdgeScope, Formulation, QBound, StressResult, StressSettings, StressStatus, TauMode};

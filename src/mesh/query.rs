@@ -1,0 +1,59 @@
+//! Small queries on a validated mesh.
+
+use super::Mesh;
+
+impl Mesh {
+    /// Number of vertices, including unreferenced ones.
+    pub fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of faces.
+    pub fn n_faces(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// Number of (undirected) edges.
+    pub fn n_edges(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// A referenced boundary vertex that is not anchored (false for out-of-range ids).
+    pub fn is_free_boundary(&self, v: usize) -> bool {
+        self.is_non_anchored(v) && self.on_boundary.get(v).copied().unwrap_or(false)
+    }
+
+    /// A referenced vertex that is not anchored, interior or boundary (false for out-of-range
+    /// ids).
+    pub fn is_non_anchored(&self, v: usize) -> bool {
+        self.referenced.get(v).copied().unwrap_or(false)
+            && !self.anchored.get(v).copied().unwrap_or(false)
+    }
+
+    /// Indices into `loops` of the holes (loops that are not the outer loop of their component).
+    pub fn holes(&self) -> impl Iterator<Item = usize> + '_ {
+        self.loops
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| !l.is_outer)
+            .map(|(i, _)| i)
+    }
+
+    /// The id of the edge joining `a` and `b` (in either order), by binary search.
+    pub fn edge_between(&self, a: u32, b: u32) -> Option<usize> {
+        let key = [a.min(b), a.max(b)];
+        self.edges.binary_search_by(|e| e.v.cmp(&key)).ok()
+    }
+
+    /// Ids of the edges incident to vertex `v`, in increasing order (empty for out-of-range
+    /// or unreferenced vertices).
+    pub fn edges_at(&self, v: usize) -> &[u32] {
+        let (Some(&s), Some(&e)) = (
+            self.vertex_edge_start.get(v),
+            self.vertex_edge_start.get(v + 1),
+        ) else {
+            return &[];
+        };
+        self.vertex_edges.get(s as usize..e as usize).unwrap_or(&[])
+    }
+}

@@ -1,0 +1,103 @@
+//! A vault to analyse: a validated mesh plus what acts on it (densities, point loads,
+//! prescribed horizontal forces and normal stresses at free edges).
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+
+/// A mesh and its loading. Construct with [`Problem::new`] and the validating `with_*` setters.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    pub mesh: Mesh,
+    /// Weight per unit area of each face (density × thickness × g). Default 1.
+    pub face_density: Vec<f64>,
+    /// Extra vertical load per vertex (downward positive). Default 0.
+    pub extra_loads: Vec<f64>,
+    /// Prescribed horizontal force per vertex; non-zero only at free boundary vertices.
+    pub horizontal_forces: Vec<[f64; 2]>,
+    /// Inward normal push per free boundary vertex, used with `TauMode::Prescribed`.
+    pub prescribed_tau: Vec<f64>,
+}
+
+fn check_len(name: &'static str, len: usize, expected: usize, what: &str) -> Result<()> {
+    if len != expected {
+        return Err(Error::InvalidArgument {
+            name,
+            reason: format!("has {len} entries, expected one per {what} ({expected})"),
+        });
+    }
+    Ok(())
+}
+
+impl Problem {
+    pub fn new(mesh: Mesh) -> Problem {
+        let (nv, nf) = (mesh.positions.len(), mesh.faces.len());
+        Problem {
+            mesh,
+            face_density: vec![1.0; nf],
+            extra_loads: vec![0.0; nv],
+            horizontal_forces: vec![[0.0; 2]; nv],
+            prescribed_tau: vec![0.0; nv],
+        }
+    }
+
+    /// Per-face density: finite and >= 0.
+    pub fn with_face_density(mut self, density: Vec<f64>) -> Result<Problem> {
+        check_len("face_density", density.len(), self.mesh.faces.len(), "face")?;
+        if let Some(t) = density.iter().position(|d| !d.is_finite() || *d < 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "face_density",
+                reason: format!("face {t} has {} (must be finite and >= 0)", density[t]),
+            });
+        }
+        self.face_density = density;
+        Ok(self)
+    }
+
+    /// Extra vertical loads per vertex: finite (negative values lift).
+    pub fn with_extra_loads(mut self, loads: Vec<f64>) -> Result<Problem> {
+        check_len("extra_loads", loads.len(), self.mesh.positions.len(), "vertex")?;
+        if let Some(v) = loads.iter().position(|d| !d.is_finite()) {
+            return Err(Error::InvalidArgument {
+                name: "extra_loads",
+                reason: format!("vertex {v} has a non-finite load"),
+            });
+        }
+        self.extra_loads = loads;
+        Ok(self)
+    }
+
+    /// Horizontal forces per vertex; only free boundary vertices may carry one (interior
+    /// vertices are balanced exactly by the Airy function, anchored ones by their support).
+    pub fn with_horizontal_forces(mut self, forces: Vec<[f64; 2]>) -> Result<Problem> {
+        check_len("horizontal_forces", forces.len(), self.mesh.positions.len(), "vertex")?;
+        for (v, f) in forces.iter().enumerate() {
+            if !f[0].is_finite() || !f[1].is_finite() {
+                return Err(Error::InvalidArgument {
+                    name: "horizontal_forces",
+                    reason: format!("vertex {v} has a non-finite force"),
+                });
+            }
+            if (f[0] != 0.0 || f[1] != 0.0) && !self.mesh.is_free_boundary(v) {
+                return Err(Error::InvalidArgument {
+                    name: "horizontal_forces",
+                    reason: format!("vertex {v} is not a free boundary vertex"),
+                });
+            }
+        }
+        self.horizontal_forces = forces;
+        Ok(self)
+    }
+
+    /// Prescribed normal push per vertex (used at free boundary vertices): finite and >= 0.
+    pub fn with_prescribed_tau(mut self, tau: Vec<f64>) -> Result<Problem> {
+        check_len("prescribed_tau", tau.len(), self.mesh.positions.len(), "vertex")?;
+        if let Some(v) = tau.iter().position(|t| !t.is_finite() || *t < 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "prescribed_tau",
+                reason: format!("vertex {v} has {} (must be finite and >= 0)", tau[v]),
+            });
+        }
+        self.prescribed_tau = tau;
+        Ok(self)
+    }
+}

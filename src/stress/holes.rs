@@ -1,0 +1,163 @@
+//! Cuts for the multivalued Airy function on domains with holes (MATH §6).
+//!
+//! Each hole gets a shortest edge path from its loop to its component's outer loop through
+//! interior vertices, and the set R_h of faces that touch the path on its right. The faces of
+//! R_h see φ + M_h on the path's vertices, which lets the stress carry a net torque (constant
+//! part c_h) and a net force (affine part a_h) around the hole while keeping every interior
+//! vertex in exact horizontal balance.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use std::collections::VecDeque;
+
+/// The cut of one hole: path vertices (hole loop first, outer loop last), cut edges and the
+/// faces on the right of the path.
+#[derive(Debug, Clone)]
+pub struct HoleCut {
+    /// Index into `mesh.loops` of the hole.
+    pub loop_index: usize,
+    pub path: Vec<u32>,
+    pub cut_edges: Vec<u32>,
+    /// Sorted face ids of R_h.
+    pub right_faces: Vec<u32>,
+}
+
+impl HoleCut {
+    pub fn is_cut_edge(&self, e: u32) -> bool {
+        self.cut_edges.contains(&e)
+    }
+
+    pub fn is_right_face(&self, t: u32) -> bool {
+        self.right_faces.binary_search(&t).is_ok()
+    }
+
+    pub fn on_path(&self, v: u32) -> bool {
+        self.path.contains(&v)
+    }
+}
+
+/// The face containing the directed edge a→b, and its third vertex.
+pub fn face_of_directed(mesh: &Mesh, a: u32, b: u32) -> Option<(u32, u32)> {
+    let e = &mesh.edges[mesh.edge_between(a, b)?];
+    let side = if e.v[0] == a { e.left } else { e.right };
+    side.map(|s| (s.face, s.opposite))
+}
+
+/// Builds the cut of every hole of `mesh`.
+pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
+    let n = mesh.positions.len();
+    let mut loop_of = vec![usize::MAX; n];
+    for (l, lp) in mesh.loops.iter().enumerate() {
+        for &v in &lp.vertices {
+            loop_of[v as usize] = l;
+        }
+    }
+    let mut cuts = Vec::new();
+    for (h, lp) in mesh.loops.iter().enumerate().filter(|(_, l)| !l.is_outer) {
+        let path = shortest_path(mesh, h, &loop_of).ok_or(Error::HoleNotCuttable {
+            hole: cuts.len(),
+            vertex: lp.vertices[0] as usize,
+        })?;
+        let cut_edges: Vec<u32> = path
+            .windows(2)
+            .map(|w| mesh.edge_between(w[0], w[1]).expect("path edge") as u32)
+            .collect();
+        let mut right_faces = Vec::new();
+        for k in 0..path.len() {
+            right_sector(mesh, &path, k, &mut right_faces);
+        }
+        right_faces.sort_unstable();
+        right_faces.dedup();
+        cuts.push(HoleCut { loop_index: h, path, cut_edges, right_faces });
+    }
+    Ok(cuts)
+}
+
+/// Breadth-first search from every vertex of loop `h` through interior vertices to the outer
+/// loop of the same component.
+fn shortest_path(mesh: &Mesh, h: usize, loop_of: &[usize]) -> Option<Vec<u32>> {
+    let n = mesh.positions.len();
+    let mut parent = vec![u32::MAX; n];
+    let mut queue = VecDeque::new();
+    for &v in &mesh.loops[h].vertices {
+        parent[v as usize] = v;
+        queue.push_back(v);
+    }
+    let neighbours = |v: u32| {
+        let (s, e) = (mesh.vertex_edge_start[v as usize], mesh.vertex_edge_start[v as usize + 1]);
+        mesh.vertex_edges[s as usize..e as usize].iter().map(move |&ed| {
+            let ed = &mesh.edges[ed as usize];
+            if ed.v[0] == v {
+                ed.v[1]
+            } else {
+                ed.v[0]
+            }
+        })
+    };
+    while let Some(v) = queue.pop_front() {
+        for w in neighbours(v) {
+            if parent[w as usize] != u32::MAX {
+                continue;
+            }
+            let l = loop_of[w as usize];
+            if l != usize::MAX && mesh.loops[l].is_outer {
+                let mut path = vec![w, v];
+                let mut x = v;
+                while parent[x as usize] != x {
+                    x = parent[x as usize];
+                    path.push(x);
+                }
+                path.reverse();
+                return Some(path);
+            }
+            if !mesh.on_boundary[w as usize] {
+                parent[w as usize] = v;
+                queue.push_back(w);
+            }
+        }
+    }
+    None
+}
+
+/// Adds the faces of path vertex k's fan that lie on the right of the path: counter-clockwise
+/// from the incoming path edge (or the start of a boundary fan) to the outgoing one (or the
+/// end of the fan).
+fn right_sector(mesh: &Mesh, path: &[u32], k: usize, out: &mut Vec<u32>) {
+    let v = path[k];
+    let next = path.get(k + 1).copied();
+    let start = if k > 0 {
+        face_of_directed(mesh, v, path[k - 1])
+    } else {
+        fan_start(mesh, v)
+    };
+    let mut current = start;
+    let mut guard = 0;
+    while let Some((t, _)) = current {
+        out.push(t);
+        let f = mesh.faces[t as usize];
+        let i = f.iter().position(|&x| x == v).expect("fan face");
+        let y = f[(i + 2) % 3];
+        if Some(y) == next {
+            return;
+        }
+        current = face_of_directed(mesh, v, y);
+        guard += 1;
+        if guard > mesh.faces.len() {
+            return;
+        }
+    }
+}
+
+/// The first face of a boundary vertex's fan in counter-clockwise order: the face (v, x, y)
+/// whose edge v–x is a boundary edge.
+fn fan_start(mesh: &Mesh, v: u32) -> Option<(u32, u32)> {
+    let (s, e) = (mesh.vertex_edge_start[v as usize], mesh.vertex_edge_start[v as usize + 1]);
+    mesh.vertex_edges[s as usize..e as usize].iter().find_map(|&ed| {
+        let ed = &mesh.edges[ed as usize];
+        if !ed.is_boundary() {
+            return None;
+        }
+        let x = if ed.v[0] == v { ed.v[1] } else { ed.v[0] };
+        face_of_directed(mesh, v, x)
+    })
+}

@@ -1,0 +1,330 @@
+//! Stress optimisation: the best compressive force densities for a fixed shape (MATH §3–8).
+//!
+//! Both formulations build q = S y for their own unknowns and share one QP ([`qp`]); the
+//! result is recomputed in physical units from the returned force densities, so every figure
+//! it reports (residuals, ε∞, imbalance) is a certificate, not the solver's own claim.
+
+pub mod airy;
+pub mod holes;
+mod qp;
+pub mod settings;
+pub mod sparse;
+
+use crate::error::Result;
+use crate::geometry::dual::{self, ForceDiagram};
+use crate::geometry::{loads, Frame, Plan};
+use crate::mesh::Mesh;
+use crate::problem::Problem;
+use airy::AiryOperator;
+use clarabel::solver::SolverStatus;
+pub use settings::{EdgeScope, Formulation, QBound, StressSettings, TauMode};
+use sparse::Csr;
+use std::time::Instant;
+
+/// How the stress QP ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StressStatus {
+    Solved,
+    /// Solved to reduced accuracy.
+    AlmostSolved,
+    /// The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
+    Infeasible,
+    MaxIterations,
+    NumericalError,
+}
+
+impl StressStatus {
+    fn from_clarabel(s: SolverStatus) -> StressStatus {
+        match s {
+            SolverStatus::Solved => StressStatus::Solved,
+            SolverStatus::AlmostSolved => StressStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                StressStatus::Infeasible
+            }
+            SolverStatus::MaxIterations | SolverStatus::MaxTime => StressStatus::MaxIterations,
+            _ => StressStatus::NumericalError,
+        }
+    }
+
+    /// True when the force densities are a usable optimum.
+    pub fn is_solved(self) -> bool {
+        matches!(self, StressStatus::Solved | StressStatus::AlmostSolved)
+    }
+}
+
+/// The outcome of one stress step, in physical units.
+#[derive(Debug, Clone)]
+pub struct StressResult {
+    pub status: StressStatus,
+    /// Force density per mesh edge (compression positive; 0 on edges that carry none).
+    pub force_densities: Vec<f64>,
+    /// Airy value φ per vertex (0 at unreferenced vertices).
+    pub airy: Vec<f64>,
+    /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram.
+    pub weights: Vec<f64>,
+    /// Hole jump M_h(u) = c + a·u per hole as (c, a_x, a_y), in the order of the mesh's holes.
+    pub hole_coefficients: Vec<[f64; 3]>,
+    /// Inward normal push τ per vertex (non-zero only at free boundary vertices).
+    pub tau: Vec<f64>,
+    /// External horizontal force per vertex needed at free edges: P − τ ν.
+    pub external_horizontal: Vec<[f64; 2]>,
+    /// Vertical load per vertex used by this step.
+    pub loads: Vec<f64>,
+    /// Vertical residual Σ_j q_ij (z_i − z_j) − p_i per non-anchored vertex (0 elsewhere).
+    pub residuals: Vec<f64>,
+    /// Horizontal imbalance Σ_j q_ij (u_i − u_j) + external per non-anchored vertex.
+    pub horizontal_imbalance: Vec<[f64; 2]>,
+    /// max |r_i| / mean p_i over non-anchored vertices.
+    pub eps_inf: f64,
+    /// Σ r_i² over non-anchored vertices.
+    pub objective: f64,
+    pub force_diagram: ForceDiagram,
+    pub iterations: u32,
+    pub seconds: f64,
+}
+
+/// Optimises the stress of `problem` as given (its mesh positions).
+pub fn analyse(problem: &Problem, settings: &StressSettings) -> Result<StressResult> {
+    analyse_at(problem, &problem.mesh.positions, settings)
+}
+
+/// Vertices whose equations count: referenced and not anchored.
+pub fn non_anchored(mesh: &Mesh) -> Vec<u32> {
+    (0..mesh.positions.len() as u32).filter(|&v| mesh.is_non_anchored(v as usize)).collect()
+}
+
+/// Unit outward normals (sum of the two boundary edges' normals) at boundary vertices.
+pub fn boundary_normals(mesh: &Mesh, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let mut nrm = vec![[0.0; 2]; u.len()];
+    for lp in &mesh.loops {
+        let n = lp.vertices.len();
+        for k in 0..n {
+            let (a, b) = (lp.vertices[k] as usize, lp.vertices[(k + 1) % n] as usize);
+            let d = [u[b][0] - u[a][0], u[b][1] - u[a][1]];
+            let len = d[0].hypot(d[1]);
+            let out = [d[1] / len, -d[0] / len];
+            for v in [a, b] {
+                nrm[v][0] += out[0];
+                nrm[v][1] += out[1];
+            }
+        }
+    }
+    for m in &mut nrm {
+        let len = m[0].hypot(m[1]);
+        if len > 0.0 {
+            *m = [m[0] / len, m[1] / len];
+        }
+    }
+    nrm
+}
+
+/// Optimises the stress of `problem` with the vertices at `positions`.
+pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSettings) -> Result<StressResult> {
+    settings.validate()?;
+    let start = Instant::now();
+    let mesh = &problem.mesh;
+    let n = positions.len();
+    let frame = Frame::of(mesh, positions);
+    let plan = Plan::new(mesh, positions, &frame);
+    let l0 = frame.scale;
+    let load = loads::vertex_loads(mesh, positions, settings.load_rule, &problem.face_density, &problem.extra_loads);
+    let free = non_anchored(mesh);
+    let mean_load = mean_over(&load, &free);
+    let p_bar = if mean_load > 0.0 { mean_load } else { 1.0 };
+    let unit = p_bar / l0; // natural force density scale
+
+    // Frame units: z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄.
+    let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
+    let p: Vec<f64> = load.iter().map(|x| x / p_bar).collect();
+    let normal = boundary_normals(mesh, &plan.u);
+    let mut external: Vec<[f64; 2]> = problem.horizontal_forces.iter().map(|f| [f[0] / p_bar, f[1] / p_bar]).collect();
+    let mut tau_normal = vec![None; n];
+    for v in 0..n {
+        if !mesh.is_free_boundary(v) {
+            continue;
+        }
+        match settings.tau {
+            TauMode::Optimized => tau_normal[v] = Some(normal[v]),
+            TauMode::Zero => {}
+            TauMode::Prescribed => {
+                let t = problem.prescribed_tau[v] / p_bar;
+                external[v][0] -= t * normal[v][0];
+                external[v][1] -= t * normal[v][1];
+            }
+        }
+    }
+
+    let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
+    let active = |e: usize| {
+        let edge = &mesh.edges[e];
+        !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize])
+    };
+    let q_min = settings.q_min.physical(unit) / unit;
+    let q_max = settings.q_max.map_or(f64::INFINITY, |b| b.physical(unit) / unit);
+    let bounds: Vec<Option<(f64, f64)>> = (0..edges.len())
+        .map(|e| {
+            active(e).then(|| {
+                let scoped = settings.q_min_scope == EdgeScope::All || !mesh.edges[e].is_boundary();
+                (if scoped { q_min } else { 0.0 }, q_max)
+            })
+        })
+        .collect();
+
+    let (airy_op, s, balance): (Option<AiryOperator>, Csr, Vec<u32>) = match settings.formulation {
+        Formulation::Reduced => {
+            let op = AiryOperator::new(mesh, &plan, settings.holes)?;
+            let s = op.s.clone();
+            let balance = free.iter().copied().filter(|&v| mesh.on_boundary[v as usize]).collect();
+            (Some(op), s, balance)
+        }
+        Formulation::EdgeBased => {
+            let n_active = bounds.iter().filter(|b| b.is_some()).count();
+            let mut s = Csr::new(n_active);
+            let mut col = 0;
+            for b in &bounds {
+                if b.is_some() {
+                    s.push_row(vec![(col, 1.0)]);
+                    col += 1;
+                } else {
+                    s.push_row(Vec::new());
+                }
+            }
+            // Interior point supports take vertical reactions only (MATH §5).
+            let balance = (0..n as u32)
+                .filter(|&v| {
+                    let v = v as usize;
+                    mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v])
+                })
+                .collect();
+            (None, s, balance)
+        }
+    };
+
+    let out = qp::solve(&qp::QpInput {
+        s: &s,
+        edges: &edges,
+        length: &plan.length,
+        u: &plan.u,
+        z: &z,
+        residual_vertices: &free,
+        load: &p,
+        balance_vertices: &balance,
+        external: &external,
+        tau_normal: &tau_normal,
+        bounds: &bounds,
+        regularisation: settings.regularisation,
+    });
+    let status = StressStatus::from_clarabel(out.status);
+    let usable = status.is_solved() || status == StressStatus::MaxIterations;
+    let y = if usable { out.y } else { vec![0.0; s.ncols] };
+    let q_frame = s.mul(&y);
+    let tau_frame = if usable { out.tau } else { vec![0.0; n] };
+
+    // Back to physical units.
+    let force_densities: Vec<f64> = q_frame.iter().map(|q| q * unit).collect();
+    let tau: Vec<f64> = match settings.tau {
+        TauMode::Prescribed => (0..n)
+            .map(|v| if mesh.is_free_boundary(v) { problem.prescribed_tau[v] } else { 0.0 })
+            .collect(),
+        _ => tau_frame.iter().map(|t| t * p_bar).collect(),
+    };
+    let external_horizontal: Vec<[f64; 2]> = (0..n)
+        .map(|v| {
+            let f = problem.horizontal_forces[v];
+            [f[0] - tau[v] * normal[v][0], f[1] - tau[v] * normal[v][1]]
+        })
+        .collect();
+
+    let (airy_frame, hole_frame, centres_frame) = match &airy_op {
+        Some(op) => {
+            let phi = op.airy_values(&y);
+            let holes = (0..op.cuts.len()).map(|h| op.hole_jump(&y, h)).collect();
+            let centres = dual::centres_from_airy(mesh, &plan, op, &phi, &y);
+            (phi, holes, centres)
+        }
+        None => {
+            let centres = dual::centres_from_forces(mesh, &plan, &q_frame);
+            let phi = dual::airy_from_centres(mesh, &plan, &centres);
+            (phi, Vec::new(), centres)
+        }
+    };
+    let airy: Vec<f64> = airy_frame.iter().map(|f| f * p_bar * l0).collect();
+    let weights = (0..n)
+        .map(|v| {
+            let p = positions[v];
+            if mesh.referenced[v] {
+                p[0] * p[0] + p[1] * p[1] - 2.0 * airy[v]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let hole_coefficients = hole_frame
+        .iter()
+        .map(|m| {
+            let a = [m[1] * p_bar, m[2] * p_bar];
+            [p_bar * l0 * m[0] - a[0] * frame.centre[0] - a[1] * frame.centre[1], a[0], a[1]]
+        })
+        .collect();
+    let force_diagram = dual::diagram(mesh, &centres_frame, airy_op.as_ref(), &y, p_bar);
+
+    let (residuals, horizontal_imbalance) =
+        equilibrium(mesh, positions, &force_densities, &load, &external_horizontal);
+    let max_r = free.iter().map(|&v| residuals[v as usize].abs()).fold(0.0, f64::max);
+    let objective = free.iter().map(|&v| residuals[v as usize].powi(2)).sum();
+    Ok(StressResult {
+        status,
+        force_densities,
+        airy,
+        weights,
+        hole_coefficients,
+        tau,
+        external_horizontal,
+        loads: load,
+        residuals,
+        horizontal_imbalance,
+        eps_inf: max_r / p_bar,
+        objective,
+        force_diagram,
+        iterations: out.iterations,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn mean_over(x: &[f64], ids: &[u32]) -> f64 {
+    if ids.is_empty() {
+        return 0.0;
+    }
+    ids.iter().map(|&v| x[v as usize]).sum::<f64>() / ids.len() as f64
+}
+
+/// Vertical residual and horizontal imbalance at every non-anchored vertex, recomputed from
+/// positions, force densities, loads and external horizontal forces (zero elsewhere).
+pub fn equilibrium(
+    mesh: &Mesh,
+    positions: &[[f64; 3]],
+    q: &[f64],
+    load: &[f64],
+    external: &[[f64; 2]],
+) -> (Vec<f64>, Vec<[f64; 2]>) {
+    let n = positions.len();
+    let mut r = vec![0.0; n];
+    let mut h = vec![[0.0; 2]; n];
+    for v in 0..n {
+        if mesh.is_non_anchored(v) {
+            r[v] = -load[v];
+            h[v] = external[v];
+        }
+    }
+    for (e, edge) in mesh.edges.iter().enumerate() {
+        let [i, j] = edge.v.map(|v| v as usize);
+        for (a, b) in [(i, j), (j, i)] {
+            if mesh.is_non_anchored(a) {
+                r[a] += q[e] * (positions[a][2] - positions[b][2]);
+                h[a][0] += q[e] * (positions[a][0] - positions[b][0]);
+                h[a][1] += q[e] * (positions[a][1] - positions[b][1]);
+            }
+        }
+    }
+    (r, h)
+}

@@ -1,0 +1,203 @@
+//! The stress QP of MATH §8, shared by the reduced and the edge-based formulations: both give
+//! q = S y for their own unknowns y, and differ only in S and in which vertices need explicit
+//! horizontal balance rows.
+//!
+//!   minimise    ‖r‖² + ε Σ_e (l_e q_e)²
+//!   subject to  r = G S y − p             (vertical residuals, lifted: keeps the KKT sparse)
+//!               H S y − τ ν = −P          (horizontal balance rows)
+//!               lower ≤ S y ≤ upper on active edges,  τ ≥ 0
+
+use super::sparse::Csr;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+/// Everything the QP needs, in frame (nondimensional) units.
+pub struct QpInput<'a> {
+    /// q (one entry per mesh edge) = s · y.
+    pub s: &'a Csr,
+    /// Edge end points.
+    pub edges: &'a [[u32; 2]],
+    /// Plan length per edge (for the regulariser).
+    pub length: &'a [f64],
+    /// Plan positions and heights per vertex.
+    pub u: &'a [[f64; 2]],
+    pub z: &'a [f64],
+    /// Vertices whose vertical residual is minimised, and their loads.
+    pub residual_vertices: &'a [u32],
+    pub load: &'a [f64],
+    /// Vertices with hard horizontal balance, their external force P and fixed normal push.
+    pub balance_vertices: &'a [u32],
+    pub external: &'a [[f64; 2]],
+    /// Per vertex: Some(normal) when an optimised τ ≥ 0 acts along −normal at that vertex.
+    pub tau_normal: &'a [Option<[f64; 2]>],
+    /// Per edge: None for an edge without force, else (lower, upper) bounds on q.
+    pub bounds: &'a [Option<(f64, f64)>],
+    pub regularisation: f64,
+}
+
+/// What the solver returned.
+pub struct QpOutput {
+    pub y: Vec<f64>,
+    /// Optimised τ per vertex (0 where none).
+    pub tau: Vec<f64>,
+    pub status: SolverStatus,
+    pub iterations: u32,
+}
+
+struct Triplets {
+    i: Vec<usize>,
+    j: Vec<usize>,
+    v: Vec<f64>,
+}
+
+impl Triplets {
+    fn push(&mut self, i: usize, j: usize, v: f64) {
+        if v != 0.0 {
+            self.i.push(i);
+            self.j.push(j);
+            self.v.push(v);
+        }
+    }
+}
+
+pub fn solve(inp: &QpInput) -> QpOutput {
+    let n_y = inp.s.ncols;
+    let n_vertices = inp.u.len();
+    let mut tau_col = vec![None; n_vertices];
+    let mut n_tau = 0;
+    for (v, nrm) in inp.tau_normal.iter().enumerate() {
+        if nrm.is_some() {
+            tau_col[v] = Some(n_y + n_tau);
+            n_tau += 1;
+        }
+    }
+    let r_start = n_y + n_tau;
+    let n = r_start + inp.residual_vertices.len();
+
+    // Objective: ½ xᵀ P x with P = 2 (ε Sᵀ D S ⊕ 0 ⊕ I), upper triangle.
+    let mut p = Triplets { i: vec![], j: vec![], v: vec![] };
+    for e in 0..inp.s.nrows() {
+        let w = 2.0 * inp.regularisation * inp.length[e] * inp.length[e];
+        for (c1, v1) in inp.s.row(e) {
+            for (c2, v2) in inp.s.row(e) {
+                if c1 <= c2 {
+                    p.push(c1, c2, w * v1 * v2);
+                }
+            }
+        }
+    }
+    for k in 0..inp.residual_vertices.len() {
+        p.push(r_start + k, r_start + k, 2.0);
+    }
+
+    // Vertex → incident edges, for the G S and H S rows.
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
+    for (e, ev) in inp.edges.iter().enumerate() {
+        if inp.bounds[e].is_some() {
+            incident[ev[0] as usize].push(e);
+            incident[ev[1] as usize].push(e);
+        }
+    }
+    let other = |e: usize, v: u32| {
+        let ev = inp.edges[e];
+        if ev[0] == v {
+            ev[1]
+        } else {
+            ev[0]
+        }
+    };
+
+    let mut a = Triplets { i: vec![], j: vec![], v: vec![] };
+    let mut b = Vec::new();
+    let mut row = 0;
+    // Vertical residuals: Σ_e (z_i − z_j) q_e − r_i = p_i.
+    for (k, &i) in inp.residual_vertices.iter().enumerate() {
+        for &e in &incident[i as usize] {
+            let dz = inp.z[i as usize] - inp.z[other(e, i) as usize];
+            for (c, s) in inp.s.row(e) {
+                a.push(row, c, dz * s);
+            }
+        }
+        a.push(row, r_start + k, -1.0);
+        b.push(inp.load[i as usize]);
+        row += 1;
+    }
+    // Horizontal balance: Σ_e (u_i − u_j) q_e − τ_i ν_i = −P_i.
+    for &i in inp.balance_vertices {
+        for d in 0..2 {
+            for &e in &incident[i as usize] {
+                let du = inp.u[i as usize][d] - inp.u[other(e, i) as usize][d];
+                for (c, s) in inp.s.row(e) {
+                    a.push(row, c, du * s);
+                }
+            }
+            if let (Some(c), Some(nrm)) = (tau_col[i as usize], inp.tau_normal[i as usize]) {
+                a.push(row, c, -nrm[d]);
+            }
+            b.push(-inp.external[i as usize][d]);
+            row += 1;
+        }
+    }
+    let n_zero = row;
+    // Bounds: q_e − lower ≥ 0, upper − q_e ≥ 0, τ ≥ 0.
+    for (e, bound) in inp.bounds.iter().enumerate() {
+        if let Some((lower, _)) = bound {
+            for (c, s) in inp.s.row(e) {
+                a.push(row, c, -s);
+            }
+            b.push(-lower);
+            row += 1;
+        }
+    }
+    for (e, bound) in inp.bounds.iter().enumerate() {
+        if let Some((_, upper)) = bound.filter(|(_, u)| u.is_finite()) {
+            for (c, s) in inp.s.row(e) {
+                a.push(row, c, s);
+            }
+            b.push(upper);
+            row += 1;
+        }
+    }
+    for c in tau_col.iter().flatten() {
+        a.push(row, *c, -1.0);
+        b.push(0.0);
+        row += 1;
+    }
+
+    let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
+    let am = CscMatrix::new_from_triplets(row, n, a.i, a.j, a.v);
+    let q = vec![0.0; n];
+    let cones = [SupportedConeT::ZeroConeT(n_zero), SupportedConeT::NonnegativeConeT(row - n_zero)];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(200)
+        // Tighter than the defaults (1e-8): the residual vector must be reproducible to ~1e-6
+        // of the mean load, and the objective is often flat near its optimum.
+        .tol_gap_abs(1e-11)
+        .tol_gap_rel(1e-11)
+        .tol_feas(1e-10)
+        .build()
+        .expect("static clarabel settings are valid");
+    let mut solver = match DefaultSolver::new(&pm, &q, &am, &b, &cones, settings) {
+        Ok(s) => s,
+        Err(_) => {
+            return QpOutput {
+                y: vec![0.0; n_y],
+                tau: vec![0.0; n_vertices],
+                status: SolverStatus::NumericalError,
+                iterations: 0,
+            }
+        }
+    };
+    solver.solve();
+    let x = &solver.solution.x;
+    let tau = tau_col.iter().map(|c| c.map_or(0.0, |c| x[c])).collect();
+    QpOutput {
+        y: x[..n_y].to_vec(),
+        tau,
+        status: solver.solution.status,
+        iterations: solver.solution.iterations,
+    }
+}

@@ -1,0 +1,117 @@
+//! Options of the stress step, validated before any work is done.
+
+use super::airy::HoleMode;
+use crate::error::{Error, Result};
+use crate::geometry::loads::LoadRule;
+
+/// Which edges a lower bound q_min applies to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EdgeScope {
+    /// Interior edges only; boundary creases stay merely q ≥ 0.
+    #[default]
+    Interior,
+    /// Interior and boundary edges.
+    All,
+}
+
+/// Normal stress at free boundary vertices (MATH §5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TauMode {
+    /// An optimised inward push τ ≥ 0 per free vertex, as the paper does. Non-zero τ means the
+    /// free edge needs a tie or buttress there: results report it per vertex.
+    #[default]
+    Optimized,
+    /// No normal stress: a truly free edge.
+    Zero,
+    /// The per-vertex values given in [`crate::Problem::prescribed_tau`].
+    Prescribed,
+}
+
+/// A force-density bound, either physical (force per length) or relative to the problem's
+/// natural scale p̄ / L₀ (mean load over non-anchored vertices / half the plan diagonal).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum QBound {
+    Absolute(f64),
+    Relative(f64),
+}
+
+impl QBound {
+    /// The bound in physical units for a problem with natural scale `unit` = p̄ / L₀.
+    pub fn physical(self, unit: f64) -> f64 {
+        match self {
+            QBound::Absolute(v) => v,
+            QBound::Relative(v) => v * unit,
+        }
+    }
+
+    fn value(self) -> f64 {
+        match self {
+            QBound::Absolute(v) | QBound::Relative(v) => v,
+        }
+    }
+}
+
+/// Which formulation solves the stress QP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Formulation {
+    /// de Goes et al. 2013: Airy values (vertex weights) as unknowns, one equation per vertex.
+    #[default]
+    Reduced,
+    /// Vouga et al. 2012: one force density per edge, three equations per vertex. Reference.
+    EdgeBased,
+}
+
+/// Settings of one stress step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StressSettings {
+    /// Lower bound on force densities (default: absolute 0, plain compression).
+    pub q_min: QBound,
+    pub q_min_scope: EdgeScope,
+    /// Optional upper bound on force densities (allowable stress × thickness).
+    pub q_max: Option<QBound>,
+    pub tau: TauMode,
+    pub holes: HoleMode,
+    pub load_rule: LoadRule,
+    pub formulation: Formulation,
+    /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10.
+    pub regularisation: f64,
+}
+
+impl Default for StressSettings {
+    fn default() -> Self {
+        StressSettings {
+            q_min: QBound::Absolute(0.0),
+            q_min_scope: EdgeScope::Interior,
+            q_max: None,
+            tau: TauMode::Optimized,
+            holes: HoleMode::Constant,
+            load_rule: LoadRule::Barycentric,
+            formulation: Formulation::Reduced,
+            regularisation: 1e-10,
+        }
+    }
+}
+
+impl StressSettings {
+    /// Rejects NaN, negative or inconsistent values, naming the field.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, reason: &str| Err(Error::InvalidArgument { name, reason: reason.into() });
+        let q_min = self.q_min.value();
+        if !q_min.is_finite() || q_min < 0.0 {
+            return bad("q_min", "must be finite and >= 0");
+        }
+        if let Some(q_max) = self.q_max {
+            let v = q_max.value();
+            if v.is_nan() || v <= 0.0 {
+                return bad("q_max", "must be > 0 (or unset)");
+            }
+            if std::mem::discriminant(&q_max) == std::mem::discriminant(&self.q_min) && v < q_min {
+                return bad("q_max", "must be >= q_min");
+            }
+        }
+        if !self.regularisation.is_finite() || self.regularisation < 0.0 {
+            return bad("regularisation", "must be finite and >= 0");
+        }
+        Ok(())
+    }
+}

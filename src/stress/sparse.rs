@@ -1,0 +1,76 @@
+//! A minimal compressed-row matrix: the force map q = S y is built row by row (one row per
+//! edge) and consumed row by row when the QP is assembled.
+
+/// Compressed sparse rows; duplicate entries within a row are summed on construction.
+#[derive(Debug, Clone, Default)]
+pub struct Csr {
+    pub ncols: usize,
+    pub start: Vec<usize>,
+    pub col: Vec<usize>,
+    pub val: Vec<f64>,
+}
+
+impl Csr {
+    pub fn new(ncols: usize) -> Csr {
+        Csr { ncols, start: vec![0], col: Vec::new(), val: Vec::new() }
+    }
+
+    pub fn nrows(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Appends a row from (column, value) pairs, summing repeated columns, dropping zeros.
+    pub fn push_row(&mut self, mut entries: Vec<(usize, f64)>) {
+        entries.sort_unstable_by_key(|e| e.0);
+        let row_start = self.col.len();
+        for (c, v) in entries {
+            debug_assert!(c < self.ncols);
+            if self.col.len() > row_start && *self.col.last().unwrap() == c {
+                *self.val.last_mut().unwrap() += v;
+            } else {
+                self.col.push(c);
+                self.val.push(v);
+            }
+        }
+        // Drop exact zeros left by cancellation, keeping the pattern minimal.
+        let mut w = row_start;
+        for r in row_start..self.col.len() {
+            if self.val[r] != 0.0 {
+                self.col[w] = self.col[r];
+                self.val[w] = self.val[r];
+                w += 1;
+            }
+        }
+        self.col.truncate(w);
+        self.val.truncate(w);
+        self.start.push(w);
+    }
+
+    pub fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let range = self.start[r]..self.start[r + 1];
+        self.col[range.clone()].iter().copied().zip(self.val[range].iter().copied())
+    }
+
+    pub fn row_len(&self, r: usize) -> usize {
+        self.start[r + 1] - self.start[r]
+    }
+
+    pub fn mul(&self, x: &[f64]) -> Vec<f64> {
+        (0..self.nrows()).map(|r| self.row(r).map(|(c, v)| v * x[c]).sum()).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_sum_duplicates_and_drop_zeros() {
+        let mut m = Csr::new(4);
+        m.push_row(vec![(2, 1.0), (0, 2.0), (2, 3.0)]);
+        m.push_row(vec![(1, 1.0), (1, -1.0), (3, 5.0)]);
+        assert_eq!(m.row(0).collect::<Vec<_>>(), vec![(0, 2.0), (2, 4.0)]);
+        assert_eq!(m.row(1).collect::<Vec<_>>(), vec![(3, 5.0)]);
+        assert_eq!(m.mul(&[1.0, 1.0, 1.0, 2.0]), vec![6.0, 10.0]);
+    }
+}

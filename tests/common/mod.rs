@@ -1,0 +1,106 @@
+//! Shared helpers of the integration tests: a small deterministic RNG, generated meshes and the
+//! path to the shared real models.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use voussoir::generate::{self, Domain};
+use voussoir::Mesh;
+
+/// xorshift64*: deterministic, bounded floats only (no NaN or inf by construction).
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The folder of the shared real models, or None (with a "skipped" line) when it is absent.
+pub fn models_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        println!("skipped: {} not found", dir.display());
+        None
+    }
+}
+
+pub const MODELS: [&str; 9] = [
+    "free_vault",
+    "dome_with_doors",
+    "lilium",
+    "cheese",
+    "four_holes",
+    "neumunster",
+    "hex",
+    "three_pillar",
+    "vault_pq",
+];
+
+pub fn load_model(name: &str) -> Option<Mesh> {
+    let dir = models_dir()?;
+    Some(
+        voussoir::io::load_model(&dir.join(format!("{name}.obj")), &dir.join(format!("{name}.json")))
+            .unwrap_or_else(|e| panic!("{name}: {e}")),
+    )
+}
+
+/// A spherical cap of rim angle `angle` on the structured polar disk, rim anchored.
+pub fn polar_cap(rings: usize, angle: f64) -> Mesh {
+    let (p, t) = generate::polar_disk(rings);
+    generate::lift(&p, &t, |u| generate::spherical_cap(1.0, angle, u[0].hypot(u[1])), |_, outer| outer).unwrap()
+}
+
+/// A unit disk meshed by spade with an off-centre hole of radius 0.25, heights of a 40° cap
+/// plus a random bump; `anchor` decides the supports from (plan point, on outer boundary).
+pub fn holed_disk(seed: u64, max_area: f64, anchor: impl Fn([f64; 2], bool) -> bool) -> Mesh {
+    let mut rng = Rng::new(seed);
+    let (a, b) = (rng.uniform(0.5, 2.0), rng.uniform(0.0, 6.0));
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, 48),
+        holes: vec![generate::circle([0.3, 0.1], 0.25, 16)],
+    };
+    let (p, t) = generate::triangulate(&domain, max_area).unwrap();
+    generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 0.7, u[0].hypot(u[1])) + 0.03 * (a * u[0] + b).sin() * u[1],
+        anchor,
+    )
+    .unwrap()
+}
+
+/// Moves every interior vertex of `mesh` by up to `amount` × (shortest incident edge) in plan,
+/// keeping the plan valid (Mesh::new validates), so the mesh is no longer Delaunay.
+pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
+    let mut rng = Rng::new(seed);
+    let mut pos = mesh.positions.clone();
+    for v in 0..pos.len() {
+        if mesh.on_boundary[v] || !mesh.referenced[v] {
+            continue;
+        }
+        let h = mesh
+            .edges_at(v)
+            .iter()
+            .map(|&e| {
+                let [a, b] = mesh.edges[e as usize].v.map(|x| mesh.positions[x as usize]);
+                (a[0] - b[0]).hypot(a[1] - b[1])
+            })
+            .fold(f64::INFINITY, f64::min);
+        pos[v][0] += amount * h * rng.uniform(-1.0, 1.0);
+        pos[v][1] += amount * h * rng.uniform(-1.0, 1.0);
+    }
+    let anchored: Vec<u32> = (0..pos.len() as u32).filter(|&v| mesh.anchored[v as usize]).collect();
+    Mesh::new(pos, mesh.faces.clone(), &anchored).expect("jiggled mesh stays valid")
+}
