@@ -14,7 +14,11 @@ pub enum Error {
     /// The mesh has no vertices or no faces.
     EmptyMesh,
     /// A face refers to a vertex index `>= n_vertices`.
-    IndexOutOfRange { face: usize, index: u64, n_vertices: usize },
+    IndexOutOfRange {
+        face: usize,
+        index: u64,
+        n_vertices: usize,
+    },
     /// An anchored (support) id is `>= n_vertices` or repeated.
     InvalidAnchor { index: u64, reason: &'static str },
     /// A vertex has a NaN or infinite coordinate.
@@ -36,7 +40,10 @@ pub enum Error {
     /// Interior vertices whose plan angles do not sum to 2π: the plan wraps around them.
     OverlappingPlan { vertices: Vec<usize> },
     /// A connected component of the mesh has no anchored vertex.
-    UnsupportedComponent { component: usize, vertices: Vec<usize> },
+    UnsupportedComponent {
+        component: usize,
+        vertices: Vec<usize>,
+    },
     /// No vertex is anchored at all.
     NoSupports,
     /// A hole could not be joined to its component's outer boundary through interior vertices.
@@ -46,11 +53,19 @@ pub enum Error {
     /// A file could not be read or written.
     Io { path: String, reason: String },
     /// A file could be read but its content is malformed.
-    Parse { path: String, line: usize, reason: String },
+    Parse {
+        path: String,
+        line: usize,
+        reason: String,
+    },
 }
 
 fn ids(list: &[usize]) -> String {
-    let mut s: Vec<String> = list.iter().take(MAX_IDS_SHOWN).map(|i| i.to_string()).collect();
+    let mut s: Vec<String> = list
+        .iter()
+        .take(MAX_IDS_SHOWN)
+        .map(|i| i.to_string())
+        .collect();
     if list.len() > MAX_IDS_SHOWN {
         s.push(format!("... ({} in all)", list.len()));
     }

@@ -3,7 +3,9 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+use spade::{
+    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
+};
 
 /// A plan domain: an outer polygon and hole polygons (any orientation).
 #[derive(Debug, Clone, Default)]
@@ -11,6 +13,9 @@ pub struct Domain {
     pub outer: Vec<[f64; 2]>,
     pub holes: Vec<Vec<[f64; 2]>>,
 }
+
+/// Plan points and triangles.
+pub type PlanMesh = (Vec<[f64; 2]>, Vec<[u32; 3]>);
 
 /// `n` points on a circle.
 pub fn circle(centre: [f64; 2], radius: f64, n: usize) -> Vec<[f64; 2]> {
@@ -42,13 +47,19 @@ pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64, nx: usize, ny: usize) -> Ve
 
 /// Plan points and triangles of `domain`, refined until no triangle is larger than `max_area`
 /// (angles at least 25° away from constraints).
-pub fn triangulate(domain: &Domain, max_area: f64) -> Result<(Vec<[f64; 2]>, Vec<[u32; 3]>)> {
-    let bad = |reason: String| Error::InvalidArgument { name: "domain", reason };
+pub fn triangulate(domain: &Domain, max_area: f64) -> Result<PlanMesh> {
+    let bad = |reason: String| Error::InvalidArgument {
+        name: "domain",
+        reason,
+    };
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
     for poly in std::iter::once(&domain.outer).chain(&domain.holes) {
         let mut handles = Vec::with_capacity(poly.len());
         for p in poly {
-            handles.push(cdt.insert(Point2::new(p[0], p[1])).map_err(|e| bad(format!("{e:?}")))?);
+            handles.push(
+                cdt.insert(Point2::new(p[0], p[1]))
+                    .map_err(|e| bad(format!("{e:?}")))?,
+            );
         }
         for k in 0..handles.len() {
             cdt.add_constraint(handles[k], handles[(k + 1) % handles.len()]);
@@ -60,8 +71,12 @@ pub fn triangulate(domain: &Domain, max_area: f64) -> Result<(Vec<[f64; 2]>, Vec
         .with_angle_limit(AngleLimit::from_deg(25.0))
         .with_max_additional_vertices(2_000_000);
     let refined = cdt.refine(params);
-    let excluded: std::collections::HashSet<_> = refined.excluded_faces.iter().map(|f| f.index()).collect();
-    let points = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+    let excluded: std::collections::HashSet<_> =
+        refined.excluded_faces.iter().map(|f| f.index()).collect();
+    let points = cdt
+        .vertices()
+        .map(|v| [v.position().x, v.position().y])
+        .collect();
     let triangles = cdt
         .inner_faces()
         .filter(|f| !excluded.contains(&f.fix().index()))
@@ -120,14 +135,25 @@ pub fn lift(
 pub fn cap_dome(angle: f64, n: usize) -> Result<Mesh> {
     let segments = ((n as f64).sqrt() * 3.5) as usize;
     let area = std::f64::consts::PI / (2.0 * n as f64);
-    let (p, t) = triangulate(&Domain { outer: circle([0.0, 0.0], 1.0, segments.max(12)), holes: vec![] }, area)?;
-    lift(&p, &t, |u| spherical_cap(1.0, angle, u[0].hypot(u[1])), |_, outer| outer)
+    let (p, t) = triangulate(
+        &Domain {
+            outer: circle([0.0, 0.0], 1.0, segments.max(12)),
+            holes: vec![],
+        },
+        area,
+    )?;
+    lift(
+        &p,
+        &t,
+        |u| spherical_cap(1.0, angle, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
 }
 
 /// A structured disk of radius 1: a centre vertex and `rings` concentric rings, ring k with
 /// 6k vertices, consecutive rings zipped together by angle. Edges follow the radial and hoop
 /// directions, the principal stress directions of a dome of revolution.
-pub fn polar_disk(rings: usize) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+pub fn polar_disk(rings: usize) -> PlanMesh {
     let mut points = vec![[0.0, 0.0]];
     let mut ring_start = vec![0usize];
     let mut ring_len = vec![1usize];
@@ -158,8 +184,12 @@ pub fn polar_disk(rings: usize) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
             a + 2.0 * std::f64::consts::PI * (m / len) as f64
         };
         let (mut i, mut o) = (0, 0);
-        let first_i = (0..il).min_by(|&a, &b| angle(points[is + a]).total_cmp(&angle(points[is + b]))).unwrap();
-        let first_o = (0..ol).min_by(|&a, &b| angle(points[os + a]).total_cmp(&angle(points[os + b]))).unwrap();
+        let first_i = (0..il)
+            .min_by(|&a, &b| angle(points[is + a]).total_cmp(&angle(points[is + b])))
+            .unwrap();
+        let first_o = (0..ol)
+            .min_by(|&a, &b| angle(points[os + a]).total_cmp(&angle(points[os + b])))
+            .unwrap();
         while i < il || o < ol {
             let vi = (is + (first_i + i) % il) as u32;
             let vo = (os + (first_o + o) % ol) as u32;

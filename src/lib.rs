@@ -14,4 +14,6 @@ pub use geometry::loads::LoadRule;
 pub use mesh::Mesh;
 pub use problem::Problem;
 pub use stress::airy::HoleMode;
-pub use stress::{analyse, EdgeScope, Formulation, QBound, StressResult, StressSettings, StressStatus, TauMode};
+pub use stress::{
+    analyse, EdgeScope, Formulation, QBound, StressResult, StressSettings, StressStatus, TauMode,
+};

@@ -55,7 +55,12 @@ impl Problem {
 
     /// Extra vertical loads per vertex: finite (negative values lift).
     pub fn with_extra_loads(mut self, loads: Vec<f64>) -> Result<Problem> {
-        check_len("extra_loads", loads.len(), self.mesh.positions.len(), "vertex")?;
+        check_len(
+            "extra_loads",
+            loads.len(),
+            self.mesh.positions.len(),
+            "vertex",
+        )?;
         if let Some(v) = loads.iter().position(|d| !d.is_finite()) {
             return Err(Error::InvalidArgument {
                 name: "extra_loads",
@@ -69,7 +74,12 @@ impl Problem {
     /// Horizontal forces per vertex; only free boundary vertices may carry one (interior
     /// vertices are balanced exactly by the Airy function, anchored ones by their support).
     pub fn with_horizontal_forces(mut self, forces: Vec<[f64; 2]>) -> Result<Problem> {
-        check_len("horizontal_forces", forces.len(), self.mesh.positions.len(), "vertex")?;
+        check_len(
+            "horizontal_forces",
+            forces.len(),
+            self.mesh.positions.len(),
+            "vertex",
+        )?;
         for (v, f) in forces.iter().enumerate() {
             if !f[0].is_finite() || !f[1].is_finite() {
                 return Err(Error::InvalidArgument {
@@ -90,7 +100,12 @@ impl Problem {
 
     /// Prescribed normal push per vertex (used at free boundary vertices): finite and >= 0.
     pub fn with_prescribed_tau(mut self, tau: Vec<f64>) -> Result<Problem> {
-        check_len("prescribed_tau", tau.len(), self.mesh.positions.len(), "vertex")?;
+        check_len(
+            "prescribed_tau",
+            tau.len(),
+            self.mesh.positions.len(),
+            "vertex",
+        )?;
         if let Some(v) = tau.iter().position(|t| !t.is_finite() || *t < 0.0) {
             return Err(Error::InvalidArgument {
                 name: "prescribed_tau",

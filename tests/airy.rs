@@ -20,7 +20,8 @@ fn closed_form_w(mesh: &Mesh, plan: &Plan, w: &[f64], e: usize) -> f64 {
     let l2 = plan.length[e].powi(2);
     let cot = |t: u32, v: u32| plan.cot_at(mesh, t, v);
     0.5 * (cot(t1.face, t1.opposite) + cot(t2.face, t2.opposite))
-        + ((cot(t1.face, j) + cot(t2.face, j)) * w[i as usize] + (cot(t1.face, i) + cot(t2.face, i)) * w[j as usize])
+        + ((cot(t1.face, j) + cot(t2.face, j)) * w[i as usize]
+            + (cot(t1.face, i) + cot(t2.face, i)) * w[j as usize])
             / (2.0 * l2)
         - w[t1.opposite as usize] / (4.0 * plan.area[t1.face as usize])
         - w[t2.opposite as usize] / (4.0 * plan.area[t2.face as usize])
@@ -39,11 +40,15 @@ fn closed_forms_equal_power_centre_dual_lengths_on_non_delaunay_meshes() {
         }
         let phi = op.airy_values(&y);
         let q = op.s.mul(&y);
-        let w: Vec<f64> = (0..phi.len()).map(|v| plan.u[v][0].powi(2) + plan.u[v][1].powi(2) - 2.0 * phi[v]).collect();
+        let w: Vec<f64> = (0..phi.len())
+            .map(|v| plan.u[v][0].powi(2) + plan.u[v][1].powi(2) - 2.0 * phi[v])
+            .collect();
         let scale = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut negative = 0;
         for (e, edge) in mesh.edges.iter().enumerate() {
-            let (Some(t1), Some(t2)) = (edge.left, edge.right) else { continue };
+            let (Some(t1), Some(t2)) = (edge.left, edge.right) else {
+                continue;
+            };
             let centre = |t: u32| {
                 let f = mesh.faces[t as usize];
                 power_centre(f.map(|v| plan.u[v as usize]), f.map(|v| w[v as usize]))
@@ -51,13 +56,24 @@ fn closed_forms_equal_power_centre_dual_lengths_on_non_delaunay_meshes() {
             let (c1, c2) = (centre(t1.face), centre(t2.face));
             let n = edge_normal(&mesh, &plan, e);
             let dual = ((c2[0] - c1[0]) * n[0] + (c2[1] - c1[1]) * n[1]) / plan.length[e];
-            assert!((q[e] - dual).abs() <= 1e-10 * scale, "edge {e}: (A) {} vs power centres {dual}", q[e]);
+            assert!(
+                (q[e] - dual).abs() <= 1e-10 * scale,
+                "edge {e}: (A) {} vs power centres {dual}",
+                q[e]
+            );
             let wq = closed_form_w(&mesh, &plan, &w, e);
-            assert!((q[e] - wq).abs() <= 1e-10 * scale, "edge {e}: (A) {} vs (W) {wq}", q[e]);
+            assert!(
+                (q[e] - wq).abs() <= 1e-10 * scale,
+                "edge {e}: (A) {} vs (W) {wq}",
+                q[e]
+            );
             negative += (dual < 0.0) as usize;
         }
         // The weights are random: the check covers edges of both signs (not locally regular).
-        assert!(negative > 0, "seed {seed}: no negative dual length, the test would be too easy");
+        assert!(
+            negative > 0,
+            "seed {seed}: no negative dual length, the test would be too easy"
+        );
     }
 }
 
@@ -68,7 +84,9 @@ fn interior_vertices_balance_exactly_for_random_airy_values_and_hole_jumps() {
             // Hole loop free in one case, anchored in the other: the cut is built either way.
             let anchor_hole = seed % 2 == 0;
             let mesh = jiggle(
-                &holed_disk(seed, 0.01, move |u, outer| outer || (anchor_hole && (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26)),
+                &holed_disk(seed, 0.01, move |u, outer| {
+                    outer || (anchor_hole && (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26)
+                }),
                 seed + 10,
                 0.2,
             );
@@ -76,7 +94,9 @@ fn interior_vertices_balance_exactly_for_random_airy_values_and_hole_jumps() {
             let op = AiryOperator::new(&mesh, &plan, mode).unwrap();
             assert_eq!(op.cuts.len(), 1);
             let mut rng = Rng::new(seed);
-            let y: Vec<f64> = (0..op.n_unknowns()).map(|_| rng.uniform(-1.0, 1.0)).collect();
+            let y: Vec<f64> = (0..op.n_unknowns())
+                .map(|_| rng.uniform(-1.0, 1.0))
+                .collect();
             let q = op.s.mul(&y);
             let mut worst = 0.0f64;
             for v in 0..mesh.positions.len() {
@@ -86,19 +106,28 @@ fn interior_vertices_balance_exactly_for_random_airy_values_and_hole_jumps() {
                 let (mut f, mut size) = ([0.0; 2], 0.0);
                 for &e in mesh.edges_at(v) {
                     let edge = &mesh.edges[e as usize];
-                    let other = if edge.v[0] as usize == v { edge.v[1] } else { edge.v[0] } as usize;
-                    for d in 0..2 {
+                    let other = if edge.v[0] as usize == v {
+                        edge.v[1]
+                    } else {
+                        edge.v[0]
+                    } as usize;
+                    for (d, fd) in f.iter_mut().enumerate() {
                         let term = q[e as usize] * (plan.u[v][d] - plan.u[other][d]);
-                        f[d] += term;
+                        *fd += term;
                         size += term.abs();
                     }
                 }
                 worst = worst.max(f[0].abs().max(f[1].abs()) / size);
             }
-            assert!(worst <= 1e-12, "{mode:?} seed {seed}: relative horizontal imbalance {worst:e}");
+            assert!(
+                worst <= 1e-12,
+                "{mode:?} seed {seed}: relative horizontal imbalance {worst:e}"
+            );
             // The hole coefficients do change the stress (they are not silently ignored).
             let mut y0 = y.clone();
-            y0[op.hole_start..op.hole_start + op.hole_width].iter_mut().for_each(|x| *x = 0.0);
+            y0[op.hole_start..op.hole_start + op.hole_width]
+                .iter_mut()
+                .for_each(|x| *x = 0.0);
             let q0 = op.s.mul(&y0);
             assert!(q.iter().zip(&q0).any(|(a, b)| (a - b).abs() > 1e-6));
         }

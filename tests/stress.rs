@@ -7,18 +7,32 @@ use common::{holed_disk, load_model, polar_cap, MODELS};
 use voussoir::*;
 
 fn solve(problem: &Problem, settings: &StressSettings, formulation: Formulation) -> StressResult {
-    let s = StressSettings { formulation, ..settings.clone() };
+    let s = StressSettings {
+        formulation,
+        ..settings.clone()
+    };
     analyse(problem, &s).unwrap()
 }
 
 /// Both formulations reach the same optimum: same objective and same residual vector (both are
 /// unique at the optimum, unlike q when ‖r‖² is flat), each a valid compressive stress.
-fn assert_same_optimum(label: &str, problem: &Problem, settings: &StressSettings) -> (StressResult, StressResult) {
+fn assert_same_optimum(
+    label: &str,
+    problem: &Problem,
+    settings: &StressSettings,
+) -> (StressResult, StressResult) {
     let red = solve(problem, settings, Formulation::Reduced);
     let edge = solve(problem, settings, Formulation::EdgeBased);
-    assert!(red.status.is_solved() && edge.status.is_solved(), "{label}: {:?} / {:?}", red.status, edge.status);
+    assert!(
+        red.status.is_solved() && edge.status.is_solved(),
+        "{label}: {:?} / {:?}",
+        red.status,
+        edge.status
+    );
     let mesh = &problem.mesh;
-    let free: Vec<usize> = (0..mesh.positions.len()).filter(|&v| mesh.is_non_anchored(v)).collect();
+    let free: Vec<usize> = (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .collect();
     let p_bar = free.iter().map(|&v| red.loads[v]).sum::<f64>() / free.len() as f64;
     let scale = free.iter().map(|&v| red.loads[v].powi(2)).sum::<f64>();
     assert!(
@@ -29,18 +43,52 @@ fn assert_same_optimum(label: &str, problem: &Problem, settings: &StressSettings
     );
     // ‖r‖² is strongly convex: ‖r_red − r_edge‖² ≤ |f_red − f*| + |f_edge − f*| ≤ 2e-6 f*, so
     // equal objectives to 1e-6 force residual vectors equal to ~1.5e-3 √f*.
-    let dr = free.iter().map(|&v| (red.residuals[v] - edge.residuals[v]).powi(2)).sum::<f64>().sqrt();
+    let dr = free
+        .iter()
+        .map(|&v| (red.residuals[v] - edge.residuals[v]).powi(2))
+        .sum::<f64>()
+        .sqrt();
     assert!(
         dr <= 1.5e-3 * edge.objective.sqrt() + 1e-6 * p_bar,
         "{label}: residual vectors differ by {dr:e} (objective {:e}, p̄ {p_bar:e})",
         edge.objective
     );
+    let (lo, hi) = mesh
+        .positions
+        .iter()
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        });
+    let natural_q = p_bar / ((hi[0] - lo[0]).hypot(hi[1] - lo[1]) / 2.0);
     for (name, r) in [("reduced", &red), ("edge-based", &edge)] {
-        let q_scale = r.force_densities.iter().fold(0.0f64, |m, q| m.max(q.abs()));
-        let min_q = r.force_densities.iter().fold(f64::INFINITY, |m, q| m.min(*q));
-        assert!(min_q >= -1e-7 * q_scale, "{label} {name}: tension {min_q:e}");
-        let h = free.iter().map(|&v| r.horizontal_imbalance[v][0].abs().max(r.horizontal_imbalance[v][1].abs())).fold(0.0, f64::max);
-        assert!(h <= 1e-6 * p_bar, "{label} {name}: horizontal imbalance {:e} p̄", h / p_bar);
+        let q_scale = r
+            .force_densities
+            .iter()
+            .fold(natural_q, |m, q| m.max(q.abs()));
+        let min_q = r
+            .force_densities
+            .iter()
+            .fold(f64::INFINITY, |m, q| m.min(*q));
+        assert!(
+            min_q >= -1e-7 * q_scale,
+            "{label} {name}: tension {min_q:e}"
+        );
+        let h = free
+            .iter()
+            .map(|&v| {
+                r.horizontal_imbalance[v][0]
+                    .abs()
+                    .max(r.horizontal_imbalance[v][1].abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            h <= 1e-6 * p_bar,
+            "{label} {name}: horizontal imbalance {:e} p̄",
+            h / p_bar
+        );
     }
     println!(
         "{label}: V={} objective {:.6e} / {:.6e}, eps_inf {:.3e} / {:.3e}, {:.3}s / {:.3}s",
@@ -73,34 +121,75 @@ fn reduced_equals_edge_based_on_generated_meshes() {
     let hemi = Problem::new(polar_cap(10, 1.3));
     assert_same_optimum("anchored rim", &hemi, &base);
     // q_min > 0 on interior edges.
-    let qmin = StressSettings { q_min: QBound::Relative(0.05), ..base.clone() };
+    let qmin = StressSettings {
+        q_min: QBound::Relative(0.05),
+        ..base.clone()
+    };
     assert_same_optimum("anchored rim, q_min", &hemi, &qmin);
     // With τ on free vertices a hole can take a net force: only affine jumps match VHWP12.
-    let base = StressSettings { holes: HoleMode::Affine, ..base };
+    let base = StressSettings {
+        holes: HoleMode::Affine,
+        ..base
+    };
     // Free edges: only an arc of the rim is anchored; τ optimised and τ = 0.
     let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
     assert_same_optimum("free rim arc, tau optimised", &arc, &base);
-    assert_same_optimum("free rim arc, tau zero", &arc, &StressSettings { tau: TauMode::Zero, ..base.clone() });
+    assert_same_optimum(
+        "free rim arc, tau zero",
+        &arc,
+        &StressSettings {
+            tau: TauMode::Zero,
+            ..base.clone()
+        },
+    );
     // A free hole (its loop has no support).
     let free_hole = Problem::new(holed_disk(4, 0.01, |_, outer| outer));
     assert_same_optimum("free hole", &free_hole, &base);
     // An anchored off-centre hole: a supported ring can take a net force and torque.
-    let anchored =
-        Problem::new(holed_disk(5, 0.01, |u, outer| outer || (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26));
+    let anchored = Problem::new(holed_disk(5, 0.01, |u, outer| {
+        outer || (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26
+    }));
     let (red, _) = assert_same_optimum("anchored hole (affine jumps)", &anchored, &base);
-    let constant = analyse(&anchored, &StressSettings { holes: HoleMode::Constant, ..base.clone() }).unwrap();
-    assert!(constant.objective >= red.objective * (1.0 - 1e-6), "constant jumps cannot beat affine ones");
+    let constant = analyse(
+        &anchored,
+        &StressSettings {
+            holes: HoleMode::Constant,
+            ..base.clone()
+        },
+    )
+    .unwrap();
+    assert!(
+        constant.objective >= red.objective * (1.0 - 1e-6),
+        "constant jumps cannot beat affine ones"
+    );
     // Prescribed τ on the free arc, and an upper bound.
     let tau = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3))
         .with_prescribed_tau(vec![0.002; arc.mesh.positions.len()])
         .unwrap();
-    assert_same_optimum("prescribed tau", &tau, &StressSettings { tau: TauMode::Prescribed, ..base.clone() });
-    assert_same_optimum("q_max", &hemi, &StressSettings { q_max: Some(QBound::Relative(1.0)), ..base.clone() });
+    assert_same_optimum(
+        "prescribed tau",
+        &tau,
+        &StressSettings {
+            tau: TauMode::Prescribed,
+            ..base.clone()
+        },
+    );
+    assert_same_optimum(
+        "q_max",
+        &hemi,
+        &StressSettings {
+            q_max: Some(QBound::Relative(1.0)),
+            ..base.clone()
+        },
+    );
 }
 
 #[test]
 fn reduced_equals_edge_based_on_every_real_model() {
-    let settings = StressSettings { holes: HoleMode::Affine, ..Default::default() };
+    let settings = StressSettings {
+        holes: HoleMode::Affine,
+        ..Default::default()
+    };
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
         assert_same_optimum(name, &Problem::new(mesh), &settings);
@@ -118,45 +207,95 @@ fn rigid_motions_and_uniform_scaling_give_the_scaled_answer() {
         .iter()
         .map(|p| {
             let (c, s) = (angle.cos(), angle.sin());
-            [scale * (c * p[0] - s * p[1]) + shift[0], scale * (s * p[0] + c * p[1]) + shift[1], scale * p[2] + shift[2]]
+            [
+                scale * (c * p[0] - s * p[1]) + shift[0],
+                scale * (s * p[0] + c * p[1]) + shift[1],
+                scale * p[2] + shift[2],
+            ]
         })
         .collect();
-    let anchored: Vec<u32> = (0..mesh.positions.len() as u32).filter(|&v| mesh.anchored[v as usize]).collect();
+    let anchored: Vec<u32> = (0..mesh.positions.len() as u32)
+        .filter(|&v| mesh.anchored[v as usize])
+        .collect();
     let moved = Problem::new(Mesh::new(moved, mesh.faces.clone(), &anchored).unwrap());
     let r = analyse(&moved, &StressSettings::default()).unwrap();
     // Loads scale with area (s²), force densities with s, residuals with s², ε∞ not at all.
     let p_scale = reference.loads.iter().fold(0.0f64, |m, x| m.max(*x));
     for v in 0..mesh.positions.len() {
-        assert!((r.loads[v] - scale * scale * reference.loads[v]).abs() <= 1e-12 * scale * scale * p_scale);
-        assert!((r.residuals[v] - scale * scale * reference.residuals[v]).abs() <= 1e-6 * scale * scale * p_scale);
+        assert!(
+            (r.loads[v] - scale * scale * reference.loads[v]).abs()
+                <= 1e-12 * scale * scale * p_scale
+        );
+        assert!(
+            (r.residuals[v] - scale * scale * reference.residuals[v]).abs()
+                <= 1e-6 * scale * scale * p_scale
+        );
     }
     assert!((r.eps_inf - reference.eps_inf).abs() <= 1e-6 * reference.eps_inf.max(1e-3));
-    let q_scale = reference.force_densities.iter().fold(0.0f64, |m, q| m.max(*q));
+    let q_scale = reference
+        .force_densities
+        .iter()
+        .fold(0.0f64, |m, q| m.max(*q));
     let dq = r
         .force_densities
         .iter()
         .zip(&reference.force_densities)
         .map(|(a, b)| (a - scale * b).abs())
         .fold(0.0, f64::max);
-    assert!(dq <= 1e-4 * scale * q_scale, "force densities differ by {:e} of the largest", dq / (scale * q_scale));
+    assert!(
+        dq <= 1e-4 * scale * q_scale,
+        "force densities differ by {:e} of the largest",
+        dq / (scale * q_scale)
+    );
 }
 
 #[test]
 fn invalid_settings_are_rejected_by_name() {
     let problem = Problem::new(polar_cap(3, 0.5));
     for (settings, name) in [
-        (StressSettings { q_min: QBound::Absolute(f64::NAN), ..Default::default() }, "q_min"),
-        (StressSettings { q_min: QBound::Relative(-1.0), ..Default::default() }, "q_min"),
-        (StressSettings { q_max: Some(QBound::Absolute(0.0)), ..Default::default() }, "q_max"),
         (
-            StressSettings { q_min: QBound::Absolute(2.0), q_max: Some(QBound::Absolute(1.0)), ..Default::default() },
+            StressSettings {
+                q_min: QBound::Absolute(f64::NAN),
+                ..Default::default()
+            },
+            "q_min",
+        ),
+        (
+            StressSettings {
+                q_min: QBound::Relative(-1.0),
+                ..Default::default()
+            },
+            "q_min",
+        ),
+        (
+            StressSettings {
+                q_max: Some(QBound::Absolute(0.0)),
+                ..Default::default()
+            },
             "q_max",
         ),
-        (StressSettings { regularisation: f64::INFINITY, ..Default::default() }, "regularisation"),
+        (
+            StressSettings {
+                q_min: QBound::Absolute(2.0),
+                q_max: Some(QBound::Absolute(1.0)),
+                ..Default::default()
+            },
+            "q_max",
+        ),
+        (
+            StressSettings {
+                regularisation: f64::INFINITY,
+                ..Default::default()
+            },
+            "regularisation",
+        ),
     ] {
         match analyse(&problem, &settings) {
             Err(Error::InvalidArgument { name: n, .. }) => assert_eq!(n, name),
-            other => panic!("{name}: expected InvalidArgument, got {:?}", other.map(|r| r.status)),
+            other => panic!(
+                "{name}: expected InvalidArgument, got {:?}",
+                other.map(|r| r.status)
+            ),
         }
     }
 }

@@ -23,7 +23,10 @@ pub fn gradient(u: [[f64; 2]; 3], f: [f64; 3]) -> [f64; 2] {
     let (d1, d2) = (sub(u[1], u[0]), sub(u[2], u[0]));
     let (f1, f2) = (f[1] - f[0], f[2] - f[0]);
     let det = cross(d1, d2);
-    [(f1 * d2[1] - d1[1] * f2) / det, (d1[0] * f2 - f1 * d2[0]) / det]
+    [
+        (f1 * d2[1] - d1[1] * f2) / det,
+        (d1[0] * f2 - f1 * d2[0]) / det,
+    ]
 }
 
 /// Power centre of three weighted sites: the point with equal |c − u_a|² − w_a to all three.
@@ -33,7 +36,10 @@ pub fn power_centre(u: [[f64; 2]; 3], w: [f64; 3]) -> [f64; 2] {
     let (d1, d2) = (sub(u[1], u[0]), sub(u[2], u[0]));
     let (r1, r2) = (rhs(1), rhs(2));
     let det = cross(d1, d2);
-    [(r1 * d2[1] - d1[1] * r2) / det, (d1[0] * r2 - r1 * d2[0]) / det]
+    [
+        (r1 * d2[1] - d1[1] * r2) / det,
+        (d1[0] * r2 - r1 * d2[0]) / det,
+    ]
 }
 
 /// Unit normal of edge e pointing from its left face into its right face.
@@ -45,7 +51,13 @@ pub fn edge_normal(mesh: &Mesh, plan: &Plan, e: usize) -> [f64; 2] {
 }
 
 /// Face points (frame units) from Airy values and hole jumps.
-pub fn centres_from_airy(mesh: &Mesh, plan: &Plan, op: &AiryOperator, phi: &[f64], y: &[f64]) -> Vec<[f64; 2]> {
+pub fn centres_from_airy(
+    mesh: &Mesh,
+    plan: &Plan,
+    op: &AiryOperator,
+    phi: &[f64],
+    y: &[f64],
+) -> Vec<[f64; 2]> {
     mesh.faces
         .iter()
         .enumerate()
@@ -129,7 +141,9 @@ pub fn airy_from_centres(mesh: &Mesh, plan: &Plan, c: &[[f64; 2]]) -> Vec<f64> {
             }
         }
     }
-    phi.iter().map(|x| if x.is_nan() { 0.0 } else { *x }).collect()
+    phi.iter()
+        .map(|x| if x.is_nan() { 0.0 } else { *x })
+        .collect()
 }
 
 /// The force diagram in physical units (frame points × p̄).
@@ -161,5 +175,8 @@ pub fn diagram(
             Some(ends.map(scaled))
         })
         .collect();
-    ForceDiagram { centres: centres.iter().map(|&c| scaled(c)).collect(), segments }
+    ForceDiagram {
+        centres: centres.iter().map(|&c| scaled(c)).collect(),
+        segments,
+    }
 }

@@ -23,7 +23,11 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// Area shares of the three corners of triangle (a, b, c) under `rule`.
@@ -42,26 +46,21 @@ fn corner_shares(rule: LoadRule, p: [[f64; 3]; 3]) -> [f64; 3] {
         LoadRule::Voronoi => {
             let n = cross3(sub3(p[1], p[0]), sub3(p[2], p[0]));
             let area = dot3(n, n).sqrt() / 2.0;
-            let mut out = [0.0; 3];
             // Corner k, its edges to the next (i) and previous (j) corner.
             let corner_dot = |k: usize| {
                 let (i, j) = ((k + 1) % 3, (k + 2) % 3);
                 dot3(sub3(p[i], p[k]), sub3(p[j], p[k]))
             };
             if let Some(obtuse) = (0..3).find(|&k| corner_dot(k) < 0.0) {
-                for (k, share) in out.iter_mut().enumerate() {
-                    *share = if k == obtuse { area / 2.0 } else { area / 4.0 };
-                }
-                return out;
+                return std::array::from_fn(|k| if k == obtuse { area / 2.0 } else { area / 4.0 });
             }
             let cot = |k: usize| corner_dot(k) / (2.0 * area);
-            for k in 0..3 {
+            let len2 = |a: usize, b: usize| dot3(sub3(p[a], p[b]), sub3(p[a], p[b]));
+            // Voronoi area at k: (|k i|² cot(j) + |k j|² cot(i)) / 8.
+            std::array::from_fn(|k| {
                 let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                let lij = |a: usize, b: usize| dot3(sub3(p[a], p[b]), sub3(p[a], p[b]));
-                // Voronoi area at k: |k i|² cot(j) + |k j|² cot(i), over 8.
-                out[k] = (lij(k, i) * cot(j) + lij(k, j) * cot(i)) / 8.0;
-            }
-            out
+                (len2(k, i) * cot(j) + len2(k, j) * cot(i)) / 8.0
+            })
         }
     }
 }
@@ -97,14 +96,20 @@ mod tests {
             let n = cross3(sub3(tri[1], tri[0]), sub3(tri[2], tri[0]));
             let area = dot3(n, n).sqrt() / 2.0;
             let s = corner_shares(LoadRule::Voronoi, tri);
-            assert!((s.iter().sum::<f64>() - area).abs() < 1e-14, "{s:?} vs {area}");
+            assert!(
+                (s.iter().sum::<f64>() - area).abs() < 1e-14,
+                "{s:?} vs {area}"
+            );
             assert!(s.iter().all(|&x| x > 0.0));
         }
     }
 
     #[test]
     fn plan_share_ignores_height() {
-        let s = corner_shares(LoadRule::PlanArea, [[0.0, 0.0, 5.0], [2.0, 0.0, -1.0], [0.0, 3.0, 2.0]]);
+        let s = corner_shares(
+            LoadRule::PlanArea,
+            [[0.0, 0.0, 5.0], [2.0, 0.0, -1.0], [0.0, 3.0, 2.0]],
+        );
         assert_eq!(s, [1.0; 3]);
     }
 }

@@ -33,7 +33,10 @@ impl Frame {
     }
 
     pub fn to_local(&self, p: &[f64; 3]) -> [f64; 2] {
-        [(p[0] - self.centre[0]) / self.scale, (p[1] - self.centre[1]) / self.scale]
+        [
+            (p[0] - self.centre[0]) / self.scale,
+            (p[1] - self.centre[1]) / self.scale,
+        ]
     }
 }
 
@@ -44,7 +47,7 @@ pub struct Plan {
     pub u: Vec<[f64; 2]>,
     /// Plan area A_t (> 0 for a validated mesh).
     pub area: Vec<f64>,
-    /// cot θ at corners f[0], f[1], f[2] of each face.
+    /// cot θ at the three corners of each face, in the face's vertex order.
     pub cot: Vec<[f64; 3]>,
     /// Plan length of each edge.
     pub length: Vec<f64>,
@@ -85,7 +88,12 @@ impl Plan {
                 dot(d, d).sqrt()
             })
             .collect();
-        Plan { u, area, cot, length }
+        Plan {
+            u,
+            area,
+            cot,
+            length,
+        }
     }
 
     /// cot θ at vertex `v` of face `t` (v must be a corner of t).

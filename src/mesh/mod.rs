@@ -20,9 +20,9 @@ pub struct Side {
     pub opposite: u32,
 }
 
-/// An undirected edge `v[0] < v[1]`. `left` is the face that contains the directed edge
-/// v[0]→v[1] (its opposite vertex lies to the left of v[0]→v[1] in the counter-clockwise
-/// plan), `right` the face that contains v[1]→v[0]. A boundary edge has exactly one side.
+/// An undirected edge `v[0]` < `v[1]`. `left` is the face that contains the directed edge
+/// `v[0]`→`v[1]` (its opposite vertex lies to the left of `v[0]`→`v[1]` in the counter-clockwise
+/// plan), `right` the face that contains `v[1]`→`v[0]`. A boundary edge has exactly one side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Edge {
     pub v: [u32; 2],
@@ -57,9 +57,9 @@ pub struct Mesh {
     pub faces: Vec<[u32; 3]>,
     /// True when the input faces were clockwise in plan and have been reversed.
     pub reversed: bool,
-    /// All edges, sorted by (v[0], v[1]).
+    /// All edges, sorted by (`v[0]`, `v[1]`).
     pub edges: Vec<Edge>,
-    /// For face t, the edge ids of (f[0],f[1]), (f[1],f[2]), (f[2],f[0]).
+    /// For face t, the edge ids of (`f[0]`,`f[1]`), (`f[1]`,`f[2]`), (`f[2]`,`f[0]`).
     pub face_edges: Vec<[u32; 3]>,
     /// CSR vertex → incident edge ids: `vertex_edges[vertex_edge_start[v]..vertex_edge_start[v+1]]`.
     pub vertex_edge_start: Vec<u32>,

@@ -45,7 +45,14 @@ pub struct AiryOperator {
 
 /// Coefficients κ_{e,t,v} of face `side` in the closed form (A) for edge (i, j) of length l:
 /// φ_opposite / (2A) − (cot θ_j φ_i + cot θ_i φ_j) / l².
-pub fn face_coefficients(mesh: &Mesh, plan: &Plan, i: u32, j: u32, l: f64, side: Side) -> [(u32, f64); 3] {
+pub fn face_coefficients(
+    mesh: &Mesh,
+    plan: &Plan,
+    i: u32,
+    j: u32,
+    l: f64,
+    side: Side,
+) -> [(u32, f64); 3] {
     let t = side.face;
     let l2 = l * l;
     [
@@ -92,7 +99,14 @@ impl AiryOperator {
                 cols += 1;
             }
         }
-        let mut op = AiryOperator { s: Csr::new(cols), phi_col, hole_start, hole_width, cuts, crease_col };
+        let mut op = AiryOperator {
+            s: Csr::new(cols),
+            phi_col,
+            hole_start,
+            hole_width,
+            cuts,
+            crease_col,
+        };
         for e in 0..mesh.edges.len() {
             let row = op.edge_row(mesh, plan, e);
             op.s.push_row(row);
@@ -131,7 +145,11 @@ impl AiryOperator {
                 let terms: Vec<(u32, f64)> = if cut.is_cut_edge(e as u32) {
                     vec![(side.opposite, -kappa[0].1)]
                 } else {
-                    kappa.iter().copied().filter(|(v, _)| cut.on_path(*v)).collect()
+                    kappa
+                        .iter()
+                        .copied()
+                        .filter(|(v, _)| cut.on_path(*v))
+                        .collect()
                 };
                 for (v, k) in terms {
                     let m = hole_basis(plan.u[v as usize]);
@@ -146,7 +164,10 @@ impl AiryOperator {
 
     /// φ per vertex (0 at gauge and unreferenced vertices), from the unknowns y.
     pub fn airy_values(&self, y: &[f64]) -> Vec<f64> {
-        self.phi_col.iter().map(|c| c.map_or(0.0, |c| y[c])).collect()
+        self.phi_col
+            .iter()
+            .map(|c| c.map_or(0.0, |c| y[c]))
+            .collect()
     }
 
     /// Hole jump coefficients (c, a_x, a_y) of hole h in frame coordinates (zeros past `width`).

@@ -1,6 +1,6 @@
 //! Stress optimisation: the best compressive force densities for a fixed shape (MATH §3–8).
 //!
-//! Both formulations build q = S y for their own unknowns and share one QP ([`qp`]); the
+//! Both formulations build q = S y for their own unknowns and share one QP (`qp.rs`); the
 //! result is recomputed in physical units from the returned force densities, so every figure
 //! it reports (residuals, ε∞, imbalance) is a certificate, not the solver's own claim.
 
@@ -80,6 +80,8 @@ pub struct StressResult {
     pub objective: f64,
     pub force_diagram: ForceDiagram,
     pub iterations: u32,
+    /// The regulariser ε actually used (larger than the setting after a numerical failure).
+    pub regularisation: f64,
     pub seconds: f64,
 }
 
@@ -90,7 +92,9 @@ pub fn analyse(problem: &Problem, settings: &StressSettings) -> Result<StressRes
 
 /// Vertices whose equations count: referenced and not anchored.
 pub fn non_anchored(mesh: &Mesh) -> Vec<u32> {
-    (0..mesh.positions.len() as u32).filter(|&v| mesh.is_non_anchored(v as usize)).collect()
+    (0..mesh.positions.len() as u32)
+        .filter(|&v| mesh.is_non_anchored(v as usize))
+        .collect()
 }
 
 /// Unit outward normals (sum of the two boundary edges' normals) at boundary vertices.
@@ -119,7 +123,11 @@ pub fn boundary_normals(mesh: &Mesh, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
 }
 
 /// Optimises the stress of `problem` with the vertices at `positions`.
-pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSettings) -> Result<StressResult> {
+pub fn analyse_at(
+    problem: &Problem,
+    positions: &[[f64; 3]],
+    settings: &StressSettings,
+) -> Result<StressResult> {
     settings.validate()?;
     let start = Instant::now();
     let mesh = &problem.mesh;
@@ -127,7 +135,13 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
     let frame = Frame::of(mesh, positions);
     let plan = Plan::new(mesh, positions, &frame);
     let l0 = frame.scale;
-    let load = loads::vertex_loads(mesh, positions, settings.load_rule, &problem.face_density, &problem.extra_loads);
+    let load = loads::vertex_loads(
+        mesh,
+        positions,
+        settings.load_rule,
+        &problem.face_density,
+        &problem.extra_loads,
+    );
     let free = non_anchored(mesh);
     let mean_load = mean_over(&load, &free);
     let p_bar = if mean_load > 0.0 { mean_load } else { 1.0 };
@@ -137,7 +151,11 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
     let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
     let p: Vec<f64> = load.iter().map(|x| x / p_bar).collect();
     let normal = boundary_normals(mesh, &plan.u);
-    let mut external: Vec<[f64; 2]> = problem.horizontal_forces.iter().map(|f| [f[0] / p_bar, f[1] / p_bar]).collect();
+    let mut external: Vec<[f64; 2]> = problem
+        .horizontal_forces
+        .iter()
+        .map(|f| [f[0] / p_bar, f[1] / p_bar])
+        .collect();
     let mut tau_normal = vec![None; n];
     for v in 0..n {
         if !mesh.is_free_boundary(v) {
@@ -160,7 +178,9 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
         !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize])
     };
     let q_min = settings.q_min.physical(unit) / unit;
-    let q_max = settings.q_max.map_or(f64::INFINITY, |b| b.physical(unit) / unit);
+    let q_max = settings
+        .q_max
+        .map_or(f64::INFINITY, |b| b.physical(unit) / unit);
     let bounds: Vec<Option<(f64, f64)>> = (0..edges.len())
         .map(|e| {
             active(e).then(|| {
@@ -174,7 +194,11 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
         Formulation::Reduced => {
             let op = AiryOperator::new(mesh, &plan, settings.holes)?;
             let s = op.s.clone();
-            let balance = free.iter().copied().filter(|&v| mesh.on_boundary[v as usize]).collect();
+            let balance = free
+                .iter()
+                .copied()
+                .filter(|&v| mesh.on_boundary[v as usize])
+                .collect();
             (Some(op), s, balance)
         }
         Formulation::EdgeBased => {
@@ -200,20 +224,32 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
         }
     };
 
-    let out = qp::solve(&qp::QpInput {
-        s: &s,
-        edges: &edges,
-        length: &plan.length,
-        u: &plan.u,
-        z: &z,
-        residual_vertices: &free,
-        load: &p,
-        balance_vertices: &balance,
-        external: &external,
-        tau_normal: &tau_normal,
-        bounds: &bounds,
-        regularisation: settings.regularisation,
-    });
+    let mut regularisation = settings.regularisation;
+    let mut out = None;
+    for _attempt in 0..3 {
+        let o = qp::solve(&qp::QpInput {
+            s: &s,
+            edges: &edges,
+            length: &plan.length,
+            u: &plan.u,
+            z: &z,
+            residual_vertices: &free,
+            load: &p,
+            balance_vertices: &balance,
+            external: &external,
+            tau_normal: &tau_normal,
+            bounds: &bounds,
+            regularisation,
+            lift_forces: settings.formulation == Formulation::Reduced,
+        });
+        let failed = StressStatus::from_clarabel(o.status) == StressStatus::NumericalError;
+        out = Some(o);
+        if !failed {
+            break;
+        }
+        regularisation = (regularisation * 100.0).max(1e-12);
+    }
+    let out = out.expect("at least one attempt");
     let status = StressStatus::from_clarabel(out.status);
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
     let y = if usable { out.y } else { vec![0.0; s.ncols] };
@@ -224,7 +260,13 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
     let force_densities: Vec<f64> = q_frame.iter().map(|q| q * unit).collect();
     let tau: Vec<f64> = match settings.tau {
         TauMode::Prescribed => (0..n)
-            .map(|v| if mesh.is_free_boundary(v) { problem.prescribed_tau[v] } else { 0.0 })
+            .map(|v| {
+                if mesh.is_free_boundary(v) {
+                    problem.prescribed_tau[v]
+                } else {
+                    0.0
+                }
+            })
             .collect(),
         _ => tau_frame.iter().map(|t| t * p_bar).collect(),
     };
@@ -263,14 +305,26 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
         .iter()
         .map(|m| {
             let a = [m[1] * p_bar, m[2] * p_bar];
-            [p_bar * l0 * m[0] - a[0] * frame.centre[0] - a[1] * frame.centre[1], a[0], a[1]]
+            [
+                p_bar * l0 * m[0] - a[0] * frame.centre[0] - a[1] * frame.centre[1],
+                a[0],
+                a[1],
+            ]
         })
         .collect();
     let force_diagram = dual::diagram(mesh, &centres_frame, airy_op.as_ref(), &y, p_bar);
 
-    let (residuals, horizontal_imbalance) =
-        equilibrium(mesh, positions, &force_densities, &load, &external_horizontal);
-    let max_r = free.iter().map(|&v| residuals[v as usize].abs()).fold(0.0, f64::max);
+    let (residuals, horizontal_imbalance) = equilibrium(
+        mesh,
+        positions,
+        &force_densities,
+        &load,
+        &external_horizontal,
+    );
+    let max_r = free
+        .iter()
+        .map(|&v| residuals[v as usize].abs())
+        .fold(0.0, f64::max);
     let objective = free.iter().map(|&v| residuals[v as usize].powi(2)).sum();
     Ok(StressResult {
         status,
@@ -287,6 +341,7 @@ pub fn analyse_at(problem: &Problem, positions: &[[f64; 3]], settings: &StressSe
         objective,
         force_diagram,
         iterations: out.iterations,
+        regularisation,
         seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -8,6 +8,7 @@
 //!               lower ≤ S y ≤ upper on active edges,  τ ≥ 0
 
 use super::sparse::Csr;
+
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
@@ -35,6 +36,10 @@ pub struct QpInput<'a> {
     /// Per edge: None for an edge without force, else (lower, upper) bounds on q.
     pub bounds: &'a [Option<(f64, f64)>],
     pub regularisation: f64,
+    /// Lift the force densities as variables (q − S y = 0, simple bounds on q). Needed when S
+    /// is not a selection: bounds on combinations S y make degenerate problems (straight free
+    /// edges force q = 0, so no strictly feasible point) numerically fragile.
+    pub lift_forces: bool,
 }
 
 /// What the solver returned.
@@ -65,23 +70,46 @@ impl Triplets {
 pub fn solve(inp: &QpInput) -> QpOutput {
     let n_y = inp.s.ncols;
     let n_vertices = inp.u.len();
+    // `force` maps the QP variables to q: S itself, or a selection of lifted q variables.
+    let lifted;
+    let force = if inp.lift_forces {
+        let mut sel = Csr::new(n_y + inp.bounds.iter().flatten().count());
+        let mut c = n_y;
+        for b in inp.bounds {
+            sel.push_row(if b.is_some() {
+                vec![(c, 1.0)]
+            } else {
+                Vec::new()
+            });
+            c += b.is_some() as usize;
+        }
+        lifted = sel;
+        &lifted
+    } else {
+        inp.s
+    };
+    let n_base = force.ncols;
     let mut tau_col = vec![None; n_vertices];
     let mut n_tau = 0;
     for (v, nrm) in inp.tau_normal.iter().enumerate() {
         if nrm.is_some() {
-            tau_col[v] = Some(n_y + n_tau);
+            tau_col[v] = Some(n_base + n_tau);
             n_tau += 1;
         }
     }
-    let r_start = n_y + n_tau;
+    let r_start = n_base + n_tau;
     let n = r_start + inp.residual_vertices.len();
 
     // Objective: ½ xᵀ P x with P = 2 (ε Sᵀ D S ⊕ 0 ⊕ I), upper triangle.
-    let mut p = Triplets { i: vec![], j: vec![], v: vec![] };
-    for e in 0..inp.s.nrows() {
+    let mut p = Triplets {
+        i: vec![],
+        j: vec![],
+        v: vec![],
+    };
+    for e in 0..force.nrows() {
         let w = 2.0 * inp.regularisation * inp.length[e] * inp.length[e];
-        for (c1, v1) in inp.s.row(e) {
-            for (c2, v2) in inp.s.row(e) {
+        for (c1, v1) in force.row(e) {
+            for (c2, v2) in force.row(e) {
                 if c1 <= c2 {
                     p.push(c1, c2, w * v1 * v2);
                 }
@@ -109,14 +137,18 @@ pub fn solve(inp: &QpInput) -> QpOutput {
         }
     };
 
-    let mut a = Triplets { i: vec![], j: vec![], v: vec![] };
+    let mut a = Triplets {
+        i: vec![],
+        j: vec![],
+        v: vec![],
+    };
     let mut b = Vec::new();
     let mut row = 0;
     // Vertical residuals: Σ_e (z_i − z_j) q_e − r_i = p_i.
     for (k, &i) in inp.residual_vertices.iter().enumerate() {
         for &e in &incident[i as usize] {
             let dz = inp.z[i as usize] - inp.z[other(e, i) as usize];
-            for (c, s) in inp.s.row(e) {
+            for (c, s) in force.row(e) {
                 a.push(row, c, dz * s);
             }
         }
@@ -129,7 +161,7 @@ pub fn solve(inp: &QpInput) -> QpOutput {
         for d in 0..2 {
             for &e in &incident[i as usize] {
                 let du = inp.u[i as usize][d] - inp.u[other(e, i) as usize][d];
-                for (c, s) in inp.s.row(e) {
+                for (c, s) in force.row(e) {
                     a.push(row, c, du * s);
                 }
             }
@@ -140,11 +172,24 @@ pub fn solve(inp: &QpInput) -> QpOutput {
             row += 1;
         }
     }
+    // Lifted forces: q_e − S_e y = 0.
+    if inp.lift_forces {
+        for e in 0..force.nrows() {
+            for (c, v) in force.row(e) {
+                a.push(row, c, v);
+                for (c, s) in inp.s.row(e) {
+                    a.push(row, c, -s);
+                }
+                b.push(0.0);
+                row += 1;
+            }
+        }
+    }
     let n_zero = row;
     // Bounds: q_e − lower ≥ 0, upper − q_e ≥ 0, τ ≥ 0.
     for (e, bound) in inp.bounds.iter().enumerate() {
         if let Some((lower, _)) = bound {
-            for (c, s) in inp.s.row(e) {
+            for (c, s) in force.row(e) {
                 a.push(row, c, -s);
             }
             b.push(-lower);
@@ -153,7 +198,7 @@ pub fn solve(inp: &QpInput) -> QpOutput {
     }
     for (e, bound) in inp.bounds.iter().enumerate() {
         if let Some((_, upper)) = bound.filter(|(_, u)| u.is_finite()) {
-            for (c, s) in inp.s.row(e) {
+            for (c, s) in force.row(e) {
                 a.push(row, c, s);
             }
             b.push(upper);
@@ -169,7 +214,10 @@ pub fn solve(inp: &QpInput) -> QpOutput {
     let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
     let am = CscMatrix::new_from_triplets(row, n, a.i, a.j, a.v);
     let q = vec![0.0; n];
-    let cones = [SupportedConeT::ZeroConeT(n_zero), SupportedConeT::NonnegativeConeT(row - n_zero)];
+    let cones = [
+        SupportedConeT::ZeroConeT(n_zero),
+        SupportedConeT::NonnegativeConeT(row - n_zero),
+    ];
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(200)

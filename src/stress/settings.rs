@@ -73,7 +73,9 @@ pub struct StressSettings {
     pub holes: HoleMode,
     pub load_rule: LoadRule,
     pub formulation: Formulation,
-    /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10.
+    /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10; when the solver
+    /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
+    /// step is retried with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
 }
 
@@ -95,7 +97,12 @@ impl Default for StressSettings {
 impl StressSettings {
     /// Rejects NaN, negative or inconsistent values, naming the field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name, reason: &str| Err(Error::InvalidArgument { name, reason: reason.into() });
+        let bad = |name, reason: &str| {
+            Err(Error::InvalidArgument {
+                name,
+                reason: reason.into(),
+            })
+        };
         let q_min = self.q_min.value();
         if !q_min.is_finite() || q_min < 0.0 {
             return bad("q_min", "must be finite and >= 0");

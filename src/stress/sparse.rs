@@ -12,7 +12,12 @@ pub struct Csr {
 
 impl Csr {
     pub fn new(ncols: usize) -> Csr {
-        Csr { ncols, start: vec![0], col: Vec::new(), val: Vec::new() }
+        Csr {
+            ncols,
+            start: vec![0],
+            col: Vec::new(),
+            val: Vec::new(),
+        }
     }
 
     pub fn nrows(&self) -> usize {
@@ -48,7 +53,10 @@ impl Csr {
 
     pub fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let range = self.start[r]..self.start[r + 1];
-        self.col[range.clone()].iter().copied().zip(self.val[range].iter().copied())
+        self.col[range.clone()]
+            .iter()
+            .copied()
+            .zip(self.val[range].iter().copied())
     }
 
     pub fn row_len(&self, r: usize) -> usize {
@@ -56,7 +64,9 @@ impl Csr {
     }
 
     pub fn mul(&self, x: &[f64]) -> Vec<f64> {
-        (0..self.nrows()).map(|r| self.row(r).map(|(c, v)| v * x[c]).sum()).collect()
+        (0..self.nrows())
+            .map(|r| self.row(r).map(|(c, v)| v * x[c]).sum())
+            .collect()
     }
 }
 

@@ -51,15 +51,24 @@ pub const MODELS: [&str; 9] = [
 pub fn load_model(name: &str) -> Option<Mesh> {
     let dir = models_dir()?;
     Some(
-        voussoir::io::load_model(&dir.join(format!("{name}.obj")), &dir.join(format!("{name}.json")))
-            .unwrap_or_else(|e| panic!("{name}: {e}")),
+        voussoir::io::load_model(
+            &dir.join(format!("{name}.obj")),
+            &dir.join(format!("{name}.json")),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}")),
     )
 }
 
 /// A spherical cap of rim angle `angle` on the structured polar disk, rim anchored.
 pub fn polar_cap(rings: usize, angle: f64) -> Mesh {
     let (p, t) = generate::polar_disk(rings);
-    generate::lift(&p, &t, |u| generate::spherical_cap(1.0, angle, u[0].hypot(u[1])), |_, outer| outer).unwrap()
+    generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, angle, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .unwrap()
 }
 
 /// A unit disk meshed by spade with an off-centre hole of radius 0.25, heights of a 40° cap
@@ -75,7 +84,9 @@ pub fn holed_disk(seed: u64, max_area: f64, anchor: impl Fn([f64; 2], bool) -> b
     generate::lift(
         &p,
         &t,
-        |u| generate::spherical_cap(1.0, 0.7, u[0].hypot(u[1])) + 0.03 * (a * u[0] + b).sin() * u[1],
+        |u| {
+            generate::spherical_cap(1.0, 0.7, u[0].hypot(u[1])) + 0.03 * (a * u[0] + b).sin() * u[1]
+        },
         anchor,
     )
     .unwrap()
@@ -86,7 +97,7 @@ pub fn holed_disk(seed: u64, max_area: f64, anchor: impl Fn([f64; 2], bool) -> b
 pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
     let mut rng = Rng::new(seed);
     let mut pos = mesh.positions.clone();
-    for v in 0..pos.len() {
+    for (v, p) in pos.iter_mut().enumerate() {
         if mesh.on_boundary[v] || !mesh.referenced[v] {
             continue;
         }
@@ -98,9 +109,11 @@ pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
                 (a[0] - b[0]).hypot(a[1] - b[1])
             })
             .fold(f64::INFINITY, f64::min);
-        pos[v][0] += amount * h * rng.uniform(-1.0, 1.0);
-        pos[v][1] += amount * h * rng.uniform(-1.0, 1.0);
+        p[0] += amount * h * rng.uniform(-1.0, 1.0);
+        p[1] += amount * h * rng.uniform(-1.0, 1.0);
     }
-    let anchored: Vec<u32> = (0..pos.len() as u32).filter(|&v| mesh.anchored[v as usize]).collect();
+    let anchored: Vec<u32> = (0..pos.len() as u32)
+        .filter(|&v| mesh.anchored[v as usize])
+        .collect();
     Mesh::new(pos, mesh.faces.clone(), &anchored).expect("jiggled mesh stays valid")
 }

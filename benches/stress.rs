@@ -1,0 +1,100 @@
+//! Stress step, reduced (de Goes et al.) and edge-based (VHWP12) side by side, on the shared
+//! real models and generated domes with a hole. Prints a table; asserts nothing.
+//!
+//!     cargo bench --bench stress              # models + generated up to 50k vertices
+//!     cargo bench --bench stress -- --quick   # models + generated up to 6k vertices
+
+use std::path::PathBuf;
+use std::time::Instant;
+use voussoir::generate::{self, Domain};
+use voussoir::{analyse, Formulation, HoleMode, Mesh, Problem, StressSettings};
+
+fn generated(n: usize) -> Mesh {
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, ((n as f64).sqrt() * 3.5) as usize),
+        holes: vec![generate::circle(
+            [0.35, 0.1],
+            0.2,
+            ((n as f64).sqrt() * 0.8) as usize,
+        )],
+    };
+    let area = 0.95 * std::f64::consts::PI / (2.0 * n as f64);
+    let (p, t) = generate::triangulate(&domain, area).expect("domain");
+    generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .expect("dome")
+}
+
+fn row(name: &str, mesh: Mesh) {
+    let (v, e, f) = (mesh.positions.len(), mesh.edges.len(), mesh.faces.len());
+    let problem = Problem::new(mesh);
+    let mut cells = Vec::new();
+    for formulation in [Formulation::Reduced, Formulation::EdgeBased] {
+        let settings = StressSettings {
+            formulation,
+            holes: HoleMode::Affine,
+            ..Default::default()
+        };
+        let t = Instant::now();
+        let r = analyse(&problem, &settings).expect("valid problem");
+        cells.push((
+            t.elapsed().as_secs_f64(),
+            r.iterations,
+            r.eps_inf,
+            format!("{:?}", r.status),
+        ));
+    }
+    let (red, edge) = (&cells[0], &cells[1]);
+    println!(
+        "| {name:<16} | {v:>6} | {e:>6} | {f:>6} | {:>8.3} ({:>2} it) | {:>8.3} ({:>2} it) | {:>5.2} | {:>9.3e} | {} / {} |",
+        red.0,
+        red.1,
+        edge.0,
+        edge.1,
+        edge.0 / red.0,
+        red.2,
+        red.3,
+        edge.3
+    );
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    println!("| model            |      V |      E |      F | reduced s (iters) | edge-based s (iters) | ratio | eps_inf   | status |");
+    println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|-----------|--------|");
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
+    if dir.is_dir() {
+        for name in [
+            "free_vault",
+            "dome_with_doors",
+            "lilium",
+            "cheese",
+            "four_holes",
+            "neumunster",
+            "hex",
+            "three_pillar",
+            "vault_pq",
+        ] {
+            let mesh = voussoir::io::load_model(
+                &dir.join(format!("{name}.obj")),
+                &dir.join(format!("{name}.json")),
+            )
+            .expect("shared model");
+            row(name, mesh);
+        }
+    } else {
+        println!("skipped: {} not found", dir.display());
+    }
+    let sizes: &[usize] = if quick {
+        &[1000, 6000]
+    } else {
+        &[1000, 6000, 20000, 50000]
+    };
+    for &n in sizes {
+        row(&format!("dome+hole {}k", n / 1000), generated(n));
+    }
+}
