@@ -7,12 +7,15 @@ pub mod geometry;
 pub mod io;
 pub mod mesh;
 pub mod problem;
+pub mod shape;
+pub mod solve;
 pub mod stress;
 
 pub use error::{Error, Result};
 pub use geometry::loads::LoadRule;
 pub use mesh::Mesh;
 pub use problem::Problem;
+pub use solve::{form_find, FormFindResult, FormFindSettings, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{
     analyse, EdgeScope, Formulation, QBound, StressResult, StressSettings, StressStatus, TauMode,

@@ -1,0 +1,253 @@
+//! Form finding (MATH §11): stress step → stop if ε∞ < tol → shape step, repeated. The result
+//! always carries the best state reached and an honest termination status.
+
+use crate::error::Result;
+use crate::problem::Problem;
+use crate::shape::{Schedule, ShapeStep};
+use crate::stress::{analyse_at, EdgeScope, QBound, StressResult, StressSettings, StressStatus};
+use std::time::Instant;
+
+/// Why the loop stopped.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Termination {
+    /// ε∞ < tolerance.
+    Converged,
+    MaxIterations,
+    /// ε∞ stopped improving; the vertices with the largest residual that carry (almost) no
+    /// stress are listed: they cannot be balanced by moving heights (raise q_min).
+    Stalled {
+        vertices: Vec<u32>,
+    },
+    /// The stress constraints admit no solution (q_min, q_max, prescribed forces, straight free
+    /// edges without τ); `constraint` names the setting to relax.
+    Infeasible {
+        constraint: String,
+    },
+    NumericalError {
+        what: String,
+    },
+    /// The progress callback asked to stop.
+    Cancelled,
+}
+
+/// Settings of the whole loop.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FormFindSettings {
+    pub stress: StressSettings,
+    /// Stop when ε∞ = max|r_i| / mean p_i < tolerance. Default 1e-6.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    pub schedule: Schedule,
+    /// Stalled when the best ε∞ has not improved by 1% over this many iterations.
+    pub stall_window: usize,
+}
+
+impl Default for FormFindSettings {
+    /// Defaults that converge on every shared model: compression bounded away from zero on
+    /// interior edges (a vertex whose edges all reach q = 0 cannot be balanced whatever its
+    /// height) and optimised τ at free vertices (a straight free edge carries no compression
+    /// otherwise; non-zero τ means the edge needs a tie or buttress there).
+    fn default() -> Self {
+        FormFindSettings {
+            stress: StressSettings {
+                q_min: QBound::Relative(0.05),
+                q_min_scope: EdgeScope::Interior,
+                ..Default::default()
+            },
+            tolerance: 1e-6,
+            max_iterations: 50,
+            schedule: Schedule::default(),
+            stall_window: 8,
+        }
+    }
+}
+
+/// Progress: (iteration, ε∞) → return false to cancel.
+pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
+
+/// The outcome of form finding.
+#[derive(Debug, Clone)]
+pub struct FormFindResult {
+    pub termination: Termination,
+    /// Final positions (plan unchanged, heights moved).
+    pub positions: Vec<[f64; 3]>,
+    /// The last stress step, at `positions` (its residuals certify the result).
+    pub stress: StressResult,
+    /// ε∞ per iteration (one entry per stress step).
+    pub history: Vec<f64>,
+    pub iterations: usize,
+    /// Vertex-based distances to the input, normalised by the plan bounding-box diagonal:
+    /// max |Δz| and the area-weighted RMS of Δz.
+    pub hausdorff: f64,
+    pub l2: f64,
+    /// Seconds summed over iterations.
+    pub stress_seconds: f64,
+    pub shape_seconds: f64,
+    pub total_seconds: f64,
+}
+
+/// Finds the nearest self-supporting shape to `problem`'s mesh.
+pub fn form_find(
+    problem: &Problem,
+    settings: &FormFindSettings,
+    progress: Option<&mut Progress>,
+) -> Result<FormFindResult> {
+    settings.stress.validate()?;
+    if !(settings.tolerance > 0.0 && settings.tolerance.is_finite()) {
+        return Err(crate::Error::InvalidArgument {
+            name: "tolerance",
+            reason: "must be finite and > 0".into(),
+        });
+    }
+    let start = Instant::now();
+    let mesh = &problem.mesh;
+    let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
+    let mut positions = mesh.positions.clone();
+    let shape = ShapeStep::new(mesh)?;
+    let mut progress = progress;
+    let (mut history, mut stress_s, mut shape_s) = (Vec::new(), 0.0, 0.0);
+    let mut best = f64::INFINITY;
+    let mut best_at = 0;
+    let mut last: Option<StressResult> = None;
+    let mut termination = Termination::MaxIterations;
+    for k in 0..settings.max_iterations.max(1) {
+        let t = Instant::now();
+        let stress = analyse_at(problem, &positions, &settings.stress)?;
+        stress_s += t.elapsed().as_secs_f64();
+        history.push(stress.eps_inf);
+        let status = stress.status;
+        let eps = stress.eps_inf;
+        last = Some(stress);
+        if let Some(cb) = progress.as_mut() {
+            if !cb(k, eps) {
+                termination = Termination::Cancelled;
+                break;
+            }
+        }
+        match status {
+            StressStatus::Infeasible => {
+                termination = Termination::Infeasible {
+                    constraint: infeasibility_hint(&settings.stress),
+                };
+                break;
+            }
+            StressStatus::NumericalError => {
+                termination = Termination::NumericalError {
+                    what: "stress QP failed".into(),
+                };
+                break;
+            }
+            _ => {}
+        }
+        if eps < settings.tolerance {
+            termination = Termination::Converged;
+            break;
+        }
+        if eps < best * 0.99 {
+            best = eps;
+            best_at = k;
+        } else if k - best_at >= settings.stall_window {
+            termination = Termination::Stalled {
+                vertices: blocking_vertices(problem, last.as_ref().unwrap()),
+            };
+            break;
+        }
+        if k + 1 == settings.max_iterations {
+            break;
+        }
+        let t = Instant::now();
+        let s = last.as_ref().unwrap();
+        let z: Vec<f64> = positions.iter().map(|p| p[2]).collect();
+        match shape.step(
+            mesh,
+            &s.force_densities,
+            &s.loads,
+            &z,
+            &z0,
+            k,
+            &settings.schedule,
+        ) {
+            Ok(z_new) => positions.iter_mut().zip(z_new).for_each(|(p, z)| p[2] = z),
+            Err(e) => {
+                termination = Termination::NumericalError {
+                    what: e.to_string(),
+                };
+                break;
+            }
+        }
+        shape_s += t.elapsed().as_secs_f64();
+    }
+    let stress = last.expect("at least one iteration");
+    let (hausdorff, l2) = distances(problem, &positions);
+    Ok(FormFindResult {
+        termination,
+        iterations: history.len(),
+        positions,
+        stress,
+        history,
+        hausdorff,
+        l2,
+        stress_seconds: stress_s,
+        shape_seconds: shape_s,
+        total_seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn infeasibility_hint(s: &StressSettings) -> String {
+    let mut parts = Vec::new();
+    if !matches!(s.q_min, QBound::Absolute(v) | QBound::Relative(v) if v == 0.0) {
+        parts.push("q_min (a straight free edge cannot carry q_min > 0 without τ)");
+    }
+    if s.q_max.is_some() {
+        parts.push("q_max");
+    }
+    parts.push("prescribed horizontal forces or τ");
+    parts.join(", or ")
+}
+
+/// Non-anchored vertices with large residuals whose incident force densities are (almost) all
+/// zero: no height can balance them.
+fn blocking_vertices(problem: &Problem, s: &StressResult) -> Vec<u32> {
+    let mesh = &problem.mesh;
+    let q_max = s.force_densities.iter().fold(0.0f64, |a, q| a.max(*q));
+    let r_max = s.residuals.iter().fold(0.0f64, |a, r| a.max(r.abs()));
+    (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v) && s.residuals[v].abs() > 0.1 * r_max)
+        .filter(|&v| {
+            mesh.edges_at(v)
+                .iter()
+                .map(|&e| s.force_densities[e as usize])
+                .sum::<f64>()
+                < 1e-6 * q_max.max(f64::MIN_POSITIVE)
+        })
+        .map(|v| v as u32)
+        .collect()
+}
+
+/// Vertex-based distances between input and output heights over the plan bounding-box diagonal.
+fn distances(problem: &Problem, positions: &[[f64; 3]]) -> (f64, f64) {
+    let mesh = &problem.mesh;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let mut area = vec![0.0; positions.len()];
+    for f in &mesh.faces {
+        let [a, b, c] = f.map(|v| mesh.positions[v as usize]);
+        let t = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() / 6.0;
+        f.iter().for_each(|&v| area[v as usize] += t);
+    }
+    let (mut max, mut sum, mut wsum) = (0.0f64, 0.0, 0.0);
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if !mesh.referenced[v] {
+            continue;
+        }
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+        let dz = positions[v][2] - p[2];
+        max = max.max(dz.abs());
+        sum += area[v] * dz * dz;
+        wsum += area[v];
+    }
+    let diag = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    (max / diag, (sum / wsum).sqrt() / diag)
+}
