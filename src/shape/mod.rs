@@ -51,9 +51,9 @@ impl ShapeStep {
         let n = mesh.positions.len();
         let mut row = vec![None; n];
         let mut vertices = Vec::new();
-        for v in 0..n {
+        for (v, slot) in row.iter_mut().enumerate() {
             if mesh.is_non_anchored(v) {
-                row[v] = Some(vertices.len());
+                *slot = Some(vertices.len());
                 vertices.push(v as u32);
             }
         }
