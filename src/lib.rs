@@ -1,6 +1,7 @@
 //! Voussoir: self-supporting masonry shapes (de Goes et al. 2013).
 #![deny(unsafe_code)]
 
+pub mod capi;
 pub mod error;
 pub mod generate;
 pub mod geometry;

@@ -1,0 +1,719 @@
+//! `VsrResult` and its copy-out getters.
+//!
+//! Every array getter has the shape `(result, out, len, needed)`: `out` is a buffer of `len`
+//! elements (or NULL with `len` 0 to query the size), `needed` (may be NULL) receives the
+//! number of elements the data has, on success and on `VSR_STATUS_BUFFER_TOO_SMALL`; `out`
+//! is written only on success.
+
+use super::boundary::{boundary, copy_out, handle, out_ptr, CResult, Failure};
+use super::status::{VsrResultKind, VsrStatus, VsrStressStatus, VsrTermination};
+use crate::mesh::Mesh;
+use crate::stress::StressResult;
+use crate::{FormFindResult, Termination};
+use std::ffi::c_char;
+
+pub(crate) enum Outcome {
+    Analysis {
+        positions: Vec<[f64; 3]>,
+        stress: StressResult,
+    },
+    FormFinding(FormFindResult),
+}
+
+/// Opaque handle: the outcome of `vsr_analyse` or `vsr_form_find`. It owns copies of
+/// everything it reports; free with `vsr_result_destroy`. Immutable: a `const VsrResult*`
+/// may be read from several threads at once.
+pub struct VsrResult {
+    outcome: Outcome,
+    /// Edge vertex pairs, flattened (#E by 2).
+    edges: Vec<u32>,
+    n_faces: usize,
+}
+
+impl VsrResult {
+    pub(crate) fn new(mesh: &Mesh, outcome: Outcome) -> VsrResult {
+        VsrResult {
+            outcome,
+            edges: mesh.edges.iter().flat_map(|e| e.v).collect(),
+            n_faces: mesh.n_faces(),
+        }
+    }
+
+    fn stress(&self) -> &StressResult {
+        match &self.outcome {
+            Outcome::Analysis { stress, .. } => stress,
+            Outcome::FormFinding(f) => &f.stress,
+        }
+    }
+
+    fn positions(&self) -> &[[f64; 3]] {
+        match &self.outcome {
+            Outcome::Analysis { positions, .. } => positions,
+            Outcome::FormFinding(f) => &f.positions,
+        }
+    }
+
+    fn form(&self, what: &str) -> CResult<&FormFindResult> {
+        match &self.outcome {
+            Outcome::FormFinding(f) => Ok(f),
+            Outcome::Analysis { .. } => Err(Failure::new(
+                VsrStatus::NotAvailable,
+                format!(
+                    "argument `result`: {what} exists only for results of vsr_form_find, \
+                     this one comes from vsr_analyse"
+                ),
+            )),
+        }
+    }
+}
+
+/// Borrows the result and copies `pick(result)` out.
+unsafe fn copy<T: Copy>(
+    result: *const VsrResult,
+    out: *mut T,
+    len: usize,
+    needed: *mut usize,
+    pick: impl FnOnce(&VsrResult) -> CResult<Vec<T>>,
+) -> CResult {
+    // SAFETY: caller's contract.
+    let r = unsafe { handle("result", result)? };
+    let data = pick(r)?;
+    // SAFETY: caller's contract.
+    unsafe { copy_out(&data, out, len, needed) }
+}
+
+/// Borrows the result, checks every out-pointer, then writes `pick(result)` into them.
+unsafe fn scalars<T: Copy, const N: usize>(
+    result: *const VsrResult,
+    outs: [(&str, *mut T); N],
+    pick: impl FnOnce(&VsrResult) -> CResult<[T; N]>,
+) -> CResult {
+    // SAFETY: caller's contract.
+    let r = unsafe { handle("result", result)? };
+    for (name, p) in outs {
+        out_ptr(name, p)?;
+    }
+    let values = pick(r)?;
+    for ((_, p), v) in outs.into_iter().zip(values) {
+        // SAFETY: non-NULL and writable by the caller's contract.
+        unsafe { p.write(v) };
+    }
+    Ok(())
+}
+
+fn flat2(v: &[[f64; 2]]) -> Vec<f64> {
+    v.iter().flatten().copied().collect()
+}
+
+/// Frees a result. NULL is a no-op.
+///
+/// # Safety
+/// `result` must be NULL or a handle from a solve not yet destroyed, used by no other thread.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_destroy(result: *mut VsrResult) {
+    boundary!(keep_error, (), {
+        if !result.is_null() {
+            // SAFETY: from Box::into_raw in a solve, destroyed once (caller's contract).
+            drop(unsafe { Box::from_raw(result) });
+        }
+    })
+}
+
+/// Which solve produced the result: `VSR_RESULT_KIND_ANALYSIS` or
+/// `VSR_RESULT_KIND_FORM_FINDING`. Written only on success.
+///
+/// # Safety
+/// `result`: a valid handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_kind(
+    result: *const VsrResult,
+    out: *mut VsrResultKind,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, [("out", out)], |r| {
+                Ok([match r.outcome {
+                    Outcome::Analysis { .. } => VsrResultKind::Analysis,
+                    Outcome::FormFinding(_) => VsrResultKind::FormFinding,
+                }])
+            })
+        }
+    })
+}
+
+/// Sizes of the arrays of a result: vertices #V, edges #E, faces #F, holes #H (as for
+/// `vsr_mesh_counts`). All four pointers required; written only on success.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_counts(
+    result: *const VsrResult,
+    n_vertices: *mut usize,
+    n_edges: *mut usize,
+    n_faces: *mut usize,
+    n_holes: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        let outs = [
+            ("n_vertices", n_vertices),
+            ("n_edges", n_edges),
+            ("n_faces", n_faces),
+            ("n_holes", n_holes),
+        ];
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, outs, |r| {
+                Ok([
+                    r.positions().len(),
+                    r.edges.len() / 2,
+                    r.n_faces,
+                    r.stress().hole_coefficients.len(),
+                ])
+            })
+        }
+    })
+}
+
+/// Vertex positions, #V by 3 doubles (x, y, z), row-major, in the input's length unit: the
+/// form-found shape (plan unchanged, heights moved), or the input for an analysis.
+/// Copy-out as described in the header's introduction.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_positions(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.positions().iter().flatten().copied().collect())
+            })
+        }
+    })
+}
+
+/// Edges, #E by 2 `uint32_t` vertex ids (smaller first), row-major, sorted; row e is edge e
+/// of every per-edge array.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_edges(
+    result: *const VsrResult,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy(result, out, len, needed, |r| Ok(r.edges.clone())) }
+    })
+}
+
+/// Force density per edge, #E doubles (force per length; compression positive, 0 on edges
+/// that carry none, e.g. boundary edges between two supports).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_force_densities(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.stress().force_densities.clone())
+            })
+        }
+    })
+}
+
+/// Airy stress function value φ per vertex, #V doubles (force × length; 0 at vertices used by
+/// no triangle).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_airy(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().airy.clone())) }
+    })
+}
+
+/// Vertex weights w = x² + y² − 2 φ, #V doubles (the power diagram of the plan points with
+/// these weights is the force diagram; units as in the paper, length² and force × length
+/// mixed, so meaningful for unit loads).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_weights(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().weights.clone())) }
+    })
+}
+
+/// Inward normal push τ per vertex, #V doubles (force; non-zero only at free boundary
+/// vertices; a non-zero τ means the free edge needs a tie or buttress there).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_tau(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().tau.clone())) }
+    })
+}
+
+/// External horizontal force per vertex needed at free edges (prescribed force − τ × outward
+/// normal), #V by 2 doubles (fx, fy; force), row-major; 0 away from free boundary vertices.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_external_horizontal(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(flat2(&r.stress().external_horizontal))
+            })
+        }
+    })
+}
+
+/// Vertical load per vertex used by the (last) stress step, #V doubles (force, downward
+/// positive): face weights shared by the load rule plus extra loads, at the result's shape.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_loads(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().loads.clone())) }
+    })
+}
+
+/// Vertical residual r_i = Σ_j q_ij (z_i − z_j) − p_i per vertex, #V doubles (force; 0 at
+/// anchored and unused vertices), recomputed from the returned force densities: the
+/// certificate of equilibrium.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_residuals(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.stress().residuals.clone())
+            })
+        }
+    })
+}
+
+/// Horizontal imbalance Σ_j q_ij (u_i − u_j) + external force per vertex, #V by 2 doubles
+/// (force), row-major; about 1e-12 × load when the stress step solved.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_horizontal_imbalance(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(flat2(&r.stress().horizontal_imbalance))
+            })
+        }
+    })
+}
+
+/// Airy jump across each hole M_h(x, y) = c + a_x x + a_y y, #H by 3 doubles (c in force ×
+/// length; a_x, a_y in force), row-major, holes in the order of the mesh's boundary loops.
+/// With `VSR_HOLE_MODE_CONSTANT` a_x = a_y = 0. Empty (0 entries) for the edge-based
+/// formulation, which has no hole unknowns.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_hole_coefficients(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.stress()
+                    .hole_coefficients
+                    .iter()
+                    .flatten()
+                    .copied()
+                    .collect())
+            })
+        }
+    })
+}
+
+/// Force diagram points: one per face, the power centre of its weighted vertices, #F by 2
+/// doubles (force), row-major, in face order.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_force_diagram_centres(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(flat2(&r.stress().force_diagram.centres))
+            })
+        }
+    })
+}
+
+/// Force diagram segments: one per interior edge, in increasing edge id, #S by 4 doubles
+/// (x0, y0, x1, y1; force), row-major: the points of the edge's left and right face (across
+/// a hole's cut the right point is shifted by the hole's jump). Its length over the edge's
+/// plan length is the edge's force density. The edge ids are given, in the same order, by
+/// `vsr_result_force_diagram_segment_edges`.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_force_diagram_segments(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.stress()
+                    .force_diagram
+                    .segments
+                    .iter()
+                    .flatten()
+                    .flat_map(|s| [s[0][0], s[0][1], s[1][0], s[1][1]])
+                    .collect())
+            })
+        }
+    })
+}
+
+/// Edge id of each force diagram segment, #S `uint32_t` (the interior edges, increasing).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_force_diagram_segment_edges(
+    result: *const VsrResult,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.stress()
+                    .force_diagram
+                    .segments
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, s)| s.is_some())
+                    .map(|(e, _)| e as u32)
+                    .collect())
+            })
+        }
+    })
+}
+
+/// ε∞ per form-finding iteration, one double per stress step (dimensionless). For an
+/// analysis result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_eps_history(
+    result: *const VsrResult,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(r.form("the eps history")?.history.clone())
+            })
+        }
+    })
+}
+
+/// Summary of the (last) stress step: `status` (a `VsrStressStatus`), `eps_inf` = max |r_i| /
+/// mean p_i over non-anchored vertices (dimensionless), `objective` = Σ r_i² (force²), and
+/// `qp_iterations` of the interior-point solver. All four pointers required; written only on
+/// success.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_stress_summary(
+    result: *const VsrResult,
+    status: *mut VsrStressStatus,
+    eps_inf: *mut f64,
+    objective: *mut f64,
+    qp_iterations: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let r = unsafe { handle("result", result)? };
+        let outs = (
+            out_ptr("status", status)?,
+            out_ptr("eps_inf", eps_inf)?,
+            out_ptr("objective", objective)?,
+            out_ptr("qp_iterations", qp_iterations)?,
+        );
+        let s = r.stress();
+        // SAFETY: all non-NULL and writable (caller's contract).
+        unsafe {
+            outs.0.write(VsrStressStatus::of(s.status));
+            outs.1.write(s.eps_inf);
+            outs.2.write(s.objective);
+            outs.3.write(s.iterations as usize);
+        }
+        Ok(())
+    })
+}
+
+/// The regulariser ε actually used by the (last) stress step (larger than the setting after
+/// a numerical failure was retried). Written only on success.
+///
+/// # Safety
+/// `result`: a valid handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_regularisation(
+    result: *const VsrResult,
+    out: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { scalars(result, [("out", out)], |r| Ok([r.stress().regularisation])) }
+    })
+}
+
+/// Why form finding stopped (a `VsrTermination`) and how many iterations (stress steps) it
+/// ran. Both pointers required; written only on success. For an analysis result:
+/// `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_termination(
+    result: *const VsrResult,
+    termination: *mut VsrTermination,
+    iterations: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let r = unsafe { handle("result", result)? };
+        let (t, i) = (
+            out_ptr("termination", termination)?,
+            out_ptr("iterations", iterations)?,
+        );
+        let f = r.form("the termination")?;
+        // SAFETY: non-NULL and writable (caller's contract).
+        unsafe {
+            t.write(VsrTermination::of(&f.termination));
+            i.write(f.iterations);
+        }
+        Ok(())
+    })
+}
+
+/// A one-line explanation of the termination, as a NUL-terminated UTF-8 string copied into
+/// `out` (`len` bytes; `needed` counts the terminating NUL). For `VSR_TERMINATION_INFEASIBLE`
+/// it names the constraints to relax, for `VSR_TERMINATION_NUMERICAL_ERROR` where it failed,
+/// for `VSR_TERMINATION_STALLED` the blocking vertices. For an analysis result:
+/// `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable bytes; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_termination_message(
+    result: *const VsrResult,
+    out: *mut c_char,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                let text = match &r.form("the termination message")?.termination {
+                    Termination::Converged => "converged: eps_inf < tolerance".to_string(),
+                    Termination::MaxIterations => "reached the iteration limit".to_string(),
+                    Termination::Stalled { vertices } => format!(
+                        "stalled: vertices {vertices:?} carry (almost) no stress; raise q_min"
+                    ),
+                    Termination::Infeasible { constraint } => {
+                        format!("infeasible stress constraints: relax {constraint}")
+                    }
+                    Termination::NumericalError { what } => format!("numerical error: {what}"),
+                    Termination::Cancelled => "cancelled by the progress callback".to_string(),
+                };
+                let mut bytes: Vec<c_char> = text
+                    .bytes()
+                    .filter(|&b| b != 0)
+                    .map(|b| b as c_char)
+                    .collect();
+                bytes.push(0);
+                Ok(bytes)
+            })
+        }
+    })
+}
+
+/// Vertices listed by a `VSR_TERMINATION_STALLED` form finding, `uint32_t` ids (0 entries for
+/// any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_stalled_vertices(
+    result: *const VsrResult,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                Ok(match &r.form("the stalled vertices")?.termination {
+                    Termination::Stalled { vertices } => vertices.clone(),
+                    _ => Vec::new(),
+                })
+            })
+        }
+    })
+}
+
+/// Distances between the form-found and the input heights, over the plan bounding-box
+/// diagonal (dimensionless): `hausdorff` = max |Δz|, `l2` = area-weighted RMS of Δz. Both
+/// pointers required; written only on success. For an analysis result:
+/// `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_distances(
+    result: *const VsrResult,
+    hausdorff: *mut f64,
+    l2: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, [("hausdorff", hausdorff), ("l2", l2)], |r| {
+                let f = r.form("the distances")?;
+                Ok([f.hausdorff, f.l2])
+            })
+        }
+    })
+}
+
+/// Wall-clock seconds spent in stress steps, in height steps, and in total. For an analysis
+/// result the shape time is 0 and the total is the stress time. All three pointers required;
+/// written only on success.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_timings(
+    result: *const VsrResult,
+    stress_seconds: *mut f64,
+    shape_seconds: *mut f64,
+    total_seconds: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        let outs = [
+            ("stress_seconds", stress_seconds),
+            ("shape_seconds", shape_seconds),
+            ("total_seconds", total_seconds),
+        ];
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, outs, |r| {
+                Ok(match &r.outcome {
+                    Outcome::Analysis { stress, .. } => [stress.seconds, 0.0, stress.seconds],
+                    Outcome::FormFinding(f) => [f.stress_seconds, f.shape_seconds, f.total_seconds],
+                })
+            })
+        }
+    })
+}

@@ -1,0 +1,468 @@
+//! `VsrSettings`: the options of both solves, with one validating setter per option.
+//!
+//! Defaults are those of the Rust [`FormFindSettings::default`]; every setter validates its
+//! value (and, for bounds, the combination with the other bound) before it changes anything.
+
+use super::boundary::{boundary, handle_mut, out_ptr, CResult, Failure};
+use super::status::{self, VsrStatus};
+use crate::stress::QBound;
+use crate::FormFindSettings;
+use std::ffi::{c_int, c_void};
+
+/// Progress callback of `vsr_form_find`, called once per iteration after its stress step with
+/// the 0-based iteration number and that step's ε∞ (max |r_i| / mean load, dimensionless).
+/// Return 0 to continue, non-zero to cancel (the result then reports
+/// `VSR_TERMINATION_CANCELLED` and holds the state reached). It runs on the thread that called
+/// `vsr_form_find`; it must not unwind (throw a C++ exception or longjmp) out of the call, and
+/// must not destroy the handles in use.
+pub type VsrProgressFn =
+    Option<unsafe extern "C" fn(user: *mut c_void, iteration: usize, eps_inf: f64) -> c_int>;
+
+/// Opaque handle: solver options. Create with `vsr_settings_create` (defaults documented
+/// there), change with the `vsr_settings_set_*` functions, free with `vsr_settings_destroy`.
+pub struct VsrSettings {
+    pub(crate) form: FormFindSettings,
+    pub(crate) progress: VsrProgressFn,
+    pub(crate) user: *mut c_void,
+}
+
+/// Creates settings with the documented defaults (those of the Rust `FormFindSettings`):
+///
+/// | option | default |
+/// |---|---|
+/// | tolerance (on ε∞) | 1e-6 |
+/// | max iterations | 50 |
+/// | stall window | 8 iterations |
+/// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_INTERIOR` |
+/// | q_max | none (+INFINITY) |
+/// | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
+/// | hole mode | `VSR_HOLE_MODE_CONSTANT` |
+/// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
+/// | formulation | `VSR_FORMULATION_REDUCED` |
+/// | regularisation ε | 1e-10 |
+/// | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
+/// | progress callback | none |
+///
+/// `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
+/// compression). `out` receives a handle owned by the caller (free with
+/// `vsr_settings_destroy`); untouched on failure.
+///
+/// # Safety
+/// `out` must be writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_create(out: *mut *mut VsrSettings) -> VsrStatus {
+    boundary!({
+        let out = out_ptr("out", out)?;
+        let handle = Box::new(VsrSettings {
+            form: FormFindSettings::default(),
+            progress: None,
+            user: std::ptr::null_mut(),
+        });
+        // SAFETY: non-NULL, writable by the caller's contract.
+        unsafe { out.write(Box::into_raw(handle)) };
+        Ok(())
+    })
+}
+
+/// Frees settings. NULL is a no-op. Results do not refer to their settings.
+///
+/// # Safety
+/// `settings` must be NULL or a handle from `vsr_settings_create` not yet destroyed, used by
+/// no other thread.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_destroy(settings: *mut VsrSettings) {
+    boundary!(keep_error, (), {
+        if !settings.is_null() {
+            // SAFETY: from Box::into_raw in vsr_settings_create, destroyed once.
+            drop(unsafe { Box::from_raw(settings) });
+        }
+    })
+}
+
+/// Applies `f` to a copy of the settings, validates the copy, and stores it on success.
+unsafe fn update(settings: *mut VsrSettings, f: impl FnOnce(&mut FormFindSettings)) -> CResult {
+    // SAFETY: caller's contract (valid handle, exclusive access).
+    let s = unsafe { handle_mut("settings", settings)? };
+    let mut form = s.form.clone();
+    f(&mut form);
+    form.stress.validate().map_err(|e| match e {
+        crate::Error::InvalidArgument { name, reason } => Failure::invalid(name, reason),
+        e => Failure::invalid("settings", e),
+    })?;
+    s.form = form;
+    Ok(())
+}
+
+fn finite(name: &str, v: f64) -> CResult<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Failure::new(
+            VsrStatus::NonFinite,
+            format!("argument `{name}`: {v} is not finite"),
+        ))
+    }
+}
+
+fn at_least(name: &str, v: f64, min: f64, strict: bool) -> CResult<f64> {
+    let v = finite(name, v)?;
+    if v < min || (strict && v == min) {
+        let op = if strict { ">" } else { ">=" };
+        return Err(Failure::invalid(name, format!("{v} must be {op} {min}")));
+    }
+    Ok(v)
+}
+
+/// Sets the convergence tolerance on ε∞ = max |r_i| / mean p_i (dimensionless): form
+/// finding stops when ε∞ < tolerance. Finite and > 0. Default 1e-6.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_tolerance(
+    settings: *mut VsrSettings,
+    tolerance: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("tolerance", tolerance, 0.0, true)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.tolerance = v) }
+    })
+}
+
+/// Sets the maximum number of form-finding iterations (stress steps), >= 1. Default 50.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_max_iterations(
+    settings: *mut VsrSettings,
+    max_iterations: usize,
+) -> VsrStatus {
+    boundary!({
+        if max_iterations == 0 {
+            return Err(Failure::invalid("max_iterations", "must be >= 1"));
+        }
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.max_iterations = max_iterations) }
+    })
+}
+
+/// Sets the stall window: form finding stops as stalled when the best ε∞ has not improved by
+/// 1% over this many iterations. >= 1. Default 8.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_stall_window(
+    settings: *mut VsrSettings,
+    iterations: usize,
+) -> VsrStatus {
+    boundary!({
+        if iterations == 0 {
+            return Err(Failure::invalid("iterations", "must be >= 1"));
+        }
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stall_window = iterations) }
+    })
+}
+
+/// Sets the lower bound q_min on force densities. `kind` is a `VsrBoundKind`:
+/// `VSR_BOUND_KIND_ABSOLUTE` (force per length) or `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀).
+/// `value` finite and >= 0, and <= q_max when both have the same kind. Default 0.05 relative
+/// (0 gives plain compression).
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_q_min(
+    settings: *mut VsrSettings,
+    value: f64,
+    kind: u32,
+) -> VsrStatus {
+    boundary!({
+        let relative = status::bound_kind("kind", kind)?;
+        let v = at_least("value", value, 0.0, false)?;
+        let bound = if relative {
+            QBound::Relative(v)
+        } else {
+            QBound::Absolute(v)
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.q_min = bound) }
+    })
+}
+
+/// Sets which edges q_min applies to: a `VsrEdgeScope`, `VSR_EDGE_SCOPE_INTERIOR` (default)
+/// or `VSR_EDGE_SCOPE_ALL`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_q_min_scope(
+    settings: *mut VsrSettings,
+    scope: u32,
+) -> VsrStatus {
+    boundary!({
+        let scope = status::edge_scope("scope", scope)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.q_min_scope = scope) }
+    })
+}
+
+/// Sets the upper bound q_max on force densities (allowable stress × thickness). `kind` is a
+/// `VsrBoundKind` as for q_min. `value` > 0 and >= q_min when both have the same kind;
+/// +INFINITY removes the bound. Default: no bound.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_q_max(
+    settings: *mut VsrSettings,
+    value: f64,
+    kind: u32,
+) -> VsrStatus {
+    boundary!({
+        let relative = status::bound_kind("kind", kind)?;
+        let bound = if value == f64::INFINITY {
+            None
+        } else {
+            let v = at_least("value", value, 0.0, true)?;
+            Some(if relative {
+                QBound::Relative(v)
+            } else {
+                QBound::Absolute(v)
+            })
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.q_max = bound) }
+    })
+}
+
+/// Sets the normal stress at free boundary vertices: a `VsrTauMode`. Default
+/// `VSR_TAU_MODE_OPTIMIZED`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_tau_mode(
+    settings: *mut VsrSettings,
+    mode: u32,
+) -> VsrStatus {
+    boundary!({
+        let mode = status::tau_mode("mode", mode)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.tau = mode) }
+    })
+}
+
+/// Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_CONSTANT`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_hole_mode(
+    settings: *mut VsrSettings,
+    mode: u32,
+) -> VsrStatus {
+    boundary!({
+        let mode = status::hole_mode("mode", mode)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.holes = mode) }
+    })
+}
+
+/// Sets how face weights become vertex loads: a `VsrLoadRule`. Default
+/// `VSR_LOAD_RULE_BARYCENTRIC`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_load_rule(
+    settings: *mut VsrSettings,
+    rule: u32,
+) -> VsrStatus {
+    boundary!({
+        let rule = status::load_rule("rule", rule)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.load_rule = rule) }
+    })
+}
+
+/// Sets the stress formulation of both solves: a `VsrFormulation`. Default
+/// `VSR_FORMULATION_REDUCED`; `VSR_FORMULATION_EDGE_BASED` is the reference solver.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_formulation(
+    settings: *mut VsrSettings,
+    formulation: u32,
+) -> VsrStatus {
+    boundary!({
+        let formulation = status::formulation("formulation", formulation)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.formulation = formulation) }
+    })
+}
+
+/// Sets ε of the regulariser ε Σ (l_e q_e)² (dimensionless, in the solver's frame) that makes
+/// the force densities unique. Finite and >= 0. Default 1e-10; the solver retries with ε × 100
+/// (twice at most) after a numerical failure and reports the ε used.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_regularisation(
+    settings: *mut VsrSettings,
+    epsilon: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("epsilon", epsilon, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.regularisation = v) }
+    })
+}
+
+/// Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
+/// of the height system; dimensionless). Finite and >= 0. Default 1.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_schedule_mu0(
+    settings: *mut VsrSettings,
+    mu0: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("mu0", mu0, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.schedule.mu0 = v) }
+    })
+}
+
+/// Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.25.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_schedule_beta(
+    settings: *mut VsrSettings,
+    beta: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("beta", beta, 0.0, false)?;
+        if v > 1.0 {
+            return Err(Failure::invalid("beta", format!("{v} must be <= 1")));
+        }
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.schedule.beta = v) }
+    })
+}
+
+/// Sets μ_min, the floor of the proximal weight (dimensionless). Finite and >= 0. Default 1e-9.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_schedule_mu_min(
+    settings: *mut VsrSettings,
+    mu_min: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("mu_min", mu_min, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.schedule.mu_min = v) }
+    })
+}
+
+/// Sets η in the per-vertex proximal weights λ_i = ‖r‖∞ / (|r_i| + η ‖r‖∞) (dimensionless).
+/// Finite and > 0. Default 1e-3.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_schedule_eta(
+    settings: *mut VsrSettings,
+    eta: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("eta", eta, 0.0, true)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.schedule.eta = v) }
+    })
+}
+
+/// Sets ν, the pull of every height towards its input value (relative to the mean diagonal
+/// of the height system; dimensionless). Finite and >= 0; 0 (default) = no pull.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_schedule_pull(
+    settings: *mut VsrSettings,
+    pull: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("pull", pull, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.schedule.pull = v) }
+    })
+}
+
+/// Sets the progress callback of `vsr_form_find` (see `VsrProgressFn`) and the `user` pointer
+/// passed back to it unchanged. `callback` NULL removes it (default: none). Voussoir never
+/// dereferences or frees `user`; it must stay valid while a solve using these settings runs.
+/// If the settings are shared by concurrent solves, the callback is called concurrently.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access; `callback`: NULL or a function with the
+/// `VsrProgressFn` signature.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_progress(
+    settings: *mut VsrSettings,
+    callback: VsrProgressFn,
+    user: *mut c_void,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let s = unsafe { handle_mut("settings", settings)? };
+        s.progress = callback;
+        s.user = if callback.is_some() {
+            user
+        } else {
+            std::ptr::null_mut()
+        };
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EdgeScope, Formulation, HoleMode, LoadRule, TauMode};
+
+    /// The defaults documented on `vsr_settings_create`. When a Rust default changes, update
+    /// the table there (src/capi/settings.rs) and rewrite the header with
+    /// `VSR_BLESS=1 cargo test --test capi_header`.
+    #[test]
+    fn documented_defaults() {
+        let f = FormFindSettings::default();
+        assert_eq!(f.tolerance, 1e-6);
+        assert_eq!(f.max_iterations, 50);
+        assert_eq!(f.stall_window, 8);
+        assert_eq!(f.stress.q_min, QBound::Relative(0.05));
+        assert_eq!(f.stress.q_min_scope, EdgeScope::Interior);
+        assert_eq!(f.stress.q_max, None);
+        assert_eq!(f.stress.tau, TauMode::Optimized);
+        assert_eq!(f.stress.holes, HoleMode::Constant);
+        assert_eq!(f.stress.load_rule, LoadRule::Barycentric);
+        assert_eq!(f.stress.formulation, Formulation::Reduced);
+        assert_eq!(f.stress.regularisation, 1e-10);
+        let s = f.schedule;
+        assert_eq!(
+            [s.mu0, s.beta, s.mu_min, s.eta, s.pull],
+            [1.0, 0.25, 1e-9, 1e-3, 0.0]
+        );
+    }
+}

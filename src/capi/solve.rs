@@ -1,0 +1,90 @@
+//! The two entry points: stress analysis of a fixed shape and form finding.
+
+use super::boundary::{boundary, from_error, handle, out_ptr};
+use super::mesh::VsrMesh;
+use super::result::{Outcome, VsrResult};
+use super::settings::VsrSettings;
+use super::status::VsrStatus;
+use crate::{analyse, form_find};
+
+/// Stress analysis of the mesh as given: the best compressive force densities for its fixed
+/// shape, with the formulation, bounds, τ mode, hole mode and load rule of `settings` (the
+/// form-finding options are ignored). The outcome of the QP is read with
+/// `vsr_result_stress_status`; an infeasible or failed QP is still `VSR_STATUS_OK`.
+///
+/// `out` receives a new result owned by the caller (free with `vsr_result_destroy`); it
+/// copies everything it reports and does not refer to `mesh` or `settings`. Untouched on
+/// failure. `mesh` and `settings` are only read: they may be shared with other threads that
+/// also only read them.
+///
+/// # Safety
+/// `mesh`, `settings`: valid handles; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_analyse(
+    mesh: *const VsrMesh,
+    settings: *const VsrSettings,
+    out: *mut *mut VsrResult,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let (mesh, settings) = unsafe { (handle("mesh", mesh)?, handle("settings", settings)?) };
+        let out = out_ptr("out", out)?;
+        let problem = &mesh.problem;
+        let stress = analyse(problem, &settings.form.stress).map_err(|e| from_error("mesh", e))?;
+        let result = VsrResult::new(
+            &problem.mesh,
+            Outcome::Analysis {
+                positions: problem.mesh.positions.clone(),
+                stress,
+            },
+        );
+        // SAFETY: non-NULL, writable by the caller's contract.
+        unsafe { out.write(Box::into_raw(Box::new(result))) };
+        Ok(())
+    })
+}
+
+/// Form finding: moves the heights (plan fixed, supports fixed) until the shape stands
+/// (ε∞ < tolerance) or the loop stops; each iteration is a stress step (as `vsr_analyse`)
+/// followed by a height step. Calls the progress callback of `settings`, if any, once per
+/// iteration on this thread.
+///
+/// A loop that does not converge is still `VSR_STATUS_OK`: read why it stopped with
+/// `vsr_result_termination`; the result always holds the best final state and its stress.
+/// `out` receives a new result owned by the caller (free with `vsr_result_destroy`);
+/// untouched on failure. `mesh` and `settings` are only read (the mesh keeps its input
+/// heights; read the new ones with `vsr_result_positions`).
+///
+/// # Safety
+/// `mesh`, `settings`: valid handles; `out` writable; the callback and its `user` pointer
+/// valid for the duration of the call.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_form_find(
+    mesh: *const VsrMesh,
+    settings: *const VsrSettings,
+    out: *mut *mut VsrResult,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let (mesh, settings) = unsafe { (handle("mesh", mesh)?, handle("settings", settings)?) };
+        let out = out_ptr("out", out)?;
+        let problem = &mesh.problem;
+        let found = match settings.progress {
+            Some(cb) => {
+                let user = settings.user;
+                let mut progress = |k: usize, eps: f64| {
+                    // SAFETY: the callback and `user` are valid for this call (caller's
+                    // contract); C code does not unwind into Rust.
+                    unsafe { cb(user, k, eps) == 0 }
+                };
+                form_find(problem, &settings.form, Some(&mut progress))
+            }
+            None => form_find(problem, &settings.form, None),
+        }
+        .map_err(|e| from_error("mesh", e))?;
+        let result = VsrResult::new(&problem.mesh, Outcome::FormFinding(found));
+        // SAFETY: non-NULL, writable by the caller's contract.
+        unsafe { out.write(Box::into_raw(Box::new(result))) };
+        Ok(())
+    })
+}

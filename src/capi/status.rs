@@ -1,0 +1,318 @@
+//! Status codes and the enumerations that cross the C ABI.
+//!
+//! Values are explicit and never reused: a removed variant leaves a gap. Enum *inputs* cross as
+//! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`); enum *outputs* are written as these
+//! types (`uint32_t` in C).
+
+use super::boundary::{CResult, Failure};
+use crate::geometry::loads::LoadRule;
+use crate::stress::airy::HoleMode;
+use crate::stress::{EdgeScope, Formulation, StressStatus, TauMode};
+use crate::Termination;
+
+/// Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
+/// function wrote no output (except `needed` with `VSR_STATUS_BUFFER_TOO_SMALL`) and
+/// `vsr_last_error_message()` says what was wrong. A solve that does not converge is still
+/// `VSR_STATUS_OK`: read its outcome with `vsr_result_termination()`.
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrStatus {
+    /// Success.
+    Ok = 0,
+    /// A required pointer argument is NULL (or an array is NULL with a non-zero length).
+    NullPointer = 1,
+    /// An argument has an invalid value (wrong length, negative, out of its range, ...).
+    InvalidArgument = 2,
+    /// A length times its row width overflows `size_t` or exceeds the supported maximum.
+    LengthOverflow = 3,
+    /// A vertex id (in `triangles` or `anchored`) is `>= n_vertices`.
+    IndexOutOfRange = 4,
+    /// A coordinate or value is NaN or infinite.
+    NonFinite = 5,
+    /// A `uint32_t` enum argument has no matching `VSR_*` constant.
+    InvalidEnum = 6,
+    /// A copy-out buffer is shorter than the data; `*needed` holds the required length.
+    BufferTooSmall = 7,
+    /// The mesh has no vertex or no triangle.
+    EmptyMesh = 8,
+    /// Connectivity is unusable: repeated vertex in a face, duplicate faces, non-manifold edge
+    /// or vertex, inconsistent orientation, a hole that cannot be cut.
+    InvalidTopology = 9,
+    /// The plan (x, y projection) is unusable: zero-area, flipped or overlapping faces.
+    InvalidPlan = 10,
+    /// No vertex is anchored, or a connected component has none.
+    NoSupport = 11,
+    /// The result does not hold this quantity (e.g. the ε∞ history of a stress analysis).
+    NotAvailable = 12,
+    /// A numerical failure inside a solver (not a property of the input).
+    Numerical = 13,
+    /// A panic was caught at the boundary: a bug in Voussoir. The handles passed in are
+    /// unchanged and may still be used or destroyed.
+    Panic = 100,
+}
+
+impl VsrStatus {
+    /// The constant's name as in the header, e.g. "VSR_STATUS_OK".
+    pub fn name(self) -> &'static std::ffi::CStr {
+        match self {
+            VsrStatus::Ok => c"VSR_STATUS_OK",
+            VsrStatus::NullPointer => c"VSR_STATUS_NULL_POINTER",
+            VsrStatus::InvalidArgument => c"VSR_STATUS_INVALID_ARGUMENT",
+            VsrStatus::LengthOverflow => c"VSR_STATUS_LENGTH_OVERFLOW",
+            VsrStatus::IndexOutOfRange => c"VSR_STATUS_INDEX_OUT_OF_RANGE",
+            VsrStatus::NonFinite => c"VSR_STATUS_NON_FINITE",
+            VsrStatus::InvalidEnum => c"VSR_STATUS_INVALID_ENUM",
+            VsrStatus::BufferTooSmall => c"VSR_STATUS_BUFFER_TOO_SMALL",
+            VsrStatus::EmptyMesh => c"VSR_STATUS_EMPTY_MESH",
+            VsrStatus::InvalidTopology => c"VSR_STATUS_INVALID_TOPOLOGY",
+            VsrStatus::InvalidPlan => c"VSR_STATUS_INVALID_PLAN",
+            VsrStatus::NoSupport => c"VSR_STATUS_NO_SUPPORT",
+            VsrStatus::NotAvailable => c"VSR_STATUS_NOT_AVAILABLE",
+            VsrStatus::Numerical => c"VSR_STATUS_NUMERICAL",
+            VsrStatus::Panic => c"VSR_STATUS_PANIC",
+        }
+    }
+
+    /// Every status, for `vsr_status_name` and tests.
+    pub const ALL: [VsrStatus; 15] = [
+        VsrStatus::Ok,
+        VsrStatus::NullPointer,
+        VsrStatus::InvalidArgument,
+        VsrStatus::LengthOverflow,
+        VsrStatus::IndexOutOfRange,
+        VsrStatus::NonFinite,
+        VsrStatus::InvalidEnum,
+        VsrStatus::BufferTooSmall,
+        VsrStatus::EmptyMesh,
+        VsrStatus::InvalidTopology,
+        VsrStatus::InvalidPlan,
+        VsrStatus::NoSupport,
+        VsrStatus::NotAvailable,
+        VsrStatus::Numerical,
+        VsrStatus::Panic,
+    ];
+}
+
+/// Why form finding stopped (`vsr_result_termination`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrTermination {
+    /// ε∞ fell below the tolerance.
+    Converged = 0,
+    /// The iteration limit was reached first.
+    MaxIterations = 1,
+    /// ε∞ stopped improving; `vsr_result_stalled_vertices` lists vertices that carry (almost)
+    /// no stress and cannot be balanced by moving heights (raise q_min).
+    Stalled = 2,
+    /// The stress constraints admit no solution; `vsr_result_termination_message` names the
+    /// setting to relax.
+    Infeasible = 3,
+    /// A solver failed numerically; `vsr_result_termination_message` says where.
+    NumericalError = 4,
+    /// The progress callback returned non-zero.
+    Cancelled = 5,
+}
+
+impl VsrTermination {
+    pub(crate) fn of(t: &Termination) -> VsrTermination {
+        match t {
+            Termination::Converged => VsrTermination::Converged,
+            Termination::MaxIterations => VsrTermination::MaxIterations,
+            Termination::Stalled { .. } => VsrTermination::Stalled,
+            Termination::Infeasible { .. } => VsrTermination::Infeasible,
+            Termination::NumericalError { .. } => VsrTermination::NumericalError,
+            Termination::Cancelled => VsrTermination::Cancelled,
+        }
+    }
+}
+
+/// How the (last) stress QP ended (`vsr_result_stress_status`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrStressStatus {
+    Solved = 0,
+    /// Solved to reduced accuracy.
+    AlmostSolved = 1,
+    /// The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
+    Infeasible = 2,
+    MaxIterations = 3,
+    NumericalError = 4,
+}
+
+impl VsrStressStatus {
+    pub(crate) fn of(s: StressStatus) -> VsrStressStatus {
+        match s {
+            StressStatus::Solved => VsrStressStatus::Solved,
+            StressStatus::AlmostSolved => VsrStressStatus::AlmostSolved,
+            StressStatus::Infeasible => VsrStressStatus::Infeasible,
+            StressStatus::MaxIterations => VsrStressStatus::MaxIterations,
+            StressStatus::NumericalError => VsrStressStatus::NumericalError,
+        }
+    }
+}
+
+/// Which solve produced a result (`vsr_result_kind`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrResultKind {
+    /// `vsr_analyse`: stress of the fixed input shape.
+    Analysis = 0,
+    /// `vsr_form_find`: heights moved until the shape stands (or the loop stopped).
+    FormFinding = 1,
+}
+
+/// Normal stress τ at free boundary vertices (`vsr_settings_set_tau_mode`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrTauMode {
+    /// Default: an optimised inward push τ >= 0 per free vertex (as in the paper); non-zero τ
+    /// means the edge needs a tie or buttress there.
+    Optimized = 0,
+    /// No normal stress: a truly free edge.
+    Zero = 1,
+    /// The values given with `vsr_mesh_set_prescribed_tau`.
+    Prescribed = 2,
+}
+
+/// Stress through holes (`vsr_settings_set_hole_mode`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrHoleMode {
+    /// Default: a constant Airy jump per hole (the paper's hole-induced stress).
+    Constant = 0,
+    /// An affine jump: also a net horizontal force through the hole.
+    Affine = 1,
+}
+
+/// How a face's weight is shared among its vertices (`vsr_settings_set_load_rule`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrLoadRule {
+    /// Default: one third of the 3-D triangle area each (the paper's rule).
+    Barycentric = 0,
+    /// Mixed Voronoi area of the 3-D triangle.
+    Voronoi = 1,
+    /// One third of the plan (projected) area each.
+    PlanArea = 2,
+}
+
+/// Stress formulation (`vsr_settings_set_formulation`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrFormulation {
+    /// Default: de Goes et al. 2013, Airy values as unknowns.
+    Reduced = 0,
+    /// Vouga et al. 2012, one force density per edge: the reference solver.
+    EdgeBased = 1,
+}
+
+/// Units of a force-density bound (`vsr_settings_set_q_min`, `vsr_settings_set_q_max`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrBoundKind {
+    /// Force per length, in the model's units.
+    Absolute = 0,
+    /// A multiple of the problem's natural scale p̄ / L₀ (mean load over non-anchored
+    /// vertices / half the plan diagonal).
+    Relative = 1,
+}
+
+/// Edges a lower bound q_min applies to (`vsr_settings_set_q_min_scope`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrEdgeScope {
+    /// Default: interior edges only.
+    Interior = 0,
+    /// Interior and boundary edges.
+    All = 1,
+}
+
+fn bad_enum(name: &str, value: u32, allowed: &str) -> Failure {
+    Failure::new(
+        super::VsrStatus::InvalidEnum,
+        format!("argument `{name}`: {value} is not one of {allowed}"),
+    )
+}
+
+pub(crate) fn tau_mode(name: &str, v: u32) -> CResult<TauMode> {
+    Ok(match v {
+        0 => TauMode::Optimized,
+        1 => TauMode::Zero,
+        2 => TauMode::Prescribed,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_TAU_MODE_OPTIMIZED (0), VSR_TAU_MODE_ZERO (1), VSR_TAU_MODE_PRESCRIBED (2)",
+            ))
+        }
+    })
+}
+
+pub(crate) fn hole_mode(name: &str, v: u32) -> CResult<HoleMode> {
+    Ok(match v {
+        0 => HoleMode::Constant,
+        1 => HoleMode::Affine,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_HOLE_MODE_CONSTANT (0), VSR_HOLE_MODE_AFFINE (1)",
+            ))
+        }
+    })
+}
+
+pub(crate) fn load_rule(name: &str, v: u32) -> CResult<LoadRule> {
+    Ok(match v {
+        0 => LoadRule::Barycentric,
+        1 => LoadRule::Voronoi,
+        2 => LoadRule::PlanArea,
+        _ => return Err(bad_enum(
+            name,
+            v,
+            "VSR_LOAD_RULE_BARYCENTRIC (0), VSR_LOAD_RULE_VORONOI (1), VSR_LOAD_RULE_PLAN_AREA (2)",
+        )),
+    })
+}
+
+pub(crate) fn formulation(name: &str, v: u32) -> CResult<Formulation> {
+    Ok(match v {
+        0 => Formulation::Reduced,
+        1 => Formulation::EdgeBased,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_FORMULATION_REDUCED (0), VSR_FORMULATION_EDGE_BASED (1)",
+            ))
+        }
+    })
+}
+
+pub(crate) fn edge_scope(name: &str, v: u32) -> CResult<EdgeScope> {
+    Ok(match v {
+        0 => EdgeScope::Interior,
+        1 => EdgeScope::All,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_EDGE_SCOPE_INTERIOR (0), VSR_EDGE_SCOPE_ALL (1)",
+            ))
+        }
+    })
+}
+
+/// True for `VSR_BOUND_KIND_RELATIVE`.
+pub(crate) fn bound_kind(name: &str, v: u32) -> CResult<bool> {
+    match v {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => Err(bad_enum(
+            name,
+            v,
+            "VSR_BOUND_KIND_ABSOLUTE (0), VSR_BOUND_KIND_RELATIVE (1)",
+        )),
+    }
+}
