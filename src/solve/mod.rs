@@ -4,7 +4,9 @@
 use crate::error::Result;
 use crate::problem::Problem;
 use crate::shape::{Schedule, ShapeStep};
-use crate::stress::{analyse_at, EdgeScope, QBound, StressResult, StressSettings, StressStatus};
+use crate::stress::{
+    analyse_near, EdgeScope, Prior, QBound, StressResult, StressSettings, StressStatus,
+};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -40,24 +42,29 @@ pub struct FormFindSettings {
     pub schedule: Schedule,
     /// Stalled when the best ε∞ has not improved by 1% over this many iterations.
     pub stall_window: usize,
+    /// Weight of the proximal term Σ l_e² (q_e − q_e^prev)² (frame units) in stress steps after
+    /// the first. Default 1e-6.
+    pub proximal_weight: f64,
 }
 
 impl Default for FormFindSettings {
-    /// Defaults that converge on every shared model: compression bounded away from zero on
-    /// interior edges (a vertex whose edges all reach q = 0 cannot be balanced whatever its
-    /// height) and optimised τ at free vertices (a straight free edge carries no compression
-    /// otherwise; non-zero τ means the edge needs a tie or buttress there).
+    /// Defaults that converge on the shared models: compression bounded away from zero on all
+    /// edges (a vertex whose edges all reach q = 0 — an interior vertex, or a free corner with
+    /// only boundary edges — cannot be balanced whatever its height) and optimised τ at free
+    /// vertices (a straight free edge carries no compression otherwise; non-zero τ means the
+    /// edge needs a tie or buttress there).
     fn default() -> Self {
         FormFindSettings {
             stress: StressSettings {
                 q_min: QBound::Relative(0.05),
-                q_min_scope: EdgeScope::Interior,
+                q_min_scope: EdgeScope::All,
                 ..Default::default()
             },
             tolerance: 1e-6,
             max_iterations: 50,
             schedule: Schedule::default(),
             stall_window: 8,
+            proximal_weight: 1e-6,
         }
     }
 }
@@ -73,7 +80,8 @@ pub struct FormFindResult {
     pub positions: Vec<[f64; 3]>,
     /// The last stress step, at `positions` (its residuals certify the result).
     pub stress: StressResult,
-    /// ε∞ per iteration (one entry per stress step).
+    /// ε∞ after each stress step, plus a last entry when the final shape step was certified
+    /// with the previous forces.
     pub history: Vec<f64>,
     pub iterations: usize,
     /// Vertex-based distances to the input, normalised by the plan bounding-box diagonal:
@@ -112,7 +120,14 @@ pub fn form_find(
     let mut termination = Termination::MaxIterations;
     for k in 0..settings.max_iterations.max(1) {
         let t = Instant::now();
-        let stress = analyse_at(problem, &positions, &settings.stress)?;
+        let prior = last
+            .as_ref()
+            .filter(|s| s.status.is_solved())
+            .map(|s| Prior {
+                force_densities: &s.force_densities,
+                weight: settings.proximal_weight,
+            });
+        let stress = analyse_near(problem, &positions, &settings.stress, prior)?;
         stress_s += t.elapsed().as_secs_f64();
         history.push(stress.eps_inf);
         let status = stress.status;

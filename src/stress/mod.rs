@@ -128,6 +128,27 @@ pub fn analyse_at(
     positions: &[[f64; 3]],
     settings: &StressSettings,
 ) -> Result<StressResult> {
+    analyse_near(problem, positions, settings, None)
+}
+
+/// A proximal centre for the stress step: the regulariser becomes
+/// `weight` Σ l_e² (q_e − prior_e)² (frame units) instead of ε Σ l_e² q_e². Form finding passes
+/// the previous iteration's forces: among equally good stresses the step then stays close to
+/// the last one, and at a self-supporting fixed point the term vanishes.
+#[derive(Debug, Clone, Copy)]
+pub struct Prior<'a> {
+    /// Physical force density per edge.
+    pub force_densities: &'a [f64],
+    pub weight: f64,
+}
+
+/// [`analyse_at`] with an optional proximal centre.
+pub fn analyse_near(
+    problem: &Problem,
+    positions: &[[f64; 3]],
+    settings: &StressSettings,
+    prior: Option<Prior>,
+) -> Result<StressResult> {
     settings.validate()?;
     let start = Instant::now();
     let mesh = &problem.mesh;
@@ -224,9 +245,28 @@ pub fn analyse_at(
         }
     };
 
-    let mut regularisation = settings.regularisation;
+    // Interior-point methods can fail on degenerate problems (straight free edges force q = 0:
+    // no strictly feasible point). The lifted and the plain reduced QP fail on different ones,
+    // so alternate between them before raising ε.
+    let reduced = settings.formulation == Formulation::Reduced;
+    let attempts: &[(bool, f64)] = if reduced {
+        &[
+            (true, 1.0),
+            (false, 1.0),
+            (true, 100.0),
+            (false, 100.0),
+            (true, 1e4),
+        ]
+    } else {
+        &[(false, 1.0), (false, 100.0), (false, 1e4)]
+    };
+    let base = prior.map_or(settings.regularisation, |p| p.weight);
+    let prior_frame: Option<Vec<f64>> =
+        prior.map(|p| p.force_densities.iter().map(|q| q / unit).collect());
+    let mut regularisation = base;
     let mut out = None;
-    for _attempt in 0..3 {
+    for &(lift_forces, factor) in attempts {
+        regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
         let o = qp::solve(&qp::QpInput {
             s: &s,
             edges: &edges,
@@ -240,14 +280,14 @@ pub fn analyse_at(
             tau_normal: &tau_normal,
             bounds: &bounds,
             regularisation,
-            lift_forces: settings.formulation == Formulation::Reduced,
+            prior: prior_frame.as_deref(),
+            lift_forces,
         });
         let failed = StressStatus::from_clarabel(o.status) == StressStatus::NumericalError;
         out = Some(o);
         if !failed {
             break;
         }
-        regularisation = (regularisation * 100.0).max(1e-12);
     }
     let out = out.expect("at least one attempt");
     let status = StressStatus::from_clarabel(out.status);
@@ -344,6 +384,48 @@ pub fn analyse_at(
         regularisation,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+impl StressResult {
+    /// The same force densities certified at new heights (plan unchanged): loads, residuals,
+    /// ε∞ and objective are recomputed at `positions`.
+    pub fn at_heights(
+        &self,
+        problem: &Problem,
+        positions: &[[f64; 3]],
+        settings: &StressSettings,
+    ) -> StressResult {
+        let mesh = &problem.mesh;
+        let load = loads::vertex_loads(
+            mesh,
+            positions,
+            settings.load_rule,
+            &problem.face_density,
+            &problem.extra_loads,
+        );
+        let free = non_anchored(mesh);
+        let mean_load = mean_over(&load, &free);
+        let p_bar = if mean_load > 0.0 { mean_load } else { 1.0 };
+        let (residuals, horizontal_imbalance) = equilibrium(
+            mesh,
+            positions,
+            &self.force_densities,
+            &load,
+            &self.external_horizontal,
+        );
+        let max_r = free
+            .iter()
+            .map(|&v| residuals[v as usize].abs())
+            .fold(0.0, f64::max);
+        StressResult {
+            eps_inf: max_r / p_bar,
+            objective: free.iter().map(|&v| residuals[v as usize].powi(2)).sum(),
+            loads: load,
+            residuals,
+            horizontal_imbalance,
+            ..self.clone()
+        }
+    }
 }
 
 fn mean_over(x: &[f64], ids: &[u32]) -> f64 {

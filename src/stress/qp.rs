@@ -36,6 +36,8 @@ pub struct QpInput<'a> {
     /// Per edge: None for an edge without force, else (lower, upper) bounds on q.
     pub bounds: &'a [Option<(f64, f64)>],
     pub regularisation: f64,
+    /// Centre q̂ of the regulariser ε Σ l_e² (q_e − q̂_e)² (per edge); None: q̂ = 0.
+    pub prior: Option<&'a [f64]>,
     /// Lift the force densities as variables (q − S y = 0, simple bounds on q). Needed when S
     /// is not a selection: bounds on combinations S y make degenerate problems (straight free
     /// edges force q = 0, so no strictly feasible point) numerically fragile.
@@ -213,7 +215,16 @@ pub fn solve(inp: &QpInput) -> QpOutput {
 
     let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
     let am = CscMatrix::new_from_triplets(row, n, a.i, a.j, a.v);
-    let q = vec![0.0; n];
+    // Linear part of the regulariser around the prior: −2 ε l² q̂ on each q_e.
+    let mut q = vec![0.0; n];
+    if let Some(prior) = inp.prior {
+        for (e, centre) in prior.iter().enumerate() {
+            let w = -2.0 * inp.regularisation * inp.length[e] * inp.length[e] * centre;
+            for (c, v) in force.row(e) {
+                q[c] += w * v;
+            }
+        }
+    }
     let cones = [
         SupportedConeT::ZeroConeT(n_zero),
         SupportedConeT::NonnegativeConeT(row - n_zero),
