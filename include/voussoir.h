@@ -383,11 +383,11 @@ enum VsrEdgeScope
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
   /**
-   * Default: interior edges only.
+   * Interior edges only.
    */
   VSR_EDGE_SCOPE_INTERIOR = 0,
   /**
-   * Interior and boundary edges.
+   * Default: interior and boundary edges.
    */
   VSR_EDGE_SCOPE_ALL = 1,
 };
@@ -826,7 +826,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | tolerance (on ε∞) | 1e-6 |
  * | max iterations | 50 |
  * | stall window | 8 iterations |
- * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_INTERIOR` |
+ * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
  * | q_max | none (+INFINITY) |
  * | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
  * | hole mode | `VSR_HOLE_MODE_CONSTANT` |
@@ -834,6 +834,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | regularisation ε | 1e-10 |
  * | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
+ * | proximal weight | 1e-6 |
  * | progress callback | none |
  *
  * `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
@@ -892,8 +893,9 @@ VsrStatus vsr_settings_set_stall_window(struct VsrSettings *settings, size_t ite
 VsrStatus vsr_settings_set_q_min(struct VsrSettings *settings, double value, uint32_t kind);
 
 /**
- * Sets which edges q_min applies to: a `VsrEdgeScope`, `VSR_EDGE_SCOPE_INTERIOR` (default)
- * or `VSR_EDGE_SCOPE_ALL`.
+ * Sets which edges q_min applies to: a `VsrEdgeScope`, `VSR_EDGE_SCOPE_ALL` (default: a free
+ * corner with only boundary edges could otherwise reach q = 0 and never balance) or
+ * `VSR_EDGE_SCOPE_INTERIOR`.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.
@@ -997,6 +999,17 @@ VsrStatus vsr_settings_set_schedule_eta(struct VsrSettings *settings, double eta
  * `settings`: a valid handle with exclusive access.
  */
 VsrStatus vsr_settings_set_schedule_pull(struct VsrSettings *settings, double pull);
+
+/**
+ * Sets the weight of the proximal term Σ l_e² (q_e − q_e^prev)² (dimensionless, in the
+ * solver's frame) that keeps each form-finding stress step after the first near the previous
+ * force densities (it vanishes at a self-supporting fixed point). Finite and >= 0; 0 turns it
+ * off. Default 1e-6. Not used by `vsr_analyse`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_proximal_weight(struct VsrSettings *settings, double weight);
 
 /**
  * Sets the progress callback of `vsr_form_find` (see `VsrProgressFn`) and the `user` pointer

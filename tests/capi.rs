@@ -423,7 +423,7 @@ fn mesh_queries_reject_null_and_short_buffers() {
 fn settings_setters_reject_bad_values() {
     let s = settings();
     type F64Setter = unsafe extern "C" fn(*mut VsrSettings, f64) -> VsrStatus;
-    let doubles: [(F64Setter, &str, f64, VsrStatus); 18] = [
+    let doubles: [(F64Setter, &str, f64, VsrStatus); 20] = [
         (
             vsr_settings_set_tolerance,
             "tolerance",
@@ -514,6 +514,18 @@ fn settings_setters_reject_bad_values() {
             vsr_settings_set_schedule_pull,
             "pull",
             f64::INFINITY,
+            S::NonFinite,
+        ),
+        (
+            vsr_settings_set_proximal_weight,
+            "weight",
+            -1e-6,
+            S::InvalidArgument,
+        ),
+        (
+            vsr_settings_set_proximal_weight,
+            "weight",
+            f64::NAN,
             S::NonFinite,
         ),
         (vsr_settings_set_tolerance, "settings", 1e-6, S::NullPointer),

@@ -33,7 +33,7 @@ pub struct VsrSettings {
 /// | tolerance (on ε∞) | 1e-6 |
 /// | max iterations | 50 |
 /// | stall window | 8 iterations |
-/// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_INTERIOR` |
+/// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
 /// | q_max | none (+INFINITY) |
 /// | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
 /// | hole mode | `VSR_HOLE_MODE_CONSTANT` |
@@ -41,6 +41,7 @@ pub struct VsrSettings {
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | regularisation ε | 1e-10 |
 /// | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
+/// | proximal weight | 1e-6 |
 /// | progress callback | none |
 ///
 /// `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
@@ -193,8 +194,9 @@ pub unsafe extern "C" fn vsr_settings_set_q_min(
     })
 }
 
-/// Sets which edges q_min applies to: a `VsrEdgeScope`, `VSR_EDGE_SCOPE_INTERIOR` (default)
-/// or `VSR_EDGE_SCOPE_ALL`.
+/// Sets which edges q_min applies to: a `VsrEdgeScope`, `VSR_EDGE_SCOPE_ALL` (default: a free
+/// corner with only boundary edges could otherwise reach q = 0 and never balance) or
+/// `VSR_EDGE_SCOPE_INTERIOR`.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -410,6 +412,25 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_pull(
     })
 }
 
+/// Sets the weight of the proximal term Σ l_e² (q_e − q_e^prev)² (dimensionless, in the
+/// solver's frame) that keeps each form-finding stress step after the first near the previous
+/// force densities (it vanishes at a self-supporting fixed point). Finite and >= 0; 0 turns it
+/// off. Default 1e-6. Not used by `vsr_analyse`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_proximal_weight(
+    settings: *mut VsrSettings,
+    weight: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("weight", weight, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.proximal_weight = v) }
+    })
+}
+
 /// Sets the progress callback of `vsr_form_find` (see `VsrProgressFn`) and the `user` pointer
 /// passed back to it unchanged. `callback` NULL removes it (default: none). Voussoir never
 /// dereferences or frees `user`; it must stay valid while a solve using these settings runs.
@@ -452,7 +473,7 @@ mod tests {
         assert_eq!(f.max_iterations, 50);
         assert_eq!(f.stall_window, 8);
         assert_eq!(f.stress.q_min, QBound::Relative(0.05));
-        assert_eq!(f.stress.q_min_scope, EdgeScope::Interior);
+        assert_eq!(f.stress.q_min_scope, EdgeScope::All);
         assert_eq!(f.stress.q_max, None);
         assert_eq!(f.stress.tau, TauMode::Optimized);
         assert_eq!(f.stress.holes, HoleMode::Constant);

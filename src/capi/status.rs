@@ -221,9 +221,9 @@ pub enum VsrBoundKind {
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VsrEdgeScope {
-    /// Default: interior edges only.
+    /// Interior edges only.
     Interior = 0,
-    /// Interior and boundary edges.
+    /// Default: interior and boundary edges.
     All = 1,
 }
 
