@@ -1,0 +1,272 @@
+//! Form finding (issue 3): every result is certified independently — loads from the 3-D
+//! triangle areas, vertical residuals, compression and horizontal balance are recomputed here
+//! from the returned positions, force densities and external forces, not through the library.
+
+mod common;
+use common::{load_model, polar_cap, MODELS};
+use voussoir::generate::{self, Domain};
+use voussoir::*;
+
+/// Independent certificate: returns ε∞ after asserting q ≥ 0 and horizontal balance.
+fn certify(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
+    let mesh = &problem.mesh;
+    let x = &r.positions;
+    let q = &r.stress.force_densities;
+    let n = x.len();
+    let mut load = problem.extra_loads.clone();
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let [a, b, c] = f.map(|v| x[v as usize]);
+        let (u, w) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let cr = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let area = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt() / 2.0;
+        f.iter()
+            .for_each(|&v| load[v as usize] += problem.face_density[t] * area / 3.0);
+    }
+    let mut r_vert = vec![0.0; n];
+    let mut r_hor = vec![[0.0; 2]; n];
+    for (e, edge) in mesh.edges.iter().enumerate() {
+        let [i, j] = edge.v.map(|v| v as usize);
+        for (a, b) in [(i, j), (j, i)] {
+            r_vert[a] += q[e] * (x[a][2] - x[b][2]);
+            r_hor[a][0] += q[e] * (x[a][0] - x[b][0]);
+            r_hor[a][1] += q[e] * (x[a][1] - x[b][1]);
+        }
+    }
+    let free: Vec<usize> = (0..n)
+        .filter(|&v| mesh.referenced[v] && !mesh.anchored[v])
+        .collect();
+    let p_bar = free.iter().map(|&v| load[v]).sum::<f64>() / free.len() as f64;
+    let q_max = q.iter().fold(0.0f64, |m, v| m.max(*v));
+    let q_min = q.iter().fold(f64::INFINITY, |m, v| m.min(*v));
+    assert!(q_min >= -1e-9 * q_max, "{label}: tension {q_min:e}");
+    let mut eps: f64 = 0.0;
+    for &v in &free {
+        eps = eps.max((r_vert[v] - load[v]).abs() / p_bar);
+        let ext = r.stress.external_horizontal[v];
+        let h = (r_hor[v][0] + ext[0])
+            .abs()
+            .max((r_hor[v][1] + ext[1]).abs());
+        assert!(
+            h <= 1e-7 * p_bar,
+            "{label}: vertex {v} horizontal imbalance {:e} p̄",
+            h / p_bar
+        );
+    }
+    assert!(
+        eps < 1e-6,
+        "{label}: independently recomputed eps_inf {eps:e} ({:?})",
+        r.termination
+    );
+    eps
+}
+
+fn run(label: &str, problem: &Problem) -> FormFindResult {
+    let r = form_find(problem, &FormFindSettings::default(), None).unwrap();
+    assert_eq!(
+        r.termination,
+        Termination::Converged,
+        "{label}: history {:?}",
+        r.history
+    );
+    let eps = certify(label, problem, &r);
+    println!(
+        "{label}: V={} {} iterations, eps_inf {eps:.2e}, hausdorff {:.4}, l2 {:.4}, {:.2}s",
+        problem.mesh.positions.len(),
+        r.iterations,
+        r.hausdorff,
+        r.l2,
+        r.total_seconds
+    );
+    r
+}
+
+#[test]
+fn every_shared_model_converges_with_default_settings() {
+    for name in MODELS {
+        let Some(mesh) = load_model(name) else { return };
+        let r = run(name, &Problem::new(mesh));
+        assert!(r.iterations <= 30, "{name}: {} iterations", r.iterations);
+    }
+}
+
+#[test]
+fn hemisphere_on_an_anchored_rim_is_reshaped() {
+    let problem = Problem::new(polar_cap(8, std::f64::consts::FRAC_PI_2));
+    let r = run("hemisphere", &problem);
+    assert!(
+        r.hausdorff > 1e-3,
+        "a hemisphere cannot stand as it is: it must change"
+    );
+}
+
+#[test]
+fn a_dent_in_a_cap_is_repaired_locally() {
+    let (centre, radius) = ([0.45, 0.0], 0.2);
+    let (p, t) = generate::polar_disk(12);
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| {
+            let d = (u[0] - centre[0]).hypot(u[1] - centre[1]) / radius;
+            let dent = if d < 1.0 {
+                0.08 * (1.0 + (std::f64::consts::PI * d).cos()) / 2.0
+            } else {
+                0.0
+            };
+            generate::spherical_cap(1.0, std::f64::consts::FRAC_PI_4, u[0].hypot(u[1])) - dent
+        },
+        |_, outer| outer,
+    )
+    .unwrap();
+    let problem = Problem::new(mesh);
+    let r = run("dented cap", &problem);
+    let (mut near, mut all) = (0.0, 0.0);
+    for (v, p) in problem.mesh.positions.iter().enumerate() {
+        let dz = (r.positions[v][2] - p[2]).abs();
+        all += dz;
+        if (p[0] - centre[0]).hypot(p[1] - centre[1]) < 2.0 * radius {
+            near += dz;
+        }
+    }
+    assert!(
+        near > 0.5 * all,
+        "only {:.0}% of the height change is near the dent",
+        100.0 * near / all
+    );
+}
+
+#[test]
+fn dome_with_a_free_oculus() {
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, 40),
+        holes: vec![generate::circle([0.0, 0.0], 0.2, 12)],
+    };
+    let (p, t) = generate::triangulate(&domain, 0.006).unwrap();
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 1.0, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .unwrap();
+    assert_eq!(mesh.holes().count(), 1);
+    run("free oculus", &Problem::new(mesh));
+}
+
+#[test]
+fn barrel_vault_with_free_gables() {
+    let outer = generate::rectangle(-1.0, -1.5, 1.0, 1.5, 8, 12);
+    let (p, t) = generate::triangulate(
+        &Domain {
+            outer,
+            holes: vec![],
+        },
+        0.01,
+    )
+    .unwrap();
+    // Long sides (x = ±1) anchored, gables (y = ±1.5) free; a segmental barrel of 60°.
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 1.0, u[0].abs()),
+        |u, _| (u[0].abs() - 1.0).abs() < 1e-9,
+    )
+    .unwrap();
+    let r = run("barrel vault", &Problem::new(mesh));
+    // The gables are free edges: any normal push they need is reported per vertex.
+    assert!(r.stress.tau.iter().all(|t| t.is_finite() && *t >= 0.0));
+}
+
+#[test]
+fn dome_with_an_anchored_off_centre_hole() {
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, 40),
+        holes: vec![generate::circle([0.3, 0.1], 0.25, 14)],
+    };
+    let (p, t) = generate::triangulate(&domain, 0.008).unwrap();
+    // A steep dome (rim at 80°): it cannot stand as given, so the loop must reshape it.
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 1.4, u[0].hypot(u[1])),
+        |u, outer| outer || (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26,
+    )
+    .unwrap();
+    let r = run("anchored hole", &Problem::new(mesh));
+    assert!(
+        r.iterations > 2 && r.hausdorff > 1e-3,
+        "the steep dome must be reshaped"
+    );
+}
+
+#[test]
+fn a_light_or_heavy_cap_changes_the_shape() {
+    let (p, t) = generate::polar_disk(10);
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 1.2, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .unwrap();
+    let cap: Vec<bool> = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            f.iter()
+                .all(|&v| mesh.positions[v as usize][0].hypot(mesh.positions[v as usize][1]) < 0.35)
+        })
+        .collect();
+    let mut crowns = Vec::new();
+    for factor in [0.1, 1.0, 5.0] {
+        let density = cap.iter().map(|&c| if c { factor } else { 1.0 }).collect();
+        let problem = Problem::new(mesh.clone())
+            .with_face_density(density)
+            .unwrap();
+        let r = run(&format!("cap density x{factor}"), &problem);
+        crowns.push(r.positions[0][2]);
+    }
+    // The centre vertex moves with the cap's weight, monotonically.
+    assert!((crowns[2] - crowns[0]).abs() > 0.01, "crowns {crowns:?}");
+    assert!(
+        (crowns[0] < crowns[1]) == (crowns[1] < crowns[2]),
+        "crowns {crowns:?}"
+    );
+}
+
+#[test]
+fn cancellation_and_progress_are_reported() {
+    let problem = Problem::new(polar_cap(6, std::f64::consts::FRAC_PI_2));
+    let mut seen = Vec::new();
+    let mut cb = |k: usize, eps: f64| {
+        seen.push((k, eps));
+        k < 2
+    };
+    let r = form_find(&problem, &FormFindSettings::default(), Some(&mut cb)).unwrap();
+    assert_eq!(r.termination, Termination::Cancelled);
+    assert_eq!(seen.len(), 3);
+    assert_eq!(r.history.len(), 3);
+    assert_eq!(seen.iter().map(|s| s.1).collect::<Vec<_>>(), r.history);
+}
+
+#[test]
+fn infeasible_bounds_are_reported_not_hidden() {
+    // q_min > q_max cannot be validated away when one is relative and the other absolute.
+    let problem = Problem::new(polar_cap(6, 0.8));
+    let mut settings = FormFindSettings::default();
+    settings.stress.q_min = QBound::Relative(10.0);
+    settings.stress.q_max = Some(QBound::Absolute(1e-6));
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert!(
+        matches!(r.termination, Termination::Infeasible { .. }),
+        "{:?}",
+        r.termination
+    );
+}
