@@ -1,0 +1,264 @@
+//! Command-line options, parsed with lexopt and validated before any file is read.
+
+use std::path::PathBuf;
+
+use voussoir::{EdgeScope, FormFindSettings, Formulation, LoadRule, QBound, TauMode};
+
+/// The choices of the enumerated options, as spelled on the command line.
+pub const SOLVERS: [(&str, Formulation); 2] = [
+    ("reduced", Formulation::Reduced),
+    ("edge-based", Formulation::EdgeBased),
+];
+pub const SCOPES: [(&str, EdgeScope); 2] =
+    [("interior", EdgeScope::Interior), ("all", EdgeScope::All)];
+pub const TAUS: [(&str, TauMode); 2] = [("optimize", TauMode::Optimized), ("zero", TauMode::Zero)];
+pub const LOADS: [(&str, LoadRule); 3] = [
+    ("barycentric", LoadRule::Barycentric),
+    ("voronoi", LoadRule::Voronoi),
+    ("plan", LoadRule::PlanArea),
+];
+
+/// The command-line spelling of `value` (its variant name when the table lacks it).
+pub fn name_of<T: PartialEq + Copy + std::fmt::Debug>(table: &[(&str, T)], value: T) -> String {
+    table.iter().find(|(_, v)| *v == value).map_or_else(
+        || crate::report::variant_name(&format!("{value:?}")),
+        |(n, _)| n.to_string(),
+    )
+}
+
+/// A bound as typed on the command line: `X` (relative) or `Xabs`.
+pub fn bound_text(b: Option<QBound>) -> String {
+    match b {
+        None => "none".into(),
+        Some(QBound::Relative(v)) => format!("{v}"),
+        Some(QBound::Absolute(v)) => format!("{v}abs"),
+    }
+}
+
+/// `--help`, with the defaults of `FormFindSettings::default()`.
+pub fn help() -> String {
+    let d = FormFindSettings::default();
+    let st = &d.stress;
+    format!(
+        "\
+formfind: the nearest self-supporting (compression-only) shape to a triangulated vault.
+
+Usage:
+  formfind                                   form-find the embedded default vault
+  formfind MESH.obj --supports S.json [options]
+  formfind MESH.obj --anchor-boundary [options]
+
+Inputs:
+  MESH.obj               vertices (x, y plan; z up) and faces; polygons are split into fans
+  --supports S.json      anchored vertex ids, 0-based: {{\"anchored\": [ids]}} or [ids]
+  --anchor-boundary      anchor every boundary vertex (instead of --supports)
+
+Outputs (all written at the end of a run, or none; existing files are replaced):
+  --out OUT.obj          final positions, same faces    [formfind-out/NAME-formfound.obj]
+  --report R.json        everything computed, as JSON   [formfind-out/report.json]
+  --pictures DIR         SVG pictures                   [formfind-out/pictures]
+
+Solver:
+  --stress-only          analyse the input shape only, do not move it
+  --solver S             reduced | edge-based                              [{solver}]
+  --tol T                stop when eps_inf = max|r_i| / mean load < T      [{tol:e}]
+  --max-iter N           at most N stress steps                            [{max_iter}]
+  --qmin X               lower bound on force densities, relative to p/L0
+                         (mean load / half the plan diagonal); Xabs is
+                         absolute, in force per length, e.g. 2.5abs        [{qmin}]
+  --qmin-scope S         interior | all: the edges --qmin applies to       [{scope}]
+  --qmax X               upper bound on force densities, as --qmin, or none [{qmax}]
+  --tau M                optimize | zero: normal push at free edges        [{tau}]
+  --odt N                optimal-Delaunay remeshing every N iterations     [not available yet]
+  --density D            weight per unit area of every face                [1]
+  --load R               barycentric | voronoi | plan: face weight sharing [{load}]
+  -h, --help             this text
+
+Exit status: 0 converged (or --stress-only solved), 3 finished without converging
+(outputs written, the report says why), 2 bad input or options, 1 other failure.
+",
+        solver = name_of(&SOLVERS, st.formulation),
+        tol = d.tolerance,
+        max_iter = d.max_iterations,
+        qmin = bound_text(Some(st.q_min)),
+        scope = name_of(&SCOPES, st.q_min_scope),
+        qmax = bound_text(st.q_max),
+        tau = name_of(&TAUS, st.tau),
+        load = name_of(&LOADS, st.load_rule),
+    )
+}
+
+/// Everything the command line says.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub mesh: Option<PathBuf>,
+    pub supports: Option<PathBuf>,
+    pub anchor_boundary: bool,
+    pub out: Option<PathBuf>,
+    pub report: Option<PathBuf>,
+    pub pictures: Option<PathBuf>,
+    pub stress_only: bool,
+    pub odt: Option<usize>,
+    pub density: f64,
+    pub settings: FormFindSettings,
+}
+
+/// What `parse` found: options to run with, or a request for help.
+pub enum Parsed {
+    Run(Box<Options>),
+    Help,
+}
+
+fn number(flag: &str, text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!("{flag}: expected a number, got `{text}`")),
+    }
+}
+
+/// `X` (relative to p̄/L₀) or `Xabs` (absolute).
+fn bound(flag: &str, text: &str) -> Result<QBound, String> {
+    let (value, absolute) = match text.strip_suffix("abs") {
+        Some(v) => (v, true),
+        None => (text, false),
+    };
+    let v = number(flag, value)
+        .map_err(|_| format!("{flag}: expected a number or NUMBERabs, got `{text}`"))?;
+    Ok(if absolute {
+        QBound::Absolute(v)
+    } else {
+        QBound::Relative(v)
+    })
+}
+
+fn choice<T: Copy>(flag: &str, text: &str, choices: &[(&str, T)]) -> Result<T, String> {
+    choices
+        .iter()
+        .find(|(name, _)| *name == text)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| {
+            let names: Vec<&str> = choices.iter().map(|(n, _)| *n).collect();
+            format!("{flag}: expected {}, got `{text}`", names.join(" or "))
+        })
+}
+
+/// Parses `args` (without the program name).
+pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parsed, String> {
+    use lexopt::Arg::{Long, Short, Value};
+    let mut parser = lexopt::Parser::from_args(args);
+    let mut o = Options {
+        mesh: None,
+        supports: None,
+        anchor_boundary: false,
+        out: None,
+        report: None,
+        pictures: None,
+        stress_only: false,
+        odt: None,
+        density: 1.0,
+        settings: FormFindSettings::default(),
+    };
+    let s = &mut o.settings;
+    while let Some(arg) = parser.next().map_err(|e| e.to_string())? {
+        // Owned copies: `arg` borrows the parser, which `value()` needs.
+        let (flag, positional) = match arg {
+            Long(name) => (format!("--{name}"), None),
+            Short(c) => (format!("-{c}"), None),
+            Value(v) => (String::new(), Some(v)),
+        };
+        let mut value = || -> Result<String, String> {
+            let v = parser.value().map_err(|e| e.to_string())?;
+            v.into_string()
+                .map_err(|v| format!("{flag}: `{}` is not valid text", v.to_string_lossy()))
+        };
+        if let Some(path) = positional {
+            if o.mesh.is_some() {
+                return Err(format!(
+                    "unexpected argument `{}`: only one mesh file is read",
+                    path.to_string_lossy()
+                ));
+            }
+            o.mesh = Some(path.into());
+            continue;
+        }
+        match flag.as_str() {
+            "-h" | "--help" => return Ok(Parsed::Help),
+            "--supports" => o.supports = Some(value()?.into()),
+            "--anchor-boundary" => o.anchor_boundary = true,
+            "--out" => o.out = Some(value()?.into()),
+            "--report" => o.report = Some(value()?.into()),
+            "--pictures" => o.pictures = Some(value()?.into()),
+            "--stress-only" => o.stress_only = true,
+            "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
+            "--tol" => {
+                let t = number(&flag, &value()?)?;
+                if t <= 0.0 {
+                    return Err(format!("{flag}: must be > 0, got {t}"));
+                }
+                s.tolerance = t;
+            }
+            "--max-iter" => {
+                let text = value()?;
+                s.max_iterations = match text.parse::<usize>() {
+                    Ok(n) if n >= 1 => n,
+                    _ => return Err(format!("{flag}: expected an integer >= 1, got `{text}`")),
+                };
+            }
+            "--qmin" => s.stress.q_min = bound(&flag, &value()?)?,
+            "--qmin-scope" => s.stress.q_min_scope = choice(&flag, &value()?, &SCOPES)?,
+            "--qmax" => {
+                let text = value()?;
+                s.stress.q_max = match text.as_str() {
+                    "none" => None,
+                    _ => Some(bound(&flag, &text)?),
+                };
+            }
+            "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
+            "--odt" => {
+                let text = value()?;
+                o.odt = match text.parse::<usize>() {
+                    Ok(n) => Some(n),
+                    _ => return Err(format!("{flag}: expected an integer >= 0, got `{text}`")),
+                };
+            }
+            "--density" => {
+                let d = number(&flag, &value()?)?;
+                if d <= 0.0 {
+                    return Err(format!("{flag}: must be > 0, got {d}"));
+                }
+                o.density = d;
+            }
+            "--load" => s.stress.load_rule = choice(&flag, &value()?, &LOADS)?,
+            _ => return Err(format!("unknown option `{flag}`; try --help")),
+        }
+    }
+    check(&o)?;
+    Ok(Parsed::Run(Box::new(o)))
+}
+
+/// Combinations of options that cannot work.
+fn check(o: &Options) -> Result<(), String> {
+    match (&o.mesh, &o.supports, o.anchor_boundary) {
+        (None, Some(_), _) | (None, _, true) => {
+            return Err("--supports and --anchor-boundary need a MESH.obj".into())
+        }
+        (Some(_), None, false) => {
+            return Err("MESH.obj needs --supports S.json or --anchor-boundary".into())
+        }
+        (Some(_), Some(_), true) => {
+            return Err("give either --supports or --anchor-boundary, not both".into())
+        }
+        _ => {}
+    }
+    if o.odt.is_some() {
+        return Err(
+            "--odt: optimal-Delaunay remeshing is not available yet in this version of voussoir"
+                .into(),
+        );
+    }
+    o.settings.stress.validate().map_err(|e| {
+        e.to_string()
+            .replace("`q_min`", "--qmin")
+            .replace("`q_max`", "--qmax")
+    })
+}

@@ -1,0 +1,248 @@
+//! `formfind`: the nearest self-supporting shape to a vault, from the command line.
+//!
+//! ```sh
+//! cargo run --release --example formfind                       # the embedded default vault
+//! cargo run --release --example formfind -- MESH.obj --supports S.json [options]
+//! cargo run --release --example formfind -- --help             # every option and default
+//! ```
+//!
+//! Writes the form-found mesh (OBJ), a JSON report and SVG pictures, all or nothing: bad input
+//! gets a one-line message on stderr, a non-zero exit status and no output files.
+
+mod args;
+mod draw;
+mod model;
+mod output;
+mod pictures;
+mod report;
+mod run;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use serde_json::Value;
+
+/// Exit status for bad input or options.
+const BAD_INPUT: u8 = 2;
+/// Exit status when the outputs were written but form finding did not converge.
+const NOT_CONVERGED: u8 = 3;
+/// Folder of the default output paths.
+const OUT_DIR: &str = "formfind-out";
+
+/// `println!` that ignores a closed stdout (as in `formfind | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+fn bad_input(message: impl ToString) -> Failure {
+    Failure {
+        code: BAD_INPUT,
+        message: message.to_string(),
+    }
+}
+
+fn failed(message: impl ToString) -> Failure {
+    Failure {
+        code: 1,
+        message: message.to_string(),
+    }
+}
+
+/// Errors of the solver are about the input (mesh, supports, settings) unless numerical.
+fn solver_failure(e: voussoir::Error) -> Failure {
+    match e {
+        voussoir::Error::Numerical { .. } | voussoir::Error::Io { .. } => failed(e),
+        _ => bad_input(e),
+    }
+}
+
+fn main() -> ExitCode {
+    match formfind() {
+        Ok(code) => code,
+        Err(f) => {
+            let one_line: Vec<&str> = f.message.split_whitespace().collect();
+            eprintln!("formfind: error: {}", one_line.join(" "));
+            ExitCode::from(f.code)
+        }
+    }
+}
+
+/// The report with one top-level key per line: objects indented, arrays kept on one line.
+fn report_text(report: &Value) -> String {
+    let Value::Object(map) = report else {
+        return report.to_string();
+    };
+    let lines: Vec<String> = map
+        .iter()
+        .map(|(k, v)| {
+            let value = match v {
+                Value::Object(_) => serde_json::to_string_pretty(v)
+                    .expect("JSON values serialise")
+                    .replace('\n', "\n  "),
+                _ => v.to_string(),
+            };
+            format!("  {}: {value}", Value::from(k.as_str()))
+        })
+        .collect();
+    format!("{{\n{}\n}}\n", lines.join(",\n"))
+}
+
+fn formfind() -> Result<ExitCode, Failure> {
+    let o = match args::parse(std::env::args_os().skip(1)).map_err(bad_input)? {
+        args::Parsed::Help => {
+            say!("{}", args::help().trim_end());
+            return Ok(ExitCode::SUCCESS);
+        }
+        args::Parsed::Run(o) => *o,
+    };
+    let model = match &o.mesh {
+        None => model::embedded_default(),
+        Some(path) => model::from_files(path, o.supports.as_ref()).map_err(bad_input)?,
+    };
+    let dir = PathBuf::from(OUT_DIR);
+    let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{}-formfound.obj", model.name)));
+    let report_path = o.report.clone().unwrap_or_else(|| dir.join("report.json"));
+    let pictures_dir = o.pictures.clone().unwrap_or_else(|| dir.join("pictures"));
+    let embedded = o.mesh.is_none();
+    let name = model.name.clone();
+
+    let outcome = run::run(model, &o).map_err(solver_failure)?;
+    let report = report::build(&o, &outcome);
+    let pictures = pictures::all(&outcome);
+
+    // Nothing is on disk before this point; the staging writes all files or none.
+    let mut staging = output::Staging::default();
+    let mesh = &outcome.model.mesh;
+    staging
+        .write_obj(&out, &outcome.positions, &outcome.model.faces)
+        .map_err(failed)?;
+    staging
+        .write(&report_path, report_text(&report).as_bytes())
+        .map_err(failed)?;
+    for (file, svg) in &pictures {
+        staging
+            .write(&pictures_dir.join(file), svg.as_bytes())
+            .map_err(failed)?;
+    }
+    let input_copy = embedded.then(|| {
+        let base = out.parent().unwrap_or(Path::new(""));
+        (
+            base.join(format!("{name}-input.obj")),
+            base.join(format!("{name}-supports.json")),
+        )
+    });
+    if let Some((obj, json)) = &input_copy {
+        let anchored: Vec<usize> = (0..mesh.n_vertices())
+            .filter(|&v| mesh.anchored[v])
+            .collect();
+        let supports = serde_json::json!({ "anchored": anchored }).to_string() + "\n";
+        staging
+            .write_obj(obj, &mesh.positions, &outcome.model.faces)
+            .map_err(failed)?;
+        staging.write(json, supports.as_bytes()).map_err(failed)?;
+    }
+    staging.commit().map_err(failed)?;
+
+    print_summary(&outcome, &report);
+    say!("wrote:");
+    say!("  {:<40} {}", out.display(), "form-found mesh (same faces)");
+    say!("  {:<40} {}", report_path.display(), "report (JSON)");
+    let names: Vec<&str> = pictures.iter().map(|(n, _)| *n).collect();
+    say!(
+        "  {:<40} {}",
+        format!("{}/", pictures_dir.display()),
+        names.join(" ")
+    );
+    if let Some((obj, json)) = &input_copy {
+        say!(
+            "  {:<40} {}",
+            obj.display(),
+            "the embedded input, with its supports in"
+        );
+        say!("  {:<40}", json.display());
+        say!(
+            "try your own options on it, e.g.:\n  cargo run --release --example formfind -- {} --supports {} --tau zero",
+            obj.display(),
+            json.display()
+        );
+    }
+    if outcome.succeeded() {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        let why = match outcome.termination {
+            Some(_) => format!("not converged ({})", phrase(&report["termination"])),
+            None => format!("stress analysis {}", phrase(&report["stress_status"])),
+        };
+        eprintln!("formfind: {why}: the outputs hold the best state reached");
+        Ok(ExitCode::from(NOT_CONVERGED))
+    }
+}
+
+/// A report's status name in words: `max_iterations` → "stopped at --max-iter".
+fn phrase(name: &Value) -> String {
+    match name.as_str().unwrap_or("?") {
+        "max_iterations" => "stopped at --max-iter".into(),
+        other => other.replace('_', " "),
+    }
+}
+
+fn print_summary(outcome: &run::Outcome, report: &Value) {
+    let m = &outcome.model;
+    let mesh = &m.mesh;
+    say!(
+        "{} ({}): {} vertices, {} faces, {} edges, {} holes, {} anchored",
+        m.name,
+        m.source,
+        mesh.n_vertices(),
+        mesh.n_faces(),
+        mesh.n_edges(),
+        mesh.holes().count(),
+        mesh.anchored.iter().filter(|a| **a).count()
+    );
+    let s = &outcome.stress;
+    match &outcome.termination {
+        None => say!(
+            "stress only ({}): ε∞ = {:.2e} (max |r_i| / mean load; below {:e} counts as balanced)",
+            phrase(&report["stress_status"]),
+            s.eps_inf,
+            outcome.tolerance
+        ),
+        Some(_) => {
+            say!(
+                "{} after {} iterations: ε∞ = {:.2e} (tolerance {:e}), from {:.2e} at the input",
+                phrase(&report["termination"]),
+                outcome.history.len(),
+                s.eps_inf,
+                outcome.tolerance,
+                outcome.before.eps_inf
+            );
+            let detail = &report["termination_detail"];
+            if !detail.is_null() {
+                say!("  details: {detail}");
+            }
+            say!(
+                "height change: max {:.3}%, RMS {:.3}% of the plan diagonal",
+                100.0 * outcome.hausdorff,
+                100.0 * outcome.l2
+            );
+        }
+    }
+    let tied = s.tau.iter().filter(|t| **t > 0.0).count();
+    if tied > 0 {
+        say!("{tied} free boundary vertices need a tie or buttress (τ > 0; see the report)");
+    }
+    say!(
+        "time: stress {:.2} s, shape {:.2} s, total {:.2} s",
+        outcome.stress_seconds,
+        outcome.shape_seconds,
+        outcome.total_seconds
+    );
+}

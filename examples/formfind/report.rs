@@ -1,0 +1,138 @@
+//! The JSON report: every number a run computed, in physical units, plus the settings used.
+
+use serde_json::{json, Value};
+use voussoir::{QBound, StressResult, Termination};
+
+use crate::args::{name_of, Options, LOADS, SCOPES, SOLVERS, TAUS};
+use crate::run::Outcome;
+
+/// snake_case name of an enum variant from its `Debug` text (`Stalled { .. }` → `stalled`), so
+/// variants added to the library later are reported without a change here.
+pub fn variant_name(debug: &str) -> String {
+    let head = debug
+        .split(|c: char| !c.is_alphanumeric())
+        .next()
+        .unwrap_or("");
+    let mut out = String::new();
+    for (k, c) in head.chars().enumerate() {
+        if c.is_uppercase() && k > 0 {
+            out.push('_');
+        }
+        out.extend(c.to_lowercase());
+    }
+    out
+}
+
+/// The termination's name and its details (blocking vertices, constraint to relax, ...).
+pub fn termination(outcome: &Outcome) -> (String, Value) {
+    let Some(t) = &outcome.termination else {
+        return ("stress_only".into(), Value::Null);
+    };
+    let detail = if let Termination::Stalled { vertices } = t {
+        json!({ "vertices": vertices })
+    } else if let Termination::Infeasible { constraint } = t {
+        json!({ "constraint": constraint })
+    } else if let Termination::NumericalError { what } = t {
+        json!({ "what": what })
+    } else {
+        Value::Null
+    };
+    (variant_name(&format!("{t:?}")), detail)
+}
+
+fn bound(b: QBound, unit: f64) -> Value {
+    match b {
+        QBound::Relative(v) => json!({ "relative": v, "physical": b.physical(unit) }),
+        QBound::Absolute(v) => json!({ "absolute": v, "physical": v }),
+    }
+}
+
+fn settings(o: &Options, outcome: &Outcome) -> Value {
+    let s = &o.settings;
+    let st = &s.stress;
+    json!({
+        "mesh": outcome.model.source,
+        "supports": outcome.model.supports,
+        "stress_only": o.stress_only,
+        "solver": name_of(&SOLVERS, st.formulation),
+        "tolerance": s.tolerance,
+        "max_iterations": s.max_iterations,
+        "stall_window": s.stall_window,
+        "proximal_weight": s.proximal_weight,
+        "q_min": bound(st.q_min, outcome.q_unit),
+        "q_min_scope": name_of(&SCOPES, st.q_min_scope),
+        "q_max": st.q_max.map_or(Value::Null, |b| bound(b, outcome.q_unit)),
+        "q_unit": outcome.q_unit,
+        "q_unit_note": "relative bounds are multiples of q_unit = mean load / L0 (half the plan diagonal), at the final shape",
+        "tau": name_of(&TAUS, st.tau),
+        "holes": variant_name(&format!("{:?}", st.holes)),
+        "load": name_of(&LOADS, st.load_rule),
+        "density": o.density,
+        "regularisation": st.regularisation,
+        "regularisation_used": outcome.stress.regularisation,
+        "odt": o.odt,
+        "schedule": {
+            "mu0": s.schedule.mu0,
+            "beta": s.schedule.beta,
+            "mu_min": s.schedule.mu_min,
+            "eta": s.schedule.eta,
+            "pull": s.schedule.pull,
+        },
+        // Every field, including any this program does not know by name.
+        "debug": format!("{s:?}"),
+    })
+}
+
+/// `[[v, x, y], ...]` for the vertices where `f` is non-zero.
+fn sparse_pairs(f: &[[f64; 2]]) -> Value {
+    f.iter()
+        .enumerate()
+        .filter(|(_, f)| f[0] != 0.0 || f[1] != 0.0)
+        .map(|(v, f)| json!([v, f[0], f[1]]))
+        .collect()
+}
+
+pub fn build(o: &Options, outcome: &Outcome) -> Value {
+    let mesh = &outcome.model.mesh;
+    let s: &StressResult = &outcome.stress;
+    let (name, detail) = termination(outcome);
+    let anchored: Vec<usize> = (0..mesh.n_vertices())
+        .filter(|&v| mesh.anchored[v])
+        .collect();
+    json!({
+        "termination": name,
+        "termination_detail": detail,
+        "stress_status": variant_name(&format!("{:?}", s.status)),
+        "iterations": outcome.history.len(),
+        "eps_inf": s.eps_inf,
+        "history": outcome.history,
+        "edges": mesh.edges.iter().map(|e| e.v).collect::<Vec<_>>(),
+        "force_densities": s.force_densities,
+        "loads": s.loads,
+        "external_horizontal": sparse_pairs(&s.external_horizontal),
+        "tau": s.tau,
+        "weights": s.weights,
+        "airy": s.airy,
+        "hole_coefficients": s.hole_coefficients,
+        "residuals": s.residuals,
+        "objective": s.objective,
+        "hausdorff": outcome.hausdorff,
+        "l2": outcome.l2,
+        "timings_s": {
+            "stress": outcome.stress_seconds,
+            "shape": outcome.shape_seconds,
+            "total": outcome.total_seconds,
+        },
+        "mesh": {
+            "vertices": mesh.n_vertices(),
+            "faces": mesh.n_faces(),
+            "edges": mesh.n_edges(),
+            "holes": mesh.holes().count(),
+            "anchored": anchored,
+            "unreferenced": mesh.unreferenced,
+        },
+        "units": "input units: lengths as in the OBJ, loads = density x area, force densities = force / length",
+        "settings": settings(o, outcome),
+        "voussoir_version": env!("CARGO_PKG_VERSION"),
+    })
+}

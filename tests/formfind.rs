@@ -1,0 +1,340 @@
+//! The `formfind` example end to end: runs the built program, reads its OBJ and JSON outputs
+//! with small parsers of its own (not through the library) and recomputes the equilibrium of
+//! the result independently; checks that bad input gets one line, exit status 2 and no files.
+
+mod formfind_support;
+
+use std::fs;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use formfind_support::*;
+
+#[test]
+fn embedded_default_converges_and_balances() {
+    let dir = Scratch::new("default");
+    let out = run(&dir.0, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "status {:?}\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("formfind-out/report.json"), "{stdout}");
+    let od = dir.path("formfind-out");
+    let eps = check_equilibrium(&od.join("vault-formfound.obj"), &od.join("report.json"));
+    check_same_plan(&od.join("vault-input.obj"), &od.join("vault-formfound.obj"));
+    check_pictures(&od.join("pictures"));
+    // The default is a vault with openings and free edges.
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["mesh"]["holes"], 2);
+    assert!(!r["external_horizontal"].as_array().unwrap().is_empty());
+    let supports = read_json(&od.join("vault-supports.json"));
+    assert_eq!(supports["anchored"], r["mesh"]["anchored"]);
+    println!("embedded default: ε∞ = {eps:e}");
+}
+
+fn shared_model(name: &str) {
+    let Some(models) = models_dir() else { return };
+    let dir = Scratch::new(name);
+    let (obj, json) = (
+        models.join(format!("{name}.obj")),
+        models.join(format!("{name}.json")),
+    );
+    let (out_obj, report, pictures) = (dir.path("out.obj"), dir.path("r.json"), dir.path("pics"));
+    let args = [
+        obj.to_str().unwrap(),
+        "--supports",
+        json.to_str().unwrap(),
+        "--out",
+        out_obj.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--pictures",
+        pictures.to_str().unwrap(),
+    ];
+    let out = run(&dir.0, &args);
+    assert!(
+        out.status.success(),
+        "{name}: status {:?}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let eps = check_equilibrium(&out_obj, &report);
+    check_same_plan(&obj, &out_obj);
+    check_pictures(&pictures);
+    println!("{name}: ε∞ = {eps:e}");
+}
+
+#[test]
+fn dome_with_doors_converges_and_balances() {
+    shared_model("dome_with_doors");
+}
+
+#[test]
+fn neumunster_converges_and_balances() {
+    shared_model("neumunster");
+}
+
+#[test]
+fn stress_only_analyses_without_moving() {
+    let dir = Scratch::new("stress-only");
+    let out = run(
+        &dir.0,
+        &["--stress-only", "--report", "r.json", "--out", "o.obj"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = read_json(&dir.path("r.json"));
+    assert_eq!(r["termination"], "stress_only");
+    assert_eq!(r["iterations"], 1);
+    assert!(
+        r["eps_inf"].as_f64().unwrap() > 1e-3,
+        "the input is not self-supporting"
+    );
+    check_same_plan(&dir.path("vault-input.obj"), &dir.path("o.obj"));
+    let (a, _) = read_obj(&dir.path("vault-input.obj"));
+    let (b, _) = read_obj(&dir.path("o.obj"));
+    assert_eq!(a, b, "--stress-only must not move vertices");
+    assert!(!dir.path("formfind-out/pictures/height_change.svg").exists());
+}
+
+/// A valid 5-vertex square with its centre: four triangles.
+const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 0.3\n\
+                      f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n";
+
+/// Runs formfind with `args` in a scratch folder holding `files`; asserts exit status 2, a
+/// single stderr line containing `message`, and that no file was added.
+fn rejects(files: &[(&str, &str)], args: &[&str], message: &str) {
+    static CASE: AtomicUsize = AtomicUsize::new(0);
+    let dir = Scratch::new(&format!("bad-{}", CASE.fetch_add(1, Ordering::Relaxed)));
+    for (name, content) in files {
+        fs::write(dir.path(name), content).unwrap();
+    }
+    let before = dir.listing();
+    let mut all = vec!["--report", "outs/r.json", "--pictures", "outs/pics"];
+    all.extend(args);
+    let out = run(&dir.0, &all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert_eq!(
+        stderr.lines().count(),
+        1,
+        "{args:?}: not one line: {stderr}"
+    );
+    assert!(
+        stderr.contains(message),
+        "{args:?}: `{stderr}` lacks `{message}`"
+    );
+    assert_eq!(dir.listing(), before, "{args:?}: output was written");
+}
+
+#[test]
+fn bad_input_gets_one_line_and_no_output() {
+    let sq = [
+        ("sq.obj", SQUARE),
+        ("s.json", "{\"anchored\": [0, 1, 2, 3]}"),
+    ];
+    rejects(&sq, &["missing.obj", "--supports", "s.json"], "missing.obj");
+    rejects(&sq, &["sq.obj", "--supports", "nope.json"], "nope.json");
+    rejects(
+        &[("bad.obj", "v 0 0\nf 1 2 3\n"), ("s.json", "[0]")],
+        &["bad.obj", "--supports", "s.json"],
+        "bad.obj:1: vertex has 2 coordinates",
+    );
+    rejects(
+        &[
+            ("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"),
+            ("s.json", "[0]"),
+        ],
+        &["bad.obj", "--supports", "s.json"],
+        "face refers to vertex 7",
+    );
+    rejects(
+        &[("sq.obj", SQUARE), ("s.json", "{\"anchored\": [0, 99]}")],
+        &["sq.obj", "--supports", "s.json"],
+        "anchored vertex 99",
+    );
+    rejects(
+        &[("sq.obj", SQUARE), ("s.json", "{\"anchored\": [0, -1]}")],
+        &["sq.obj", "--supports", "s.json"],
+        "s.json:1:",
+    );
+    rejects(&sq, &["sq.obj"], "needs --supports");
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--anchor-boundary"],
+        "not both",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--tol", "-1"],
+        "--tol: must be > 0",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--tol", "x"],
+        "--tol: expected a number",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--max-iter", "0"],
+        "--max-iter",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--solver", "fast"],
+        "reduced or edge-based",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--qmin", "-0.1"],
+        "--qmin",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--qmin", "big"],
+        "--qmin",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--qmax", "0"],
+        "--qmax",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--tau", "maybe"],
+        "optimize or zero",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--load", "x"],
+        "barycentric",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--density", "0"],
+        "--density",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--frobnicate"],
+        "unknown option",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "--supports", "s.json", "--odt", "5"],
+        "not available yet",
+    );
+    rejects(
+        &sq,
+        &["sq.obj", "other.obj", "--supports", "s.json"],
+        "only one mesh",
+    );
+    rejects(&sq, &["--supports", "s.json"], "need a MESH.obj");
+    rejects(&sq, &["sq.obj", "--supports", "s.json", "--out"], "--out");
+}
+
+#[test]
+fn failed_write_leaves_nothing_behind() {
+    // The pictures go last and cannot be written (their folder would be inside a file): the
+    // mesh and report staged before them must be removed too.
+    let dir = Scratch::new("write-fails");
+    fs::write(dir.path("file"), "").unwrap();
+    let before = dir.listing();
+    let out = run(
+        &dir.0,
+        &[
+            "--out",
+            "a/o.obj",
+            "--report",
+            "a/r.json",
+            "--pictures",
+            "file/pics",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("file/pics"), "{stderr}");
+    assert_eq!(dir.listing(), before);
+}
+
+#[test]
+fn help_lists_every_option() {
+    let dir = Scratch::new("help");
+    let out = run(&dir.0, &["--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for flag in [
+        "--supports",
+        "--anchor-boundary",
+        "--out",
+        "--report",
+        "--pictures",
+        "--stress-only",
+        "--solver",
+        "--tol",
+        "--max-iter",
+        "--qmin",
+        "--qmin-scope",
+        "--qmax",
+        "--tau",
+        "--odt",
+        "--density",
+        "--load",
+    ] {
+        assert!(text.contains(flag), "--help lacks {flag}");
+    }
+    assert!(dir.listing().is_empty());
+}
+
+#[test]
+fn not_converged_writes_outputs_and_exits_3() {
+    let dir = Scratch::new("max-iter");
+    let out = run(&dir.0, &["--max-iter", "2"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("not converged"), "{stderr}");
+    let r = read_json(&dir.path("formfind-out/report.json"));
+    assert_eq!(r["termination"], "max_iterations");
+    assert_eq!(r["iterations"], 2);
+    assert!(dir.path("formfind-out/vault-formfound.obj").is_file());
+    check_pictures(&dir.path("formfind-out/pictures"));
+}
+
+#[test]
+fn anchor_boundary_with_quad_faces() {
+    // A 4 × 4 grid of vertices, 3 × 3 quads; the four inner vertices are raised.
+    let mut obj = String::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            let inner = (1..3).contains(&i) && (1..3).contains(&j);
+            obj += &format!("v {i} {j} {}\n", if inner { 0.8 } else { 0.0 });
+        }
+    }
+    for j in 0..3 {
+        for i in 0..3 {
+            let v = |di: usize, dj: usize| (j + dj) * 4 + i + di + 1;
+            obj += &format!("f {} {} {} {}\n", v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+        }
+    }
+    let dir = Scratch::new("quads");
+    fs::write(dir.path("quads.obj"), obj).unwrap();
+    let out = run(&dir.0, &["quads.obj", "--anchor-boundary"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let od = dir.path("formfind-out");
+    let (_, faces) = read_obj(&od.join("quads-formfound.obj"));
+    assert_eq!(faces.len(), 18, "each quad is split into two triangles");
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["mesh"]["anchored"].as_array().unwrap().len(), 12);
+    check_equilibrium(&od.join("quads-formfound.obj"), &od.join("report.json"));
+}
