@@ -616,8 +616,12 @@ pub unsafe extern "C" fn vsr_result_termination_message(
                 let text = match &r.form("the termination message")?.termination {
                     Termination::Converged => "converged: eps_inf < tolerance".to_string(),
                     Termination::MaxIterations => "reached the iteration limit".to_string(),
+                    Termination::Stalled { vertices } if vertices.is_empty() => {
+                        "stalled: eps_inf stopped improving".to_string()
+                    }
                     Termination::Stalled { vertices } => format!(
-                        "stalled: vertices {vertices:?} carry (almost) no stress; raise q_min"
+                        "stalled: eps_inf stopped improving; vertices {vertices:?} carry \
+                         (almost) no stress (raise q_min)"
                     ),
                     Termination::Infeasible { constraint } => {
                         format!("infeasible stress constraints: relax {constraint}")

@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# C ABI checks (issue 4), run by CI and by the README's test command:
+#   1. include/voussoir.h compiles alone as C11 and as C++17 with -Wall -Wextra -Wpedantic -Werror;
+#   2. cmake/ builds the library with cargo (release) and installs it into a staging prefix;
+#      the shared library has its SONAME;
+#   3. examples/ (C dome, C hostile-input test, C++ OpenMesh OBJ example) builds against the
+#      installed package with find_package(Voussoir CONFIG REQUIRED) and runs under ctest:
+#      shared library; static library with AddressSanitizer + UBSan (Debug);
+#   4. the C dome and hostile-input test build with `pkg-config --cflags --libs voussoir` alone;
+#   5. the Rust example (examples/dome.rs) runs.
+# Needs cmake, pkg-config, a C/C++ compiler and OpenMesh (Debian: cmake pkg-config g++
+# libopenmesh-dev). Work files go to $VSR_CHECK_DIR (default target/cmake-checks).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+export CARGO_BUILD_JOBS=${CARGO_BUILD_JOBS:-2}
+work=${VSR_CHECK_DIR:-$root/target/cmake-checks}
+stage=$work/stage
+jobs=${CARGO_BUILD_JOBS}
+
+missing=()
+for tool in cmake pkg-config cc c++; do
+  command -v "$tool" >/dev/null || missing+=("$tool")
+done
+[ -f /usr/include/OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh ] || missing+=("OpenMesh headers")
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "cmake-checks: missing ${missing[*]}; on Debian: apt-get install -y cmake pkg-config g++ libopenmesh-dev" >&2
+  exit 1
+fi
+rm -rf "$work"
+mkdir -p "$work"
+step() { printf '\n== %s\n' "$*"; }
+
+step "header alone: C11 and C++17, -Wall -Wextra -Wpedantic -Werror"
+printf '#include <voussoir.h>\nint main(void) { return vsr_abi_version() == VSR_ABI_VERSION ? 0 : 1; }\n' >"$work/header.c"
+cp "$work/header.c" "$work/header.cpp"
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror -I include -fsyntax-only "$work/header.c"
+c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror -I include -fsyntax-only "$work/header.cpp"
+echo ok
+
+step "cmake/: cargo release build, install into $stage"
+cmake -S cmake -B "$work/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX="$stage" >/dev/null
+cmake --build "$work/build" -j "$jobs"
+cmake --install "$work/build"
+soname=$(readelf -d "$stage/lib/libvoussoir.so.1" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+[ "$soname" = "libvoussoir.so.1" ] || { echo "SONAME is '$soname'" >&2; exit 1; }
+echo "SONAME $soname"
+
+step "examples/ against the installed package: find_package(Voussoir), shared library"
+cmake -S examples -B "$work/examples" -DCMAKE_PREFIX_PATH="$stage" >/dev/null
+cmake --build "$work/examples" -j "$jobs"
+ctest --test-dir "$work/examples" --output-on-failure
+
+step "examples/ against the installed package: static library, ASan + UBSan (Debug)"
+cmake -S examples -B "$work/examples-asan" -DCMAKE_PREFIX_PATH="$stage" \
+  -DCMAKE_BUILD_TYPE=Debug -DVSR_STATIC=ON -DVSR_SANITIZE=ON >/dev/null
+cmake --build "$work/examples-asan" -j "$jobs"
+ctest --test-dir "$work/examples-asan" --output-on-failure
+
+step "pkg-config --cflags --libs voussoir"
+export PKG_CONFIG_PATH="$stage/lib/pkgconfig"
+pkg-config --modversion voussoir
+flags=$(pkg-config --cflags --libs voussoir)
+libdir=$(pkg-config --variable=libdir voussoir)
+mkdir -p "$work/pkgconfig"
+for prog in examples/c/dome.c tests/c/hostile.c; do
+  exe="$work/pkgconfig/$(basename "$prog" .c)"
+  # shellcheck disable=SC2086
+  cc -std=c11 -Wall -Wextra -Wpedantic -Werror "$prog" -o "$exe" $flags -lm -Wl,-rpath,"$libdir"
+  "$exe" >"$exe.log" || { cat "$exe.log"; exit 1; }
+  tail -n 1 "$exe.log"
+done
+
+step "Rust example: cargo run --example dome"
+cargo run --quiet --locked --example dome | tail -n 3
+
+printf '\ncmake-checks: all passed\n'

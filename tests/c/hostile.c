@@ -1,0 +1,189 @@
+/*
+ * Hostile input through the installed C library: each case checks the status, a non-empty
+ * one-line message naming the argument at fault, and untouched outputs. Built against the
+ * installed package by examples/CMakeLists.txt and .ci/cmake-checks.sh; prints one line per
+ * failure and exits non-zero if any.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include <voussoir.h>
+
+static int failures = 0;
+static int checks = 0;
+
+static void expect(int line, VsrStatus got, VsrStatus want, const char *argument) {
+    const char *message = vsr_last_error_message();
+    char quoted[64];
+    ++checks;
+    snprintf(quoted, sizeof quoted, "`%s`", argument);
+    if (got != want) {
+        printf("line %d: got %s, want %s (%s)\n", line, vsr_status_name(got),
+               vsr_status_name(want), message);
+        ++failures;
+    } else if (want != VSR_STATUS_OK && (message[0] == '\0' || !strstr(message, quoted) ||
+                                         strchr(message, '\n'))) {
+        printf("line %d: message does not name %s on one line: \"%s\"\n", line, quoted, message);
+        ++failures;
+    } else if (want == VSR_STATUS_OK && message[0] != '\0') {
+        printf("line %d: success left a message: \"%s\"\n", line, message);
+        ++failures;
+    }
+}
+
+static void truth(int line, int condition, const char *what) {
+    ++checks;
+    if (!condition) {
+        printf("line %d: %s\n", line, what);
+        ++failures;
+    }
+}
+
+#define EXPECT(call, status, argument) expect(__LINE__, (call), (status), (argument))
+#define TRUE(condition) truth(__LINE__, (condition), #condition)
+
+/* A square of 4 triangles around a centre vertex, corners anchored. */
+static const double positions[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0.3};
+static const uint32_t triangles[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+static const uint32_t anchored[] = {0, 1, 2, 3};
+
+int main(void) {
+    VsrMesh *const sentinel_mesh = (VsrMesh *)(uintptr_t)0xdeadbee8u;
+    VsrResult *const sentinel_result = (VsrResult *)(uintptr_t)0xdeadbee8u;
+    VsrMesh *mesh = sentinel_mesh;
+    VsrSettings *settings = NULL;
+    VsrResult *result = sentinel_result;
+    double nan_positions[15];
+    uint32_t bad_triangles[12];
+    double buffer[64];
+    size_t needed;
+    size_t i;
+
+    /* destroy(NULL) */
+    vsr_mesh_destroy(NULL);
+    vsr_settings_destroy(NULL);
+    vsr_result_destroy(NULL);
+
+    /* NULL in each slot of vsr_mesh_create. */
+    EXPECT(vsr_mesh_create(NULL, 5, triangles, 4, anchored, 4, &mesh), VSR_STATUS_NULL_POINTER,
+           "positions");
+    EXPECT(vsr_mesh_create(positions, 5, NULL, 4, anchored, 4, &mesh), VSR_STATUS_NULL_POINTER,
+           "triangles");
+    EXPECT(vsr_mesh_create(positions, 5, triangles, 4, NULL, 4, &mesh), VSR_STATUS_NULL_POINTER,
+           "anchored");
+    EXPECT(vsr_mesh_create(positions, 5, triangles, 4, anchored, 4, NULL), VSR_STATUS_NULL_POINTER,
+           "out");
+    /* Zero, huge and overflowing lengths: the arrays are never read past their end. */
+    EXPECT(vsr_mesh_create(positions, 0, triangles, 4, anchored, 4, &mesh), VSR_STATUS_EMPTY_MESH,
+           "positions");
+    EXPECT(vsr_mesh_create(positions, SIZE_MAX, triangles, 4, anchored, 4, &mesh),
+           VSR_STATUS_LENGTH_OVERFLOW, "positions");
+    EXPECT(vsr_mesh_create(positions, SIZE_MAX / 3 + 1, triangles, 4, anchored, 4, &mesh),
+           VSR_STATUS_LENGTH_OVERFLOW, "positions");
+    EXPECT(vsr_mesh_create(positions, 5, triangles, SIZE_MAX / 2, anchored, 4, &mesh),
+           VSR_STATUS_LENGTH_OVERFLOW, "triangles");
+    EXPECT(vsr_mesh_create(positions, (size_t)UINT32_MAX + 1, triangles, 4, anchored, 4, &mesh),
+           VSR_STATUS_LENGTH_OVERFLOW, "positions");
+    /* Out-of-range ids, NaN coordinates. */
+    memcpy(bad_triangles, triangles, sizeof triangles);
+    bad_triangles[5] = 5;
+    EXPECT(vsr_mesh_create(positions, 5, bad_triangles, 4, anchored, 4, &mesh),
+           VSR_STATUS_INDEX_OUT_OF_RANGE, "triangles");
+    {
+        const uint32_t bad_anchors[] = {0, 1, 2, 99};
+        EXPECT(vsr_mesh_create(positions, 5, triangles, 4, bad_anchors, 4, &mesh),
+               VSR_STATUS_INDEX_OUT_OF_RANGE, "anchored");
+    }
+    memcpy(nan_positions, positions, sizeof positions);
+    nan_positions[13] = NAN;
+    EXPECT(vsr_mesh_create(nan_positions, 5, triangles, 4, anchored, 4, &mesh),
+           VSR_STATUS_NON_FINITE, "positions");
+    EXPECT(vsr_mesh_create(positions, 5, triangles, 4, anchored, 0, &mesh), VSR_STATUS_NO_SUPPORT,
+           "anchored");
+    TRUE(mesh == sentinel_mesh);
+
+    /* A valid mesh; the last error is cleared by success but kept by destroy(NULL). */
+    EXPECT(vsr_mesh_create(positions, 5, triangles, 4, anchored, 4, &mesh), VSR_STATUS_OK, "");
+    EXPECT(vsr_settings_create(&settings), VSR_STATUS_OK, "");
+
+    /* Setters: NULL handle, NaN, negative, invalid enum values, wrong lengths. */
+    EXPECT(vsr_settings_set_tolerance(NULL, 1e-6), VSR_STATUS_NULL_POINTER, "settings");
+    EXPECT(vsr_settings_set_tolerance(settings, NAN), VSR_STATUS_NON_FINITE, "tolerance");
+    EXPECT(vsr_settings_set_tolerance(settings, -1.0), VSR_STATUS_INVALID_ARGUMENT, "tolerance");
+    EXPECT(vsr_settings_set_q_min(settings, -0.5, VSR_BOUND_KIND_ABSOLUTE),
+           VSR_STATUS_INVALID_ARGUMENT, "value");
+    EXPECT(vsr_settings_set_q_min(settings, 0.1, 7), VSR_STATUS_INVALID_ENUM, "kind");
+    EXPECT(vsr_settings_set_q_max(settings, NAN, VSR_BOUND_KIND_RELATIVE), VSR_STATUS_NON_FINITE,
+           "value");
+    EXPECT(vsr_settings_set_tau_mode(settings, 42), VSR_STATUS_INVALID_ENUM, "mode");
+    EXPECT(vsr_settings_set_hole_mode(settings, 42), VSR_STATUS_INVALID_ENUM, "mode");
+    EXPECT(vsr_settings_set_load_rule(settings, 42), VSR_STATUS_INVALID_ENUM, "rule");
+    EXPECT(vsr_settings_set_formulation(settings, 42), VSR_STATUS_INVALID_ENUM, "formulation");
+    EXPECT(vsr_settings_set_q_min_scope(settings, 42), VSR_STATUS_INVALID_ENUM, "scope");
+    EXPECT(vsr_settings_set_max_iterations(settings, 0), VSR_STATUS_INVALID_ARGUMENT,
+           "max_iterations");
+    EXPECT(vsr_settings_set_schedule_beta(settings, 2.0), VSR_STATUS_INVALID_ARGUMENT, "beta");
+    {
+        double density[4] = {1, 1, -1, 1};
+        double loads[5] = {0, 0, 0, 0, NAN};
+        EXPECT(vsr_mesh_set_face_density(mesh, density, 4), VSR_STATUS_INVALID_ARGUMENT,
+               "density");
+        EXPECT(vsr_mesh_set_face_density(mesh, density, 3), VSR_STATUS_INVALID_ARGUMENT,
+               "n_faces");
+        EXPECT(vsr_mesh_set_extra_loads(mesh, loads, 5), VSR_STATUS_NON_FINITE, "loads");
+        EXPECT(vsr_mesh_set_extra_loads(mesh, NULL, 5), VSR_STATUS_NULL_POINTER, "loads");
+        EXPECT(vsr_mesh_set_horizontal_forces(mesh, loads, SIZE_MAX), VSR_STATUS_LENGTH_OVERFLOW,
+               "forces");
+        EXPECT(vsr_mesh_set_extra_loads(NULL, loads, 5), VSR_STATUS_NULL_POINTER, "mesh");
+    }
+
+    /* Solves: NULL in each slot, output untouched. */
+    EXPECT(vsr_analyse(NULL, settings, &result), VSR_STATUS_NULL_POINTER, "mesh");
+    EXPECT(vsr_analyse(mesh, NULL, &result), VSR_STATUS_NULL_POINTER, "settings");
+    EXPECT(vsr_form_find(mesh, settings, NULL), VSR_STATUS_NULL_POINTER, "out");
+    TRUE(result == sentinel_result);
+
+    /* Reuse after the failed calls: the handles still work. */
+    EXPECT(vsr_analyse(mesh, settings, &result), VSR_STATUS_OK, "");
+    TRUE(result != sentinel_result && result != NULL);
+
+    /* Short buffers: status, `needed`, untouched buffer. */
+    for (i = 0; i < 64; ++i) buffer[i] = -7.0;
+    needed = 0;
+    EXPECT(vsr_result_positions(result, buffer, 14, &needed), VSR_STATUS_BUFFER_TOO_SMALL, "len");
+    TRUE(needed == 15);
+    for (i = 0; i < 64; ++i) TRUE(buffer[i] == -7.0);
+    EXPECT(vsr_result_positions(result, NULL, 3, &needed), VSR_STATUS_NULL_POINTER, "out");
+    EXPECT(vsr_result_positions(NULL, buffer, 64, &needed), VSR_STATUS_NULL_POINTER, "result");
+    EXPECT(vsr_result_eps_history(result, buffer, 64, &needed), VSR_STATUS_NOT_AVAILABLE,
+           "result");
+    for (i = 0; i < 64; ++i) TRUE(buffer[i] == -7.0);
+    EXPECT(vsr_result_positions(result, buffer, 64, &needed), VSR_STATUS_OK, "");
+    TRUE(needed == 15 && buffer[14] == 0.3 && buffer[15] == -7.0);
+    {
+        double eps = -1.0, objective = -1.0;
+        size_t qp = 0;
+        VsrStressStatus status = VSR_STRESS_STATUS_NUMERICAL_ERROR;
+        EXPECT(vsr_result_stress_summary(result, &status, &eps, NULL, &qp),
+               VSR_STATUS_NULL_POINTER, "objective");
+        TRUE(eps == -1.0 && status == VSR_STRESS_STATUS_NUMERICAL_ERROR);
+        EXPECT(vsr_result_stress_summary(result, &status, &eps, &objective, &qp), VSR_STATUS_OK,
+               "");
+        TRUE(status == VSR_STRESS_STATUS_SOLVED);
+    }
+
+    /* Names and versions. */
+    TRUE(strcmp(vsr_status_name(VSR_STATUS_OK), "VSR_STATUS_OK") == 0);
+    TRUE(strcmp(vsr_status_name(VSR_STATUS_BUFFER_TOO_SMALL), "VSR_STATUS_BUFFER_TOO_SMALL") == 0);
+    TRUE(strcmp(vsr_status_name(987654), "VSR_STATUS_UNKNOWN") == 0);
+    TRUE(strcmp(vsr_version(), VSR_VERSION_STRING) == 0);
+    TRUE(vsr_abi_version() == VSR_ABI_VERSION);
+
+    vsr_result_destroy(result);
+    vsr_settings_destroy(settings);
+    vsr_mesh_destroy(mesh);
+    printf("%d checks, %d failures\n", checks, failures);
+    return failures == 0 ? 0 : 1;
+}
