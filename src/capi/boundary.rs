@@ -268,3 +268,37 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
     };
     Failure::new(status, format!("argument `{arg}`: {e}"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn last_error() -> String {
+        // SAFETY: the pointer is this thread's NUL-terminated last error.
+        unsafe { std::ffi::CStr::from_ptr(last_error_ptr()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    #[test]
+    fn a_panic_becomes_a_status_and_a_one_line_message() {
+        let status = run(|| panic!("boom\nsecond line"));
+        assert_eq!(status, VsrStatus::Panic);
+        let message = last_error();
+        assert!(message.contains("panic") && message.contains("boom"), "{message}");
+        assert!(!message.contains('\n'));
+        // Infallible functions return their fallback and keep a message.
+        assert_eq!(run_value(7, || -> i32 { panic!("again") }), 7);
+        assert!(last_error().contains("again"));
+        // A successful call clears it.
+        assert_eq!(run(|| Ok(())), VsrStatus::Ok);
+        assert_eq!(last_error(), "");
+    }
+
+    #[test]
+    fn messages_never_hold_nul_bytes() {
+        let status = run(|| Err(Failure::invalid("x", "a\0b")));
+        assert_eq!(status, VsrStatus::InvalidArgument);
+        assert_eq!(last_error(), "argument `x`: a b");
+    }
+}

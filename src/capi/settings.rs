@@ -2,6 +2,12 @@
 //!
 //! Defaults are those of the Rust [`FormFindSettings::default`]; every setter validates its
 //! value (and, for bounds, the combination with the other bound) before it changes anything.
+//!
+//! Every option of [`FormFindSettings`] and its [`crate::StressSettings`] has a setter here.
+//! When an option is added to the Rust settings (the ODT smoothing option is planned), add its
+//! `vsr_settings_set_*` function, a row in the defaults table of `vsr_settings_create` and in
+//! the `documented_defaults` test below, then rewrite the header
+//! (`VSR_BLESS=1 cargo test --test capi_header`).
 
 use super::boundary::{boundary, handle_mut, out_ptr, CResult, Failure};
 use super::status::{self, VsrStatus};
