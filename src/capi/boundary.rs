@@ -285,7 +285,10 @@ mod tests {
         let status = run(|| panic!("boom\nsecond line"));
         assert_eq!(status, VsrStatus::Panic);
         let message = last_error();
-        assert!(message.contains("panic") && message.contains("boom"), "{message}");
+        assert!(
+            message.contains("panic") && message.contains("boom"),
+            "{message}"
+        );
         assert!(!message.contains('\n'));
         // Infallible functions return their fallback and keep a message.
         assert_eq!(run_value(7, || -> i32 { panic!("again") }), 7);
