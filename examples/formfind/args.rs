@@ -57,6 +57,8 @@ Outputs (all written at the end of a run, or none; existing files are replaced):
   --out OUT.obj          final positions, same faces    [formfind-out/NAME-formfound.obj]
   --report R.json        everything computed, as JSON   [formfind-out/report.json]
   --pictures DIR         SVG pictures                   [formfind-out/pictures]
+  Without MESH.obj, the embedded input is also written next to OUT, as NAME-input.obj
+  and NAME-supports.json, to try other options on.
 
 Solver:
   --stress-only          analyse the input shape only, do not move it

@@ -5,7 +5,7 @@ use svg::Document;
 use voussoir::Mesh;
 
 use crate::draw::{self, bbox, colour_bar, fmt, line, page, text, View};
-use crate::run::Outcome;
+use crate::run::{mean_load, Outcome};
 
 const WIDTH: f64 = 900.0;
 const TOP: f64 = 70.0;
@@ -263,15 +263,23 @@ fn force_diagram(o: &Outcome) -> Document {
 fn residuals(o: &Outcome) -> Document {
     let mesh = &o.model.mesh;
     let tol = o.tolerance;
-    let rel = |r: &[f64], v: usize| r[v].abs() / o.p_bar;
     let floor = (tol / 10.0).log10().floor();
     let mut panels = vec![("input", &o.model.mesh.positions, &o.before)];
     if o.termination.is_some() {
         panels.push(("form-found", &o.positions, &o.stress));
     }
-    let top = panels
+    // |r_i| over the mean load of the same stress step (loads follow the 3-D area).
+    let rel: Vec<Vec<f64>> = panels
         .iter()
-        .flat_map(|(_, _, s)| (0..mesh.n_vertices()).map(|v| rel(&s.residuals, v)))
+        .map(|(_, _, s)| {
+            let mean = mean_load(&o.model, &s.loads);
+            s.residuals.iter().map(|r| r.abs() / mean).collect()
+        })
+        .collect();
+    let top = rel
+        .iter()
+        .flatten()
+        .copied()
         .fold(0.0, f64::max)
         .log10()
         .ceil()
@@ -286,7 +294,7 @@ fn residuals(o: &Outcome) -> Document {
             "|r_i| / mean load, log scale; tolerance {tol:e}; balanced vertices are pale and small"
         ),
     );
-    for ((label, pos, s), view) in panels.iter().zip(&views) {
+    for (((label, pos, s), rel), view) in panels.iter().zip(&rel).zip(&views) {
         let (x, _) = view.px(lo);
         let mut g = Group::new()
             .add(text(
@@ -298,7 +306,7 @@ fn residuals(o: &Outcome) -> Document {
             .add(wireframe(mesh, pos, view, "#d8d8d8"))
             .add(outline(mesh, pos, view));
         for v in (0..mesh.n_vertices()).filter(|&v| mesh.is_non_anchored(v)) {
-            let t = ((rel(&s.residuals, v).log10() - floor) / (top - floor)).max(0.0);
+            let t = ((rel[v].log10() - floor) / (top - floor)).max(0.0);
             let (cx, cy) = view.px(plan(&pos[v]));
             g = g.add(
                 Circle::new()

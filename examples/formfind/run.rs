@@ -59,7 +59,7 @@ fn progress_bar(max_iterations: usize) -> Option<ProgressBar> {
 }
 
 /// Mean load over non-anchored vertices (1 when there is none, as the library does).
-fn mean_load(model: &Model, loads: &[f64]) -> f64 {
+pub fn mean_load(model: &Model, loads: &[f64]) -> f64 {
     let mesh = &model.mesh;
     let free: Vec<f64> = (0..mesh.n_vertices())
         .filter(|&v| mesh.is_non_anchored(v))
