@@ -196,7 +196,7 @@ pub fn check_equilibrium(obj: &Path, report_path: &Path) -> f64 {
     }
     let mut free = vec![false; n];
     faces.iter().flatten().for_each(|&v| free[v] = true);
-    for a in r["mesh"]["anchored"].as_array().unwrap() {
+    for a in r["anchored"].as_array().unwrap() {
         free[a.as_u64().unwrap() as usize] = false;
     }
 
