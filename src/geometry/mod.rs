@@ -3,6 +3,7 @@
 //! Everything the solvers see is expressed in the frame u' = (u − centre)/L₀, z' = z/L₀ with
 //! L₀ half the plan bounding-box diagonal (MATH §8), so conditioning does not depend on units.
 
+pub mod distance;
 pub mod dual;
 pub mod loads;
 

@@ -84,8 +84,8 @@ pub struct FormFindResult {
     /// with the previous forces.
     pub history: Vec<f64>,
     pub iterations: usize,
-    /// Vertex-based distances to the input, normalised by the plan bounding-box diagonal:
-    /// max |Δz| and the area-weighted RMS of Δz.
+    /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
+    /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
     pub l2: f64,
     /// Seconds summed over iterations.
@@ -239,30 +239,17 @@ fn blocking_vertices(problem: &Problem, s: &StressResult) -> Vec<u32> {
         .collect()
 }
 
-/// Vertex-based distances between input and output heights over the plan bounding-box diagonal.
+/// Distances between input and output surfaces over the plan bounding-box diagonal: symmetric
+/// Hausdorff and area-weighted RMS, both sampled at vertices (see `geometry::distance`).
 fn distances(problem: &Problem, positions: &[[f64; 3]]) -> (f64, f64) {
     let mesh = &problem.mesh;
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    let mut area = vec![0.0; positions.len()];
-    for f in &mesh.faces {
-        let [a, b, c] = f.map(|v| mesh.positions[v as usize]);
-        let t = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() / 6.0;
-        f.iter().for_each(|&v| area[v as usize] += t);
-    }
-    let (mut max, mut sum, mut wsum) = (0.0f64, 0.0, 0.0);
-    for (v, p) in mesh.positions.iter().enumerate() {
-        if !mesh.referenced[v] {
-            continue;
-        }
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-        let dz = positions[v][2] - p[2];
-        max = max.max(dz.abs());
-        sum += area[v] * dz * dz;
-        wsum += area[v];
-    }
-    let diag = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
-    (max / diag, (sum / wsum).sqrt() / diag)
+    let frame = crate::geometry::Frame::of(mesh, &mesh.positions);
+    let diag = 2.0 * frame.scale;
+    let (h, l2) = crate::geometry::distance::surface_distances(
+        &mesh.positions,
+        positions,
+        &mesh.faces,
+        &mesh.referenced,
+    );
+    (h / diag, l2 / diag)
 }
