@@ -9,6 +9,7 @@ pub mod io;
 pub mod mesh;
 pub mod problem;
 pub mod shape;
+pub mod smooth;
 pub mod solve;
 pub mod stress;
 

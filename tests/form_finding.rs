@@ -270,3 +270,52 @@ fn infeasible_bounds_are_reported_not_hidden() {
         r.termination
     );
 }
+
+#[test]
+fn odt_smoothing_improves_the_plan_and_never_flips_a_triangle() {
+    let base = common::jiggle(&common::holed_disk(11, 0.01, |_, outer| outer), 11, 0.35);
+    let problem = Problem::new(base.clone());
+    let settings = FormFindSettings {
+        odt_iterations: 3,
+        ..Default::default()
+    };
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged, "{:?}", r.history);
+    certify("odt", &problem, &r);
+    // The plan moved, stays a valid triangulation, and its worst triangles got better.
+    let anchored: Vec<u32> = (0..base.positions.len() as u32)
+        .filter(|&v| base.anchored[v as usize])
+        .collect();
+    Mesh::new(r.positions.clone(), base.faces.clone(), &anchored).expect("plan still valid");
+    let min_angle = |x: &[[f64; 3]]| {
+        base.faces
+            .iter()
+            .map(|f| {
+                let p = f.map(|v| x[v as usize]);
+                (0..3)
+                    .map(|k| {
+                        let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+                        let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+                        (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1])
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let moved = (0..base.positions.len())
+        .filter(|&v| {
+            (r.positions[v][0] - base.positions[v][0])
+                .hypot(r.positions[v][1] - base.positions[v][1])
+                > 1e-9
+        })
+        .count();
+    assert!(moved > 0);
+    assert!(
+        min_angle(&r.positions) > min_angle(&base.positions),
+        "ODT did not improve the worst angle"
+    );
+    // Anchored vertices never move.
+    for &v in &anchored {
+        assert_eq!(r.positions[v as usize], base.positions[v as usize]);
+    }
+}

@@ -42,6 +42,13 @@ pub struct FormFindSettings {
     pub schedule: Schedule,
     /// Stalled when the best ε∞ has not improved by 1% over this many iterations.
     pub stall_window: usize,
+    /// Optimal Delaunay Triangulation sweeps of the plan: one before each of the first
+    /// `odt_iterations` stress steps (0: the plan never moves). Default 0.
+    pub odt_iterations: usize,
+    /// Let ODT move free boundary vertices too (it favours concave free edges, which is what a
+    /// free edge needs to carry compression). Default false: on the shared models it made the
+    /// loop infeasible or divergent more often than it helped.
+    pub odt_free_boundary: bool,
     /// Weight of the proximal term Σ l_e² (q_e − q_e^prev)² (frame units) in stress steps after
     /// the first. Default 1e-6.
     pub proximal_weight: f64,
@@ -65,6 +72,8 @@ impl Default for FormFindSettings {
             schedule: Schedule::default(),
             stall_window: 8,
             proximal_weight: 1e-6,
+            odt_iterations: 0,
+            odt_free_boundary: false,
         }
     }
 }
@@ -76,7 +85,7 @@ pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 #[derive(Debug, Clone)]
 pub struct FormFindResult {
     pub termination: Termination,
-    /// Final positions (plan unchanged, heights moved).
+    /// Final positions (heights moved; the plan too when ODT is on).
     pub positions: Vec<[f64; 3]>,
     /// The last stress step, at `positions` (its residuals certify the result).
     pub stress: StressResult,
@@ -118,7 +127,13 @@ pub fn form_find(
     let mut best_at = 0;
     let mut last: Option<StressResult> = None;
     let mut termination = Termination::MaxIterations;
+    let fans = crate::smooth::vertex_faces(mesh);
     for k in 0..settings.max_iterations.max(1) {
+        if k < settings.odt_iterations {
+            let t = Instant::now();
+            crate::smooth::odt_sweep(mesh, &fans, &mut positions, settings.odt_free_boundary);
+            shape_s += t.elapsed().as_secs_f64();
+        }
         let t = Instant::now();
         let prior = last
             .as_ref()

@@ -80,6 +80,9 @@ pub struct StressResult {
     pub objective: f64,
     pub force_diagram: ForceDiagram,
     pub iterations: u32,
+    /// The formulation that produced the forces: the requested one, or the edge-based one when
+    /// every reduced attempt failed numerically.
+    pub formulation: Formulation,
     /// The regulariser ε actually used (larger than the setting after a numerical failure).
     pub regularisation: f64,
     pub seconds: f64,
@@ -211,62 +214,44 @@ pub fn analyse_near(
         })
         .collect();
 
-    let (airy_op, s, balance): (Option<AiryOperator>, Csr, Vec<u32>) = match settings.formulation {
-        Formulation::Reduced => {
-            let op = AiryOperator::new(mesh, &plan, settings.holes)?;
-            let s = op.s.clone();
-            let balance = free
-                .iter()
-                .copied()
-                .filter(|&v| mesh.on_boundary[v as usize])
-                .collect();
-            (Some(op), s, balance)
-        }
-        Formulation::EdgeBased => {
-            let n_active = bounds.iter().filter(|b| b.is_some()).count();
-            let mut s = Csr::new(n_active);
-            let mut col = 0;
-            for b in &bounds {
-                if b.is_some() {
-                    s.push_row(vec![(col, 1.0)]);
-                    col += 1;
-                } else {
-                    s.push_row(Vec::new());
-                }
-            }
-            // Interior point supports take vertical reactions only (MATH §5).
-            let balance = (0..n as u32)
-                .filter(|&v| {
-                    let v = v as usize;
-                    mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v])
-                })
-                .collect();
-            (None, s, balance)
-        }
-    };
-
     // Interior-point methods can fail on degenerate problems (straight free edges force q = 0:
     // no strictly feasible point). The lifted and the plain reduced QP fail on different ones,
-    // so alternate between them before raising ε.
-    let reduced = settings.formulation == Formulation::Reduced;
-    let attempts: &[(bool, f64)] = if reduced {
-        &[
-            (true, 1.0),
-            (false, 1.0),
-            (true, 100.0),
-            (false, 100.0),
-            (true, 1e4),
-        ]
-    } else {
-        &[(false, 1.0), (false, 100.0), (false, 1e4)]
+    // so alternate between them, then raise ε, then fall back to the edge-based formulation
+    // (same optimum); the result says which formulation and ε were used.
+    use Formulation::{EdgeBased, Reduced};
+    let attempts: &[(Formulation, bool, f64)] = match settings.formulation {
+        Reduced => &[
+            (Reduced, true, 1.0),
+            (Reduced, false, 1.0),
+            (Reduced, true, 100.0),
+            (Reduced, false, 100.0),
+            (EdgeBased, false, 1.0),
+            (EdgeBased, false, 100.0),
+        ],
+        EdgeBased => &[
+            (EdgeBased, false, 1.0),
+            (EdgeBased, false, 100.0),
+            (EdgeBased, false, 1e4),
+        ],
     };
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / unit).collect());
-    let mut regularisation = base;
-    let mut out = None;
-    for &(lift_forces, factor) in attempts {
-        regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
+    let mut solved: Option<(
+        Formulation,
+        Option<AiryOperator>,
+        Csr,
+        Vec<u32>,
+        qp::QpOutput,
+        f64,
+    )> = None;
+    for &(formulation, lift_forces, factor) in attempts {
+        let reuse = matches!(&solved, Some((f, ..)) if *f == formulation);
+        let (airy_op, s, balance) = match solved.take() {
+            Some((_, op, s, balance, _)) if reuse => (op, s, balance),
+            _ => force_model(mesh, &plan, settings.holes, formulation, &bounds, &free)?,
+        };
+        let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
         let o = qp::solve(&qp::QpInput {
             s: &s,
             edges: &edges,
@@ -284,12 +269,13 @@ pub fn analyse_near(
             lift_forces,
         });
         let failed = StressStatus::from_clarabel(o.status) == StressStatus::NumericalError;
-        out = Some(o);
+        solved = Some((formulation, airy_op, s, balance, (o, regularisation)));
         if !failed {
             break;
         }
     }
-    let out = out.expect("at least one attempt");
+    let (formulation_used, airy_op, s, _, out, regularisation) =
+        solved.expect("at least one attempt");
     let status = StressStatus::from_clarabel(out.status);
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
     let y = if usable { out.y } else { vec![0.0; s.ncols] };
@@ -381,6 +367,7 @@ pub fn analyse_near(
         objective,
         force_diagram,
         iterations: out.iterations,
+        formulation: formulation_used,
         regularisation,
         seconds: start.elapsed().as_secs_f64(),
     })
@@ -426,6 +413,53 @@ impl StressResult {
             ..self.clone()
         }
     }
+}
+
+/// A QP outcome and the regulariser it was solved with.
+type QpAttempt = (qp::QpOutput, f64);
+
+/// The force map q = S y of a formulation and the vertices that need explicit horizontal
+/// balance rows.
+type ForceModel = (Option<AiryOperator>, Csr, Vec<u32>);
+
+fn force_model(
+    mesh: &Mesh,
+    plan: &Plan,
+    holes: airy::HoleMode,
+    formulation: Formulation,
+    bounds: &[Option<(f64, f64)>],
+    free: &[u32],
+) -> Result<ForceModel> {
+    Ok(match formulation {
+        Formulation::Reduced => {
+            let op = AiryOperator::new(mesh, plan, holes)?;
+            let s = op.s.clone();
+            let balance = free
+                .iter()
+                .copied()
+                .filter(|&v| mesh.on_boundary[v as usize])
+                .collect();
+            (Some(op), s, balance)
+        }
+        Formulation::EdgeBased => {
+            let mut s = Csr::new(bounds.iter().flatten().count());
+            let mut col = 0;
+            for b in bounds {
+                s.push_row(if b.is_some() {
+                    vec![(col, 1.0)]
+                } else {
+                    Vec::new()
+                });
+                col += b.is_some() as usize;
+            }
+            // Interior point supports take vertical reactions only (MATH §5).
+            let balance = (0..mesh.positions.len())
+                .filter(|&v| mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v]))
+                .map(|v| v as u32)
+                .collect();
+            (None, s, balance)
+        }
+    })
 }
 
 fn mean_over(x: &[f64], ids: &[u32]) -> f64 {
