@@ -237,18 +237,10 @@ pub fn analyse_near(
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / unit).collect());
-    let mut solved: Option<(
-        Formulation,
-        Option<AiryOperator>,
-        Csr,
-        Vec<u32>,
-        qp::QpOutput,
-        f64,
-    )> = None;
+    let mut solved: Option<Attempt> = None;
     for &(formulation, lift_forces, factor) in attempts {
-        let reuse = matches!(&solved, Some((f, ..)) if *f == formulation);
         let (airy_op, s, balance) = match solved.take() {
-            Some((_, op, s, balance, _)) if reuse => (op, s, balance),
+            Some(a) if a.formulation == formulation => a.model,
             _ => force_model(mesh, &plan, settings.holes, formulation, &bounds, &free)?,
         };
         let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
@@ -269,13 +261,22 @@ pub fn analyse_near(
             lift_forces,
         });
         let failed = StressStatus::from_clarabel(o.status) == StressStatus::NumericalError;
-        solved = Some((formulation, airy_op, s, balance, (o, regularisation)));
+        solved = Some(Attempt {
+            formulation,
+            model: (airy_op, s, balance),
+            out: o,
+            regularisation,
+        });
         if !failed {
             break;
         }
     }
-    let (formulation_used, airy_op, s, _, out, regularisation) =
-        solved.expect("at least one attempt");
+    let Attempt {
+        formulation: formulation_used,
+        model: (airy_op, s, _),
+        out,
+        regularisation,
+    } = solved.expect("at least one attempt");
     let status = StressStatus::from_clarabel(out.status);
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
     let y = if usable { out.y } else { vec![0.0; s.ncols] };
@@ -415,8 +416,13 @@ impl StressResult {
     }
 }
 
-/// A QP outcome and the regulariser it was solved with.
-type QpAttempt = (qp::QpOutput, f64);
+/// One solve of the stress QP: the formulation, its force model, the outcome and ε.
+struct Attempt {
+    formulation: Formulation,
+    model: ForceModel,
+    out: qp::QpOutput,
+    regularisation: f64,
+}
 
 /// The force map q = S y of a formulation and the vertices that need explicit horizontal
 /// balance rows.
