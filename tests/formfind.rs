@@ -226,8 +226,8 @@ fn bad_input_gets_one_line_and_no_output() {
     );
     rejects(
         &sq,
-        &["sq.obj", "--supports", "s.json", "--odt", "5"],
-        "not available yet",
+        &["sq.obj", "--supports", "s.json", "--odt", "five"],
+        "expected an integer",
     );
     rejects(
         &sq,

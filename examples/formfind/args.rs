@@ -71,7 +71,7 @@ Solver:
   --qmin-scope S         interior | all: the edges --qmin applies to       [{scope}]
   --qmax X               upper bound on force densities, as --qmin, or none [{qmax}]
   --tau M                optimize | zero: normal push at free edges        [{tau}]
-  --odt N                optimal-Delaunay remeshing every N iterations     [not available yet]
+  --odt N                ODT smoothing of the plan before each of the first N stress steps [0]
   --density D            weight per unit area of every face                [1]
   --load R               barycentric | voronoi | plan: face weight sharing [{load}]
   -h, --help             this text
@@ -222,6 +222,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                     Ok(n) => Some(n),
                     _ => return Err(format!("{flag}: expected an integer >= 0, got `{text}`")),
                 };
+                s.odt_iterations = o.odt.unwrap_or(0);
             }
             "--density" => {
                 let d = number(&flag, &value()?)?;
@@ -251,12 +252,6 @@ fn check(o: &Options) -> Result<(), String> {
             return Err("give either --supports or --anchor-boundary, not both".into())
         }
         _ => {}
-    }
-    if o.odt.is_some() {
-        return Err(
-            "--odt: optimal-Delaunay remeshing is not available yet in this version of voussoir"
-                .into(),
-        );
     }
     o.settings.stress.validate().map_err(|e| {
         e.to_string()
