@@ -603,7 +603,8 @@ VsrStatus vsr_result_counts(const struct VsrResult *result, size_t *n_vertices, 
 
 /**
  * Vertex positions, #V by 3 doubles (x, y, z), row-major, in the input's length unit: the
- * form-found shape (plan unchanged, heights moved), or the input for an analysis.
+ * form-found shape (heights moved; the plan too when ODT sweeps are on), or the input for an
+ * analysis.
  * Copy-out as described in the header's introduction.
  *
  * # Safety
@@ -835,6 +836,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | regularisation ε | 1e-10 |
  * | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
+ * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
  *
  * `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
@@ -1012,6 +1014,27 @@ VsrStatus vsr_settings_set_schedule_pull(struct VsrSettings *settings, double pu
 VsrStatus vsr_settings_set_proximal_weight(struct VsrSettings *settings, double weight);
 
 /**
+ * Sets the number of Optimal Delaunay Triangulation sweeps of the plan: one before each of
+ * the first `iterations` stress steps of form finding (vertices move in plan, on the 3-D
+ * surface; connectivity is unchanged). 0 (default) keeps the plan fixed. Not used by
+ * `vsr_analyse`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_odt_iterations(struct VsrSettings *settings, size_t iterations);
+
+/**
+ * Lets ODT sweeps move free boundary vertices too (`enable` 1) or not (0, default: on the
+ * shared models it made form finding infeasible or divergent more often than it helped).
+ * Any other value: `VSR_STATUS_INVALID_ARGUMENT`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_odt_free_boundary(struct VsrSettings *settings, uint32_t enable);
+
+/**
  * Sets the progress callback of `vsr_form_find` (see `VsrProgressFn`) and the `user` pointer
  * passed back to it unchanged. `callback` NULL removes it (default: none). Voussoir never
  * dereferences or frees `user`; it must stay valid while a solve using these settings runs.
@@ -1040,7 +1063,8 @@ VsrStatus vsr_settings_set_progress(struct VsrSettings *settings, VsrProgressFn 
 VsrStatus vsr_analyse(const struct VsrMesh *mesh, const struct VsrSettings *settings, struct VsrResult **out);
 
 /**
- * Form finding: moves the heights (plan fixed, supports fixed) until the shape stands
+ * Form finding: moves the heights (supports fixed; the plan fixed unless ODT sweeps are
+ * set) until the shape stands
  * (ε∞ < tolerance) or the loop stops; each iteration is a stress step (as `vsr_analyse`)
  * followed by a height step. Calls the progress callback of `settings`, if any, once per
  * iteration on this thread.

@@ -551,6 +551,18 @@ fn settings_setters_reject_bad_values() {
         assert_failed(unsafe { set(null_mut(), 0) }, S::NullPointer, "settings");
     }
     assert_failed(
+        unsafe { vsr_settings_set_odt_free_boundary(s, 2) },
+        S::InvalidArgument,
+        "enable",
+    );
+    assert_ok(unsafe { vsr_settings_set_odt_free_boundary(s, 0) });
+    assert_ok(unsafe { vsr_settings_set_odt_iterations(s, 3) });
+    assert_failed(
+        unsafe { vsr_settings_set_odt_iterations(null_mut(), 3) },
+        S::NullPointer,
+        "settings",
+    );
+    assert_failed(
         unsafe { vsr_settings_set_max_iterations(s, 0) },
         S::InvalidArgument,
         "max_iterations",
@@ -892,6 +904,35 @@ fn progress_callback_sees_every_iteration_and_can_cancel() {
     assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), vec![0, 1, 2]);
     assert_eq!(seen.iter().map(|s| s.1).collect::<Vec<_>>(), history);
     let _ = last_error();
+    unsafe {
+        vsr_result_destroy(r);
+        vsr_settings_destroy(s);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
+#[test]
+fn odt_sweeps_move_the_plan_through_the_c_abi() {
+    let mut d = Dome::new(4, 10);
+    d.positions
+        .iter_mut()
+        .skip(2)
+        .step_by(3)
+        .for_each(|z| *z *= 0.3);
+    let mesh = d.create();
+    let s = settings();
+    assert_ok(unsafe { vsr_settings_set_odt_iterations(s, 2) });
+    let mut r = null_mut();
+    assert_ok(unsafe { vsr_form_find(mesh, s, &mut r) });
+    let p = doubles(r, vsr_result_positions);
+    let moved = (0..d.n_vertices())
+        .map(|v| (p[3 * v] - d.positions[3 * v]).hypot(p[3 * v + 1] - d.positions[3 * v + 1]))
+        .fold(0.0, f64::max);
+    assert!(moved.is_finite());
+    for &a in &d.anchored {
+        let a = a as usize;
+        assert_eq!(&p[3 * a..3 * a + 3], &d.positions[3 * a..3 * a + 3]);
+    }
     unsafe {
         vsr_result_destroy(r);
         vsr_settings_destroy(s);

@@ -177,7 +177,8 @@ pub unsafe extern "C" fn vsr_result_counts(
 }
 
 /// Vertex positions, #V by 3 doubles (x, y, z), row-major, in the input's length unit: the
-/// form-found shape (plan unchanged, heights moved), or the input for an analysis.
+/// form-found shape (heights moved; the plan too when ODT sweeps are on), or the input for an
+/// analysis.
 /// Copy-out as described in the header's introduction.
 ///
 /// # Safety

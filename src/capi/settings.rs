@@ -4,7 +4,7 @@
 //! value (and, for bounds, the combination with the other bound) before it changes anything.
 //!
 //! Every option of [`FormFindSettings`] and its [`crate::StressSettings`] has a setter here.
-//! When an option is added to the Rust settings (the ODT smoothing option is planned), add its
+//! When an option is added to the Rust settings, add its
 //! `vsr_settings_set_*` function, a row in the defaults table of `vsr_settings_create` and in
 //! the `documented_defaults` test below, then rewrite the header
 //! (`VSR_BLESS=1 cargo test --test capi_header`).
@@ -48,6 +48,7 @@ pub struct VsrSettings {
 /// | regularisation ε | 1e-10 |
 /// | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
+/// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
 ///
 /// `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
@@ -434,6 +435,46 @@ pub unsafe extern "C" fn vsr_settings_set_proximal_weight(
         let v = at_least("weight", weight, 0.0, false)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, |f| f.proximal_weight = v) }
+    })
+}
+
+/// Sets the number of Optimal Delaunay Triangulation sweeps of the plan: one before each of
+/// the first `iterations` stress steps of form finding (vertices move in plan, on the 3-D
+/// surface; connectivity is unchanged). 0 (default) keeps the plan fixed. Not used by
+/// `vsr_analyse`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_odt_iterations(
+    settings: *mut VsrSettings,
+    iterations: usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.odt_iterations = iterations) }
+    })
+}
+
+/// Lets ODT sweeps move free boundary vertices too (`enable` 1) or not (0, default: on the
+/// shared models it made form finding infeasible or divergent more often than it helped).
+/// Any other value: `VSR_STATUS_INVALID_ARGUMENT`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_odt_free_boundary(
+    settings: *mut VsrSettings,
+    enable: u32,
+) -> VsrStatus {
+    boundary!({
+        let on = match enable {
+            0 => false,
+            1 => true,
+            v => return Err(Failure::invalid("enable", format!("{v} is not 0 or 1"))),
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.odt_free_boundary = on) }
     })
 }
 

@@ -44,7 +44,8 @@ pub unsafe extern "C" fn vsr_analyse(
     })
 }
 
-/// Form finding: moves the heights (plan fixed, supports fixed) until the shape stands
+/// Form finding: moves the heights (supports fixed; the plan fixed unless ODT sweeps are
+/// set) until the shape stands
 /// (ε∞ < tolerance) or the loop stops; each iteration is a stress step (as `vsr_analyse`)
 /// followed by a height step. Calls the progress callback of `settings`, if any, once per
 /// iteration on this thread.
