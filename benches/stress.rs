@@ -1,13 +1,17 @@
 //! Stress step, reduced (de Goes et al.) and edge-based (VHWP12) side by side, on the shared
 //! real models and generated domes with a hole. Prints a table; asserts nothing.
 //!
-//!     cargo bench --bench stress              # models + generated up to 50k vertices
-//!     cargo bench --bench stress -- --quick   # models + generated up to 6k vertices
+//!     cargo bench --bench stress              # models + generated domes of ~1.6k and ~6k vertices
+//!     cargo bench --bench stress -- --large   # also ~20k and ~50k vertices (slow)
+//!
+//! A second table gives the whole form-finding loop with default settings per model.
 
 use std::path::PathBuf;
 use std::time::Instant;
 use voussoir::generate::{self, Domain};
-use voussoir::{analyse, Formulation, HoleMode, Mesh, Problem, StressSettings};
+use voussoir::{
+    analyse, form_find, FormFindSettings, Formulation, HoleMode, Mesh, Problem, StressSettings,
+};
 
 fn generated(n: usize) -> Mesh {
     let domain = Domain {
@@ -63,7 +67,7 @@ fn row(name: &str, mesh: Mesh) {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let large = std::env::args().any(|a| a == "--large");
     println!("| model            |      V |      E |      F | reduced s (iters) | edge-based s (iters) | ratio | eps_inf   | status |");
     println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|-----------|--------|");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
@@ -89,12 +93,48 @@ fn main() {
     } else {
         println!("skipped: {} not found", dir.display());
     }
-    let sizes: &[usize] = if quick {
-        &[1000, 6000]
+    let sizes: &[usize] = if large {
+        &[1000, 4000, 12000, 30000]
     } else {
-        &[1000, 6000, 20000, 50000]
+        &[1000, 4000]
     };
     for &n in sizes {
-        row(&format!("dome+hole {}k", n / 1000), generated(n));
+        let mesh = generated(n);
+        row(&format!("dome+hole {}", mesh.positions.len()), mesh);
+    }
+    println!();
+    println!("| model            |      V | form finding: termination | iterations | eps_inf   | total s | stress s | hausdorff | l2     |");
+    println!("|------------------|--------|---------------------------|------------|-----------|---------|----------|-----------|--------|");
+    if dir.is_dir() {
+        for name in [
+            "free_vault",
+            "dome_with_doors",
+            "lilium",
+            "cheese",
+            "four_holes",
+            "neumunster",
+            "hex",
+            "three_pillar",
+            "vault_pq",
+        ] {
+            let mesh = voussoir::io::load_model(
+                &dir.join(format!("{name}.obj")),
+                &dir.join(format!("{name}.json")),
+            )
+            .expect("shared model");
+            let v = mesh.positions.len();
+            let r = form_find(&Problem::new(mesh), &FormFindSettings::default(), None)
+                .expect("valid problem");
+            println!(
+                "| {name:<16} | {v:>6} | {:<25} | {:>10} | {:>9.2e} | {:>7.2} | {:>8.2} | {:>9.4} | {:>6.4} |",
+                format!("{:?}", r.termination).chars().take(25).collect::<String>(),
+                r.iterations,
+                r.stress.eps_inf,
+                r.total_seconds,
+                r.stress_seconds,
+                r.hausdorff,
+                r.l2
+            );
+        }
     }
 }
