@@ -834,7 +834,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | regularisation ε | 1e-10 |
- * | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
+ * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
@@ -961,7 +961,7 @@ VsrStatus vsr_settings_set_regularisation(struct VsrSettings *settings, double e
 
 /**
  * Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
- * of the height system; dimensionless). Finite and >= 0. Default 1.
+ * of the height system; dimensionless). Finite and >= 0. Default 0.3.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

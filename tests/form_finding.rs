@@ -92,7 +92,8 @@ fn every_shared_model_converges_with_default_settings() {
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
         let r = run(name, &Problem::new(mesh));
-        assert!(r.iterations <= 30, "{name}: {} iterations", r.iterations);
+        // Issue 3 aims at 20; three_pillar and vault_pq take 21–22 with the default schedule.
+        assert!(r.iterations <= 22, "{name}: {} iterations", r.iterations);
     }
 }
 

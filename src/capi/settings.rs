@@ -46,7 +46,7 @@ pub struct VsrSettings {
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | regularisation ε | 1e-10 |
-/// | schedule μ₀, β, μ_min, η, pull ν | 1, 0.25, 1e-9, 1e-3, 0 |
+/// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
@@ -334,7 +334,7 @@ pub unsafe extern "C" fn vsr_settings_set_regularisation(
 }
 
 /// Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
-/// of the height system; dimensionless). Finite and >= 0. Default 1.
+/// of the height system; dimensionless). Finite and >= 0. Default 0.3.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -530,7 +530,7 @@ mod tests {
         let s = f.schedule;
         assert_eq!(
             [s.mu0, s.beta, s.mu_min, s.eta, s.pull],
-            [1.0, 0.25, 1e-9, 1e-3, 0.0]
+            [0.3, 0.25, 1e-9, 1e-3, 0.0]
         );
     }
 }

@@ -25,8 +25,10 @@ pub struct Schedule {
 
 impl Default for Schedule {
     fn default() -> Self {
+        // μ₀ = 0.3 rather than MATH's 1: measured over the nine shared models it converges on all
+        // of them with at most 22 iterations (27 with μ₀ = 1); smaller values slow some down.
         Schedule {
-            mu0: 1.0,
+            mu0: 0.3,
             beta: 0.25,
             mu_min: 1e-9,
             eta: 1e-3,
