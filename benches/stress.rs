@@ -33,6 +33,26 @@ fn generated(n: usize) -> Mesh {
     .expect("dome")
 }
 
+const MODELS: [&str; 9] = [
+    "free_vault",
+    "dome_with_doors",
+    "lilium",
+    "cheese",
+    "four_holes",
+    "neumunster",
+    "hex",
+    "three_pillar",
+    "vault_pq",
+];
+
+fn shared_model(dir: &std::path::Path, name: &str) -> Mesh {
+    voussoir::io::load_model(
+        &dir.join(format!("{name}.obj")),
+        &dir.join(format!("{name}.json")),
+    )
+    .expect("shared model")
+}
+
 fn row(name: &str, mesh: Mesh) {
     let (v, e, f) = (mesh.positions.len(), mesh.edges.len(), mesh.faces.len());
     let problem = Problem::new(mesh);
@@ -72,22 +92,8 @@ fn main() {
     println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|-----------|--------|");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
     if dir.is_dir() {
-        for name in [
-            "free_vault",
-            "dome_with_doors",
-            "lilium",
-            "cheese",
-            "four_holes",
-            "neumunster",
-            "hex",
-            "three_pillar",
-            "vault_pq",
-        ] {
-            let mesh = voussoir::io::load_model(
-                &dir.join(format!("{name}.obj")),
-                &dir.join(format!("{name}.json")),
-            )
-            .expect("shared model");
+        for name in MODELS {
+            let mesh = shared_model(&dir, name);
             row(name, mesh);
         }
     } else {
@@ -106,22 +112,8 @@ fn main() {
     println!("| model            |      V | form finding: termination | iterations | eps_inf   | total s | stress s | hausdorff | l2     |");
     println!("|------------------|--------|---------------------------|------------|-----------|---------|----------|-----------|--------|");
     if dir.is_dir() {
-        for name in [
-            "free_vault",
-            "dome_with_doors",
-            "lilium",
-            "cheese",
-            "four_holes",
-            "neumunster",
-            "hex",
-            "three_pillar",
-            "vault_pq",
-        ] {
-            let mesh = voussoir::io::load_model(
-                &dir.join(format!("{name}.obj")),
-                &dir.join(format!("{name}.json")),
-            )
-            .expect("shared model");
+        for name in MODELS {
+            let mesh = shared_model(&dir, name);
             let v = mesh.positions.len();
             let r = form_find(&Problem::new(mesh), &FormFindSettings::default(), None)
                 .expect("valid problem");

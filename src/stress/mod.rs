@@ -159,16 +159,7 @@ pub fn analyse_near(
     let frame = Frame::of(mesh, positions);
     let plan = Plan::new(mesh, positions, &frame);
     let l0 = frame.scale;
-    let load = loads::vertex_loads(
-        mesh,
-        positions,
-        settings.load_rule,
-        &problem.face_density,
-        &problem.extra_loads,
-    );
-    let free = non_anchored(mesh);
-    let mean_load = mean_over(&load, &free);
-    let p_bar = if mean_load > 0.0 { mean_load } else { 1.0 };
+    let (load, free, p_bar) = loads_at(problem, positions, settings);
     let unit = p_bar / l0; // natural force density scale
 
     // Frame units: z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄.
@@ -384,16 +375,7 @@ impl StressResult {
         settings: &StressSettings,
     ) -> StressResult {
         let mesh = &problem.mesh;
-        let load = loads::vertex_loads(
-            mesh,
-            positions,
-            settings.load_rule,
-            &problem.face_density,
-            &problem.extra_loads,
-        );
-        let free = non_anchored(mesh);
-        let mean_load = mean_over(&load, &free);
-        let p_bar = if mean_load > 0.0 { mean_load } else { 1.0 };
+        let (load, free, p_bar) = loads_at(problem, positions, settings);
         let (residuals, horizontal_imbalance) = equilibrium(
             mesh,
             positions,
@@ -466,6 +448,26 @@ fn force_model(
             (None, s, balance)
         }
     })
+}
+
+/// Loads at `positions`, the non-anchored vertices, and their mean load p̄ (1 when zero, so
+/// that weightless problems still have a scale).
+fn loads_at(
+    problem: &Problem,
+    positions: &[[f64; 3]],
+    settings: &StressSettings,
+) -> (Vec<f64>, Vec<u32>, f64) {
+    let mesh = &problem.mesh;
+    let load = loads::vertex_loads(
+        mesh,
+        positions,
+        settings.load_rule,
+        &problem.face_density,
+        &problem.extra_loads,
+    );
+    let free = non_anchored(mesh);
+    let mean_load = mean_over(&load, &free);
+    (load, free, if mean_load > 0.0 { mean_load } else { 1.0 })
 }
 
 fn mean_over(x: &[f64], ids: &[u32]) -> f64 {
