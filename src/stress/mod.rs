@@ -46,6 +46,16 @@ impl StressStatus {
         }
     }
 
+    /// Preference among attempts: lower is better.
+    fn rank(self) -> u8 {
+        match self {
+            StressStatus::Solved | StressStatus::Infeasible => 0,
+            StressStatus::AlmostSolved => 1,
+            StressStatus::MaxIterations => 2,
+            StressStatus::NumericalError => 3,
+        }
+    }
+
     /// True when the force densities are a usable optimum.
     pub fn is_solved(self) -> bool {
         matches!(self, StressStatus::Solved | StressStatus::AlmostSolved)
@@ -212,10 +222,10 @@ pub fn analyse_near(
     use Formulation::{EdgeBased, Reduced};
     let attempts: &[(Formulation, bool, f64)] = match settings.formulation {
         Reduced => &[
-            (Reduced, true, 1.0),
             (Reduced, false, 1.0),
-            (Reduced, true, 100.0),
+            (Reduced, true, 1.0),
             (Reduced, false, 100.0),
+            (Reduced, true, 100.0),
             (EdgeBased, false, 1.0),
             (EdgeBased, false, 100.0),
         ],
@@ -228,22 +238,32 @@ pub fn analyse_near(
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / unit).collect());
-    let mut solved: Option<Attempt> = None;
-    for &(formulation, lift_forces, factor) in attempts {
-        let (airy_op, s, balance) = match solved.take() {
-            Some(a) if a.formulation == formulation => a.model,
-            _ => force_model(mesh, &plan, settings.holes, formulation, &bounds, &free)?,
-        };
+    // Each force model is built at most once; index 0 reduced, 1 edge-based.
+    let mut models: [Option<ForceModel>; 2] = [None, None];
+    let slot = |f: Formulation| (f == EdgeBased) as usize;
+    let mut best: Option<Attempt> = None;
+    for (k, &(formulation, lift_forces, factor)) in attempts.iter().enumerate() {
+        if models[slot(formulation)].is_none() {
+            models[slot(formulation)] = Some(force_model(
+                mesh,
+                &plan,
+                settings.holes,
+                formulation,
+                &bounds,
+                &free,
+            )?);
+        }
+        let (_, s, balance) = models[slot(formulation)].as_ref().expect("built above");
         let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
-        let o = qp::solve(&qp::QpInput {
-            s: &s,
+        let out = qp::solve(&qp::QpInput {
+            s,
             edges: &edges,
             length: &plan.length,
             u: &plan.u,
             z: &z,
             residual_vertices: &free,
             load: &p,
-            balance_vertices: &balance,
+            balance_vertices: balance,
             external: &external,
             tau_normal: &tau_normal,
             bounds: &bounds,
@@ -251,23 +271,36 @@ pub fn analyse_near(
             prior: prior_frame.as_deref(),
             lift_forces,
         });
-        let failed = StressStatus::from_clarabel(o.status) == StressStatus::NumericalError;
-        solved = Some(Attempt {
-            formulation,
-            model: (airy_op, s, balance),
-            out: o,
-            regularisation,
-        });
-        if !failed {
+        let status = StressStatus::from_clarabel(out.status);
+        if best
+            .as_ref()
+            .is_none_or(|b| status.rank() < b.status().rank())
+        {
+            best = Some(Attempt {
+                formulation,
+                out,
+                regularisation,
+            });
+        }
+        // Solved or infeasible: done. Reduced accuracy: one more try with the other form of the
+        // same problem, then keep the better. Numerical failure: go down the list.
+        let done = match status {
+            StressStatus::Solved | StressStatus::Infeasible => true,
+            StressStatus::AlmostSolved | StressStatus::MaxIterations => k >= 1,
+            StressStatus::NumericalError => false,
+        };
+        if done {
             break;
         }
     }
     let Attempt {
         formulation: formulation_used,
-        model: (airy_op, s, _),
         out,
         regularisation,
-    } = solved.expect("at least one attempt");
+    } = best.expect("at least one attempt");
+    let (airy_op, s, _) = models[slot(formulation_used)]
+        .take()
+        .expect("model of the attempt");
     let status = StressStatus::from_clarabel(out.status);
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
     let y = if usable { out.y } else { vec![0.0; s.ncols] };
@@ -398,12 +431,17 @@ impl StressResult {
     }
 }
 
-/// One solve of the stress QP: the formulation, its force model, the outcome and ε.
+/// One solve of the stress QP: the formulation, the outcome and ε.
 struct Attempt {
     formulation: Formulation,
-    model: ForceModel,
     out: qp::QpOutput,
     regularisation: f64,
+}
+
+impl Attempt {
+    fn status(&self) -> StressStatus {
+        StressStatus::from_clarabel(self.out.status)
+    }
 }
 
 /// The force map q = S y of a formulation and the vertices that need explicit horizontal
