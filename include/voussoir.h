@@ -834,6 +834,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | regularisation ε | 1e-10 |
+ * | dual edge length bounds | none |
  * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
@@ -958,6 +959,17 @@ VsrStatus vsr_settings_set_formulation(struct VsrSettings *settings, uint32_t fo
  * `settings`: a valid handle with exclusive access.
  */
 VsrStatus vsr_settings_set_regularisation(struct VsrSettings *settings, double epsilon);
+
+/**
+ * Bounds the dual (force-diagram) edge length of interior edges: `lo` ≤ q_e l_e / p̄ ≤ `hi`,
+ * in units of the mean load p̄ over non-anchored vertices (dimensionless). `lo` must be
+ * finite and at least 0, `hi` greater than `lo` (+INFINITY for no upper bound); `lo` = 0 with
+ * `hi` = +INFINITY removes the bounds. Default none.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_dual_length_bounds(struct VsrSettings *settings, double lo, double hi);
 
 /**
  * Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal

@@ -622,6 +622,29 @@ fn settings_setters_reject_bad_values() {
     );
     assert_ok(unsafe { vsr_settings_set_q_max(s, f64::INFINITY, 0) });
     assert_ok(unsafe { vsr_settings_set_q_min(s, 2.0, VsrBoundKind::Relative as u32) });
+    // Dual edge length bounds: lo >= 0 finite, hi > lo; (0, +inf) removes them.
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_bounds(s, -1.0, 1.0) },
+        S::InvalidArgument,
+        "lo",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_bounds(s, f64::NAN, 1.0) },
+        S::NonFinite,
+        "lo",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_bounds(s, 0.5, 0.5) },
+        S::InvalidArgument,
+        "hi",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_bounds(s, 0.1, f64::NAN) },
+        S::InvalidArgument,
+        "hi",
+    );
+    assert_ok(unsafe { vsr_settings_set_dual_length_bounds(s, 0.01, 0.5) });
+    assert_ok(unsafe { vsr_settings_set_dual_length_bounds(s, 0.0, f64::INFINITY) });
     assert_failed(
         unsafe { vsr_settings_set_progress(null_mut(), None, null_mut()) },
         S::NullPointer,

@@ -320,3 +320,47 @@ fn odt_smoothing_improves_the_plan_and_never_flips_a_triangle() {
         assert_eq!(r.positions[v as usize], base.positions[v as usize]);
     }
 }
+
+#[test]
+fn dual_length_bounds_shape_the_force_diagram() {
+    let problem = Problem::new(polar_cap(8, 1.2));
+    let free_run = form_find(&problem, &FormFindSettings::default(), None).unwrap();
+    let mesh = &problem.mesh;
+    let p_bar = |r: &FormFindResult| {
+        let free: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&v| mesh.is_non_anchored(v))
+            .collect();
+        free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64
+    };
+    let dual = |r: &FormFindResult| -> Vec<f64> {
+        let pb = p_bar(r);
+        mesh.edges
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| !e.is_boundary())
+            .map(|(i, e)| {
+                let [a, b] = e.v.map(|v| r.positions[v as usize]);
+                r.stress.force_densities[i] * (a[0] - b[0]).hypot(a[1] - b[1]) / pb
+            })
+            .collect()
+    };
+    let unbounded = dual(&free_run);
+    let max = unbounded.iter().fold(0.0f64, |m, d| m.max(*d));
+    // Cap the longest force-diagram edges at 70% of their unbounded length.
+    let (lo, hi) = (0.01, 0.7 * max);
+    let mut settings = FormFindSettings::default();
+    settings.stress.dual_length_bounds = Some((lo, hi));
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged, "{:?}", r.history);
+    certify("dual bounds", &problem, &r);
+    for d in dual(&r) {
+        assert!(
+            d >= lo * (1.0 - 1e-6) - 1e-9 && d <= hi * (1.0 + 1e-6) + 1e-9,
+            "dual length {d} outside [{lo}, {hi}]"
+        );
+    }
+    assert!(
+        max > hi * 1.1,
+        "the bound is active: the unbounded diagram was longer"
+    );
+}

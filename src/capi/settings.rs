@@ -46,6 +46,7 @@ pub struct VsrSettings {
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | regularisation ε | 1e-10 |
+/// | dual edge length bounds | none |
 /// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
@@ -330,6 +331,30 @@ pub unsafe extern "C" fn vsr_settings_set_regularisation(
         let v = at_least("epsilon", epsilon, 0.0, false)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, |f| f.stress.regularisation = v) }
+    })
+}
+
+/// Bounds the dual (force-diagram) edge length of interior edges: `lo` ≤ q_e l_e / p̄ ≤ `hi`,
+/// in units of the mean load p̄ over non-anchored vertices (dimensionless). `lo` must be
+/// finite and at least 0, `hi` greater than `lo` (+INFINITY for no upper bound); `lo` = 0 with
+/// `hi` = +INFINITY removes the bounds. Default none.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_dual_length_bounds(
+    settings: *mut VsrSettings,
+    lo: f64,
+    hi: f64,
+) -> VsrStatus {
+    boundary!({
+        let lo = at_least("lo", lo, 0.0, false)?;
+        if hi.is_nan() || hi <= lo {
+            return Err(Failure::invalid("hi", format!("{hi} must be > lo ({lo})")));
+        }
+        let bounds = (lo > 0.0 || hi.is_finite()).then_some((lo, hi));
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.dual_length_bounds = bounds) }
     })
 }
 

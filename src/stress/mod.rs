@@ -209,16 +209,24 @@ pub fn analyse_near(
     let bounds: Vec<Option<(f64, f64)>> = (0..edges.len())
         .map(|e| {
             active(e).then(|| {
-                let scoped = settings.q_min_scope == EdgeScope::All || !mesh.edges[e].is_boundary();
-                (if scoped { q_min } else { 0.0 }, q_max)
+                let interior = !mesh.edges[e].is_boundary();
+                let scoped = settings.q_min_scope == EdgeScope::All || interior;
+                let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
+                // Dual length d* = q l is p̄ q' l' in frame units: bounds on it are per-edge q bounds.
+                if let (Some((d_lo, d_hi)), true) = (settings.dual_length_bounds, interior) {
+                    lo = lo.max(d_lo / plan.length[e]);
+                    hi = hi.min(d_hi / plan.length[e]);
+                }
+                (lo, hi)
             })
         })
         .collect();
 
     // Interior-point methods can fail on degenerate problems (straight free edges force q = 0:
-    // no strictly feasible point). The lifted and the plain reduced QP fail on different ones,
-    // so alternate between them, then raise ε, then fall back to the edge-based formulation
-    // (same optimum); the result says which formulation and ε were used.
+    // no strictly feasible point). The plain reduced QP is fastest; the lifted one (q as
+    // variables) copes with problems where the plain one reaches only reduced accuracy. Then ε
+    // is raised, then the edge-based formulation (same optimum) is used; the result says which
+    // formulation and ε were used.
     use Formulation::{EdgeBased, Reduced};
     let attempts: &[(Formulation, bool, f64)] = match settings.formulation {
         Reduced => &[

@@ -73,6 +73,10 @@ pub struct StressSettings {
     pub holes: HoleMode,
     pub load_rule: LoadRule,
     pub formulation: Formulation,
+    /// Bounds (lo, hi) on the dual (force-diagram) edge length of interior edges, in units of
+    /// the mean load p̄: lo ≤ q_e l_e / p̄ ≤ hi. A lower bound keeps every force-diagram edge
+    /// visible, an upper bound smooths the diagram. Default none.
+    pub dual_length_bounds: Option<(f64, f64)>,
     /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10; when the solver
     /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is retried with ε × 100, up to twice, and the result says which ε was used.
@@ -89,6 +93,7 @@ impl Default for StressSettings {
             holes: HoleMode::Constant,
             load_rule: LoadRule::Barycentric,
             formulation: Formulation::Reduced,
+            dual_length_bounds: None,
             regularisation: 1e-10,
         }
     }
@@ -114,6 +119,11 @@ impl StressSettings {
             }
             if std::mem::discriminant(&q_max) == std::mem::discriminant(&self.q_min) && v < q_min {
                 return bad("q_max", "must be >= q_min");
+            }
+        }
+        if let Some((lo, hi)) = self.dual_length_bounds {
+            if !(lo.is_finite() && lo >= 0.0 && hi > lo) {
+                return bad("dual_length_bounds", "must be finite with 0 <= lo < hi");
             }
         }
         if !self.regularisation.is_finite() || self.regularisation < 0.0 {
