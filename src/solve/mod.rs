@@ -141,6 +141,7 @@ pub fn form_find(
             .map(|s| Prior {
                 force_densities: &s.force_densities,
                 weight: settings.proximal_weight,
+                lifted_first: s.lifted,
             });
         let stress = analyse_near(problem, &positions, &settings.stress, prior)?;
         stress_s += t.elapsed().as_secs_f64();

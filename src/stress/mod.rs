@@ -93,6 +93,8 @@ pub struct StressResult {
     /// The formulation that produced the forces: the requested one, or the edge-based one when
     /// every reduced attempt failed numerically.
     pub formulation: Formulation,
+    /// Whether the answer came from the lifted form of the QP (q as variables).
+    pub lifted: bool,
     /// The regulariser ε actually used (larger than the setting after a numerical failure).
     pub regularisation: f64,
     pub seconds: f64,
@@ -153,6 +155,8 @@ pub struct Prior<'a> {
     /// Physical force density per edge.
     pub force_densities: &'a [f64],
     pub weight: f64,
+    /// Start with the lifted reduced QP (the form that produced the previous step's answer).
+    pub lifted_first: bool,
 }
 
 /// [`analyse_at`] with an optional proximal centre.
@@ -228,15 +232,18 @@ pub fn analyse_near(
     // is raised, then the edge-based formulation (same optimum) is used; the result says which
     // formulation and ε were used.
     use Formulation::{EdgeBased, Reduced};
+    let lifted_first = prior.is_some_and(|p| p.lifted_first);
+    let (a, b) = (lifted_first, !lifted_first);
+    let reduced_attempts = [
+        (Reduced, a, 1.0),
+        (Reduced, b, 1.0),
+        (Reduced, a, 100.0),
+        (Reduced, b, 100.0),
+        (EdgeBased, false, 1.0),
+        (EdgeBased, false, 100.0),
+    ];
     let attempts: &[(Formulation, bool, f64)] = match settings.formulation {
-        Reduced => &[
-            (Reduced, false, 1.0),
-            (Reduced, true, 1.0),
-            (Reduced, false, 100.0),
-            (Reduced, true, 100.0),
-            (EdgeBased, false, 1.0),
-            (EdgeBased, false, 100.0),
-        ],
+        Reduced => &reduced_attempts,
         EdgeBased => &[
             (EdgeBased, false, 1.0),
             (EdgeBased, false, 100.0),
@@ -286,6 +293,7 @@ pub fn analyse_near(
         {
             best = Some(Attempt {
                 formulation,
+                lifted: lift_forces,
                 out,
                 regularisation,
             });
@@ -303,6 +311,7 @@ pub fn analyse_near(
     }
     let Attempt {
         formulation: formulation_used,
+        lifted,
         out,
         regularisation,
     } = best.expect("at least one attempt");
@@ -401,6 +410,7 @@ pub fn analyse_near(
         force_diagram,
         iterations: out.iterations,
         formulation: formulation_used,
+        lifted,
         regularisation,
         seconds: start.elapsed().as_secs_f64(),
     })
@@ -442,6 +452,7 @@ impl StressResult {
 /// One solve of the stress QP: the formulation, the outcome and ε.
 struct Attempt {
     formulation: Formulation,
+    lifted: bool,
     out: qp::QpOutput,
     regularisation: f64,
 }
