@@ -428,11 +428,6 @@ typedef struct VsrSettings VsrSettings;
  */
 typedef int (*VsrProgressFn)(void *user, size_t iteration, double eps_inf);
 
-/**
- * Every status, for `vsr_status_name` and tests.
- */
-#define VsrStatus_ALL { VsrStatus_Ok, VsrStatus_NullPointer, VsrStatus_InvalidArgument, VsrStatus_LengthOverflow, VsrStatus_IndexOutOfRange, VsrStatus_NonFinite, VsrStatus_InvalidEnum, VsrStatus_BufferTooSmall, VsrStatus_EmptyMesh, VsrStatus_InvalidTopology, VsrStatus_InvalidPlan, VsrStatus_NoSupport, VsrStatus_NotAvailable, VsrStatus_Numerical, VsrStatus_Panic, }
-
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -642,8 +637,9 @@ VsrStatus vsr_result_airy(const struct VsrResult *result, double *out, size_t le
 
 /**
  * Vertex weights w = x² + y² − 2 φ, #V doubles (the power diagram of the plan points with
- * these weights is the force diagram; units as in the paper, length² and force × length
- * mixed, so meaningful for unit loads).
+ * these weights is the force diagram, except along the cuts of holes whose jump is non-zero,
+ * where φ is multivalued; units as in the paper, length² and force × length mixed, so
+ * meaningful for unit loads).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -689,7 +685,9 @@ VsrStatus vsr_result_residuals(const struct VsrResult *result, double *out, size
 
 /**
  * Horizontal imbalance Σ_j q_ij (u_i − u_j) + external force per vertex, #V by 2 doubles
- * (force), row-major; about 1e-12 × load when the stress step solved.
+ * (force), row-major. Exact by construction at interior vertices up to rounding (measured
+ * ≤ 1e-10 of Σ|q| l + load); at free boundary vertices it is the QP solver's feasibility
+ * accuracy (measured ≤ 1e-9 relative).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -708,8 +706,10 @@ VsrStatus vsr_result_horizontal_imbalance(const struct VsrResult *result, double
 VsrStatus vsr_result_hole_coefficients(const struct VsrResult *result, double *out, size_t len, size_t *needed);
 
 /**
- * Force diagram points: one per face, the power centre of its weighted vertices, #F by 2
- * doubles (force), row-major, in face order.
+ * Force diagram points: one per face, the gradient of the Airy function on it, #F by 2
+ * doubles (force), row-major, in face order. This is the power centre of the face's weighted
+ * vertices except on the faces along a hole's cut when that hole's jump is non-zero (the Airy
+ * function is multivalued there; see `vsr_result_hole_coefficients`).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.

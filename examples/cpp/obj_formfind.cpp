@@ -23,7 +23,30 @@
 #include <string>
 #include <vector>
 
-using Mesh = OpenMesh::TriMesh_ArrayKernelT<>;
+// Double-precision points: the form-found heights balance to ~1e-7 of the load, which single
+// precision (OpenMesh's default Vec3f) would destroy.
+struct DoubleTraits : public OpenMesh::DefaultTraits {
+    using Point = OpenMesh::Vec3d;
+    using Normal = OpenMesh::Vec3d;
+};
+using Mesh = OpenMesh::TriMesh_ArrayKernelT<DoubleTraits>;
+
+// OpenMesh 9's OBJ writer prints single precision even for double points, so the result is
+// written here with 17 significant digits (faces as OpenMesh holds them).
+static bool write_obj(const Mesh &mesh, const char *path) {
+    std::ofstream out(path);
+    out.precision(17);
+    for (auto v : mesh.vertices()) {
+        const auto &p = mesh.point(v);
+        out << "v " << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+    }
+    for (auto f : mesh.faces()) {
+        out << 'f';
+        for (auto v : mesh.fv_range(f)) out << ' ' << v.idx() + 1;
+        out << '\n';
+    }
+    return static_cast<bool>(out);
+}
 
 namespace {
 
@@ -124,7 +147,7 @@ int run(int argc, char **argv) {
         const size_t i = static_cast<size_t>(v.idx());
         mesh.set_point(v, Mesh::Point(found[3 * i], found[3 * i + 1], found[3 * i + 2]));
     }
-    if (!OpenMesh::IO::write_mesh(mesh, argv[2], OpenMesh::IO::Options::Default, 17))
+    if (!write_obj(mesh, argv[2]))
         throw std::runtime_error(std::string("OpenMesh cannot write ") + argv[2]);
 
     VsrTermination termination;

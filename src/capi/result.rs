@@ -260,8 +260,9 @@ pub unsafe extern "C" fn vsr_result_airy(
 }
 
 /// Vertex weights w = x² + y² − 2 φ, #V doubles (the power diagram of the plan points with
-/// these weights is the force diagram; units as in the paper, length² and force × length
-/// mixed, so meaningful for unit loads).
+/// these weights is the force diagram, except along the cuts of holes whose jump is non-zero,
+/// where φ is multivalued; units as in the paper, length² and force × length mixed, so
+/// meaningful for unit loads).
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -360,7 +361,9 @@ pub unsafe extern "C" fn vsr_result_residuals(
 }
 
 /// Horizontal imbalance Σ_j q_ij (u_i − u_j) + external force per vertex, #V by 2 doubles
-/// (force), row-major; about 1e-12 × load when the stress step solved.
+/// (force), row-major. Exact by construction at interior vertices up to rounding (measured
+/// ≤ 1e-10 of Σ|q| l + load); at free boundary vertices it is the QP solver's feasibility
+/// accuracy (measured ≤ 1e-9 relative).
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -410,8 +413,10 @@ pub unsafe extern "C" fn vsr_result_hole_coefficients(
     })
 }
 
-/// Force diagram points: one per face, the power centre of its weighted vertices, #F by 2
-/// doubles (force), row-major, in face order.
+/// Force diagram points: one per face, the gradient of the Airy function on it, #F by 2
+/// doubles (force), row-major, in face order. This is the power centre of the face's weighted
+/// vertices except on the faces along a hole's cut when that hole's jump is non-zero (the Airy
+/// function is multivalued there; see `vsr_result_hole_coefficients`).
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.

@@ -74,6 +74,7 @@ impl VsrStatus {
     }
 
     /// Every status, for `vsr_status_name` and tests.
+    /// cbindgen:ignore
     pub const ALL: [VsrStatus; 15] = [
         VsrStatus::Ok,
         VsrStatus::NullPointer,

@@ -70,7 +70,8 @@ pub struct StressResult {
     pub force_densities: Vec<f64>,
     /// Airy value φ per vertex (0 at unreferenced vertices).
     pub airy: Vec<f64>,
-    /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram.
+    /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram, except
+    /// along the cut of a hole whose jump is non-zero (φ is multivalued there).
     pub weights: Vec<f64>,
     /// Hole jump M_h(u) = c + a·u per hole as (c, a_x, a_y), in the order of the mesh's holes.
     pub hole_coefficients: Vec<[f64; 3]>,
