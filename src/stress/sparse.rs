@@ -59,10 +59,6 @@ impl Csr {
             .zip(self.val[range].iter().copied())
     }
 
-    pub fn row_len(&self, r: usize) -> usize {
-        self.start[r + 1] - self.start[r]
-    }
-
     pub fn mul(&self, x: &[f64]) -> Vec<f64> {
         (0..self.nrows())
             .map(|r| self.row(r).map(|(c, v)| v * x[c]).sum())
