@@ -53,6 +53,26 @@ fn shared_model(dir: &std::path::Path, name: &str) -> Mesh {
     .expect("shared model")
 }
 
+/// The paper's timing table (de Goes et al. 2013, 2.2 GHz laptop): (VHWP12 s, de Goes s) for
+/// the rows that are shared models.
+fn paper(name: &str) -> Option<(f64, f64)> {
+    match name {
+        "free_vault" => Some((0.387, 0.18)),
+        "dome_with_doors" => Some((0.877, 0.368)),
+        "lilium" => Some((4.136, 0.887)),
+        "cheese" => Some((13.078, 9.8)),
+        _ => None,
+    }
+}
+
+/// Peak resident memory of this process so far, in MiB.
+fn peak_rss_mib() -> f64 {
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: getrusage writes into the struct we own.
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) };
+    usage.ru_maxrss as f64 / 1024.0
+}
+
 fn row(name: &str, mesh: Mesh) {
     let (v, e, f) = (mesh.positions.len(), mesh.edges.len(), mesh.faces.len());
     let problem = Problem::new(mesh);
@@ -73,8 +93,9 @@ fn row(name: &str, mesh: Mesh) {
         ));
     }
     let (red, edge) = (&cells[0], &cells[1]);
+    let paper = paper(name).map_or("—".to_string(), |(vh, dg)| format!("{dg} / {vh}"));
     println!(
-        "| {name:<16} | {v:>6} | {e:>6} | {f:>6} | {:>8.3} ({:>2} it) | {:>8.3} ({:>2} it) | {:>5.2} | {:>9.3e} | {} / {} |",
+        "| {name:<16} | {v:>6} | {e:>6} | {f:>6} | {:>8.3} ({:>2} it) | {:>8.3} ({:>2} it) | {:>5.2} | {paper:>14} | {:>9.3e} | {} / {} |",
         red.0,
         red.1,
         edge.0,
@@ -88,8 +109,8 @@ fn row(name: &str, mesh: Mesh) {
 
 fn main() {
     let large = std::env::args().any(|a| a == "--large");
-    println!("| model            |      V |      E |      F | reduced s (iters) | edge-based s (iters) | ratio | eps_inf   | status |");
-    println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|-----------|--------|");
+    println!("| model            |      V |      E |      F | reduced s (iters) | edge-based s (iters) | ratio | paper dG / VHWP12 s | eps_inf   | status |");
+    println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|---------------------|-----------|--------|");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
     if dir.is_dir() {
         for name in MODELS {
@@ -129,4 +150,9 @@ fn main() {
             );
         }
     }
+    println!();
+    println!(
+        "peak resident memory of the whole run: {:.0} MiB",
+        peak_rss_mib()
+    );
 }
