@@ -20,5 +20,6 @@ pub use problem::Problem;
 pub use solve::{form_find, FormFindResult, FormFindSettings, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{
-    analyse, EdgeScope, Formulation, QBound, StressResult, StressSettings, StressStatus, TauMode,
+    analyse, EdgeScope, Formulation, QBound, QpSolver, StressResult, StressSettings, StressStatus,
+    TauMode,
 };

@@ -6,6 +6,7 @@
 
 pub mod airy;
 pub mod holes;
+mod ipm;
 mod qp;
 pub mod settings;
 pub mod sparse;
@@ -17,7 +18,7 @@ use crate::mesh::Mesh;
 use crate::problem::Problem;
 use airy::AiryOperator;
 use clarabel::solver::SolverStatus;
-pub use settings::{EdgeScope, Formulation, QBound, StressSettings, TauMode};
+pub use settings::{EdgeScope, Formulation, QBound, QpSolver, StressSettings, TauMode};
 use sparse::Csr;
 use std::time::Instant;
 
@@ -94,6 +95,8 @@ pub struct StressResult {
     /// The formulation that produced the forces: the requested one, or the edge-based one when
     /// every reduced attempt failed numerically.
     pub formulation: Formulation,
+    /// The solver that produced the answer (clarabel after a fallback from the native one).
+    pub solver: QpSolver,
     /// Whether the answer came from the lifted form of the QP (q as variables).
     pub lifted: bool,
     /// The regulariser ε actually used (larger than the setting after a numerical failure).
@@ -227,30 +230,35 @@ pub fn analyse_near(
         })
         .collect();
 
-    // Interior-point methods can fail on degenerate problems (straight free edges force q = 0:
-    // no strictly feasible point). The plain reduced QP is fastest; the lifted one (q as
-    // variables) copes with problems where the plain one reaches only reduced accuracy. Then ε
-    // is raised, then the edge-based formulation (same optimum) is used; the result says which
-    // formulation and ε were used.
+    // The native solver goes first. Interior-point methods can fail on degenerate problems
+    // (straight free edges force q = 0: no strictly feasible point), and only clarabel
+    // certifies infeasibility, so when it does not converge clarabel takes over: the plain
+    // reduced QP is fastest; the lifted one (q as variables) copes with problems where the
+    // plain one reaches only reduced accuracy. Then ε is raised, then the edge-based
+    // formulation (same optimum) is used; the result says which solver, formulation and ε.
     use Formulation::{EdgeBased, Reduced};
+    use QpSolver::{Clarabel, Native};
     let lifted_first = prior.is_some_and(|p| p.lifted_first);
     let (a, b) = (lifted_first, !lifted_first);
-    let reduced_attempts = [
-        (Reduced, a, 1.0),
-        (Reduced, b, 1.0),
-        (Reduced, a, 100.0),
-        (Reduced, b, 100.0),
-        (EdgeBased, false, 1.0),
-        (EdgeBased, false, 100.0),
-    ];
-    let attempts: &[(Formulation, bool, f64)] = match settings.formulation {
-        Reduced => &reduced_attempts,
-        EdgeBased => &[
-            (EdgeBased, false, 1.0),
-            (EdgeBased, false, 100.0),
-            (EdgeBased, false, 1e4),
-        ],
-    };
+    let mut attempts: Vec<(QpSolver, Formulation, bool, f64)> = Vec::new();
+    if settings.solver == Native {
+        attempts.push((Native, settings.formulation, false, 1.0));
+    }
+    match settings.formulation {
+        Reduced => attempts.extend_from_slice(&[
+            (Clarabel, Reduced, a, 1.0),
+            (Clarabel, Reduced, b, 1.0),
+            (Clarabel, Reduced, a, 100.0),
+            (Clarabel, Reduced, b, 100.0),
+            (Clarabel, EdgeBased, false, 1.0),
+            (Clarabel, EdgeBased, false, 100.0),
+        ]),
+        EdgeBased => attempts.extend_from_slice(&[
+            (Clarabel, EdgeBased, false, 1.0),
+            (Clarabel, EdgeBased, false, 100.0),
+            (Clarabel, EdgeBased, false, 1e4),
+        ]),
+    }
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / unit).collect());
@@ -258,7 +266,8 @@ pub fn analyse_near(
     let mut models: [Option<ForceModel>; 2] = [None, None];
     let slot = |f: Formulation| (f == EdgeBased) as usize;
     let mut best: Option<Attempt> = None;
-    for (k, &(formulation, lift_forces, factor)) in attempts.iter().enumerate() {
+    let mut clarabel_tries = 0;
+    for &(solver, formulation, lift_forces, factor) in &attempts {
         if models[slot(formulation)].is_none() {
             models[slot(formulation)] = Some(force_model(
                 mesh,
@@ -271,7 +280,7 @@ pub fn analyse_near(
         }
         let (_, s, balance) = models[slot(formulation)].as_ref().expect("built above");
         let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
-        let out = qp::solve(&qp::QpInput {
+        let input = qp::QpInput {
             s,
             edges: &edges,
             length: &plan.length,
@@ -286,31 +295,42 @@ pub fn analyse_near(
             regularisation,
             prior: prior_frame.as_deref(),
             lift_forces,
-        });
-        let status = StressStatus::from_clarabel(out.status);
+        };
+        let out = match solver {
+            Native => qp::solve_native(&input),
+            Clarabel => {
+                clarabel_tries += 1;
+                qp::solve_clarabel(&input)
+            }
+        };
+        let status = out.status;
         if best
             .as_ref()
-            .is_none_or(|b| status.rank() < b.status().rank())
+            .is_none_or(|b| status.rank() < b.out.status.rank())
         {
             best = Some(Attempt {
+                solver,
                 formulation,
                 lifted: lift_forces,
                 out,
                 regularisation,
             });
         }
-        // Solved or infeasible: done. Reduced accuracy: one more try with the other form of the
-        // same problem, then keep the better. Numerical failure: go down the list.
-        let done = match status {
-            StressStatus::Solved | StressStatus::Infeasible => true,
-            StressStatus::AlmostSolved | StressStatus::MaxIterations => k >= 1,
-            StressStatus::NumericalError => false,
+        // Native: only a converged answer stands. Clarabel solved or infeasible: done.
+        // Reduced accuracy: one more try with the other form of the same problem, then keep
+        // the better. Numerical failure: go down the list.
+        let done = match (solver, status) {
+            (Native, s) => s == StressStatus::Solved,
+            (_, StressStatus::Solved | StressStatus::Infeasible) => true,
+            (_, StressStatus::AlmostSolved | StressStatus::MaxIterations) => clarabel_tries >= 2,
+            (_, StressStatus::NumericalError) => false,
         };
         if done {
             break;
         }
     }
     let Attempt {
+        solver,
         formulation: formulation_used,
         lifted,
         out,
@@ -319,7 +339,7 @@ pub fn analyse_near(
     let (airy_op, s, _) = models[slot(formulation_used)]
         .take()
         .expect("model of the attempt");
-    let status = StressStatus::from_clarabel(out.status);
+    let status = out.status;
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
     let y = if usable { out.y } else { vec![0.0; s.ncols] };
     let q_frame = s.mul(&y);
@@ -410,6 +430,7 @@ pub fn analyse_near(
         objective,
         force_diagram,
         iterations: out.iterations,
+        solver,
         formulation: formulation_used,
         lifted,
         regularisation,
@@ -452,16 +473,11 @@ impl StressResult {
 
 /// One solve of the stress QP: the formulation, the outcome and ε.
 struct Attempt {
+    solver: QpSolver,
     formulation: Formulation,
     lifted: bool,
     out: qp::QpOutput,
     regularisation: f64,
-}
-
-impl Attempt {
-    fn status(&self) -> StressStatus {
-        StressStatus::from_clarabel(self.out.status)
-    }
 }
 
 /// The force map q = S y of a formulation and the vertices that need explicit horizontal

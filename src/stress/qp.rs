@@ -7,12 +7,12 @@
 //!               H S y − τ ν = −P          (horizontal balance rows)
 //!               lower ≤ S y ≤ upper on active edges,  τ ≥ 0
 
+use super::ipm;
 use super::sparse::Csr;
+use super::StressStatus;
 
 use clarabel::algebra::CscMatrix;
-use clarabel::solver::{
-    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
-};
+use clarabel::solver::{DefaultSettingsBuilder, DefaultSolver, IPSolver, SupportedConeT};
 
 /// Everything the QP needs, in frame (nondimensional) units.
 pub struct QpInput<'a> {
@@ -49,7 +49,7 @@ pub struct QpOutput {
     pub y: Vec<f64>,
     /// Optimised τ per vertex (0 where none).
     pub tau: Vec<f64>,
-    pub status: SolverStatus,
+    pub status: StressStatus,
     pub iterations: u32,
 }
 
@@ -69,7 +69,8 @@ impl Triplets {
     }
 }
 
-pub fn solve(inp: &QpInput) -> QpOutput {
+/// The reference path: clarabel on the (optionally lifted) QP.
+pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     let n_y = inp.s.ncols;
     let n_vertices = inp.u.len();
     // `force` maps the QP variables to q: S itself, or a selection of lifted q variables.
@@ -245,7 +246,7 @@ pub fn solve(inp: &QpInput) -> QpOutput {
             return QpOutput {
                 y: vec![0.0; n_y],
                 tau: vec![0.0; n_vertices],
-                status: SolverStatus::NumericalError,
+                status: StressStatus::NumericalError,
                 iterations: 0,
             }
         }
@@ -256,7 +257,137 @@ pub fn solve(inp: &QpInput) -> QpOutput {
     QpOutput {
         y: x[..n_y].to_vec(),
         tau,
-        status: solver.solution.status,
+        status: StressStatus::from_clarabel(solver.solution.status),
         iterations: solver.solution.iterations,
+    }
+}
+
+/// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
+/// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
+/// matrix lives in y space. `lift_forces` does not apply.
+pub fn solve_native(inp: &QpInput) -> QpOutput {
+    let n_y = inp.s.ncols;
+    let n_vertices = inp.u.len();
+    let mut tau_col = vec![None; n_vertices];
+    let mut n = n_y;
+    for (v, nrm) in inp.tau_normal.iter().enumerate() {
+        if nrm.is_some() {
+            tau_col[v] = Some(n);
+            n += 1;
+        }
+    }
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
+    for (e, ev) in inp.edges.iter().enumerate() {
+        if inp.bounds[e].is_some() {
+            incident[ev[0] as usize].push(e);
+            incident[ev[1] as usize].push(e);
+        }
+    }
+    let other = |e: usize, v: usize| {
+        let ev = inp.edges[e];
+        if ev[0] as usize == v {
+            ev[1] as usize
+        } else {
+            ev[0] as usize
+        }
+    };
+    // ‖B y − p‖² with B = G S (one row per residual vertex) and ε Σ l² (S_e y − q̂_e)².
+    let mut quad = Csr::new(n);
+    let mut weight = Vec::new();
+    let mut c = vec![0.0; n];
+    let mut constant = 0.0;
+    for &i in inp.residual_vertices {
+        let i = i as usize;
+        let mut row = Vec::new();
+        for &e in &incident[i] {
+            let dz = inp.z[i] - inp.z[other(e, i)];
+            row.extend(inp.s.row(e).map(|(col, v)| (col, dz * v)));
+        }
+        quad.push_row(row);
+        weight.push(2.0);
+        let p = inp.load[i];
+        let r = quad.nrows() - 1;
+        for (col, v) in quad.row(r) {
+            c[col] -= 2.0 * p * v;
+        }
+        constant += p * p;
+    }
+    if inp.regularisation > 0.0 {
+        for (e, bound) in inp.bounds.iter().enumerate() {
+            if bound.is_none() {
+                continue;
+            }
+            let w = inp.regularisation * inp.length[e] * inp.length[e];
+            quad.push_row(inp.s.row(e).collect());
+            weight.push(2.0 * w);
+            if let Some(prior) = inp.prior {
+                for (col, v) in inp.s.row(e) {
+                    c[col] -= 2.0 * w * prior[e] * v;
+                }
+                constant += w * prior[e] * prior[e];
+            }
+        }
+    }
+    // Horizontal balance rows: Σ_e (u_i − u_j) S_e y − τ_i ν_i = −P_i.
+    let mut eq = Csr::new(n);
+    let mut f = Vec::new();
+    for &i in inp.balance_vertices {
+        let i = i as usize;
+        for d in 0..2 {
+            let mut row = Vec::new();
+            for &e in &incident[i] {
+                let du = inp.u[i][d] - inp.u[other(e, i)][d];
+                row.extend(inp.s.row(e).map(|(col, v)| (col, du * v)));
+            }
+            if let (Some(col), Some(nrm)) = (tau_col[i], inp.tau_normal[i]) {
+                row.push((col, -nrm[d]));
+            }
+            eq.push_row(row);
+            f.push(-inp.external[i][d]);
+        }
+    }
+    // S_e y ≥ lower, −S_e y ≥ −upper, τ ≥ 0.
+    let mut ineq = Csr::new(n);
+    let mut h = Vec::new();
+    for (e, bound) in inp.bounds.iter().enumerate() {
+        if let Some((lower, upper)) = bound {
+            ineq.push_row(inp.s.row(e).collect());
+            h.push(*lower);
+            if upper.is_finite() {
+                ineq.push_row(inp.s.row(e).map(|(col, v)| (col, -v)).collect());
+                h.push(-upper);
+            }
+        }
+    }
+    for col in tau_col.iter().flatten() {
+        ineq.push_row(vec![(*col, 1.0)]);
+        h.push(0.0);
+    }
+    let out = ipm::solve(
+        &ipm::Qp {
+            quad: &quad,
+            quad_weight: &weight,
+            c: &c,
+            constant,
+            eq: &eq,
+            f: &f,
+            ineq: &ineq,
+            h: &h,
+        },
+        &ipm::Tolerances::default(),
+    );
+    let tau = tau_col
+        .iter()
+        .map(|col| col.map_or(0.0, |col| out.x[col]))
+        .collect();
+    QpOutput {
+        y: out.x[..n_y].to_vec(),
+        tau,
+        status: match out.status {
+            ipm::IpmStatus::Solved => StressStatus::Solved,
+            ipm::IpmStatus::MaxIterations => StressStatus::MaxIterations,
+            ipm::IpmStatus::NumericalError => StressStatus::NumericalError,
+        },
+        iterations: out.iterations,
     }
 }

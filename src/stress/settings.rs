@@ -61,6 +61,17 @@ pub enum Formulation {
     EdgeBased,
 }
 
+/// Which solver minimises the stress QP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum QpSolver {
+    /// The structured interior-point method (sparse LDLᵀ of the two-ring Newton matrix, one
+    /// symbolic analysis); when it does not converge the step falls back to clarabel.
+    #[default]
+    Native,
+    /// clarabel's generic conic interior-point method only: the reference.
+    Clarabel,
+}
+
 /// Settings of one stress step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StressSettings {
@@ -81,6 +92,7 @@ pub struct StressSettings {
     /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is retried with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
+    pub solver: QpSolver,
 }
 
 impl Default for StressSettings {
@@ -95,6 +107,7 @@ impl Default for StressSettings {
             formulation: Formulation::Reduced,
             dual_length_bounds: None,
             regularisation: 1e-10,
+            solver: QpSolver::Native,
         }
     }
 }
