@@ -197,6 +197,32 @@ typedef uint32_t VsrStressStatus;
 #endif // __cplusplus
 
 /**
+ * Solver of the stress QP (`vsr_settings_set_qp_solver`, `vsr_result_qp_solver`).
+ */
+enum VsrQpSolver
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Default: the structured interior-point method; falls back to clarabel when it does not
+   * converge.
+   */
+  VSR_QP_SOLVER_NATIVE = 0,
+  /**
+   * clarabel's generic conic solver only: the reference.
+   */
+  VSR_QP_SOLVER_CLARABEL = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VsrQpSolver VsrQpSolver;
+#else
+typedef uint32_t VsrQpSolver;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Why form finding stopped (`vsr_result_termination`).
  */
 enum VsrTermination
@@ -767,6 +793,15 @@ VsrStatus vsr_result_stress_summary(const struct VsrResult *result, VsrStressSta
 VsrStatus vsr_result_regularisation(const struct VsrResult *result, double *out);
 
 /**
+ * The solver that produced the (last) stress step's forces: `VSR_QP_SOLVER_CLARABEL` when
+ * the native one was asked for but did not converge. Written only on success.
+ *
+ * # Safety
+ * `result`: a valid handle; `out` writable.
+ */
+VsrStatus vsr_result_qp_solver(const struct VsrResult *result, VsrQpSolver *out);
+
+/**
  * Why form finding stopped (a `VsrTermination`) and how many iterations (stress steps) it
  * ran. Both pointers required; written only on success. For an analysis result:
  * `VSR_STATUS_NOT_AVAILABLE`.
@@ -833,6 +868,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | hole mode | `VSR_HOLE_MODE_CONSTANT` |
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
+ * | QP solver | `VSR_QP_SOLVER_NATIVE` |
  * | regularisation ε | 1e-10 |
  * | dual edge length bounds | none |
  * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
@@ -949,6 +985,16 @@ VsrStatus vsr_settings_set_load_rule(struct VsrSettings *settings, uint32_t rule
  * `settings`: a valid handle with exclusive access.
  */
 VsrStatus vsr_settings_set_formulation(struct VsrSettings *settings, uint32_t formulation);
+
+/**
+ * Sets the solver of the stress QP of both solves: a `VsrQpSolver`. Default
+ * `VSR_QP_SOLVER_NATIVE` (the structured interior-point method, falling back to clarabel when
+ * it does not converge); `VSR_QP_SOLVER_CLARABEL` is the reference.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_qp_solver(struct VsrSettings *settings, uint32_t solver);
 
 /**
  * Sets ε of the regulariser ε Σ (l_e q_e)² (dimensionless, in the solver's frame) that makes

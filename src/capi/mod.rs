@@ -22,8 +22,8 @@ pub use result::*;
 pub use settings::*;
 pub use solve::*;
 pub use status::{
-    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrResultKind, VsrStatus,
-    VsrStressStatus, VsrTauMode, VsrTermination,
+    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrQpSolver,
+    VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
 };
 
 use boundary::boundary;

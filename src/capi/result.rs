@@ -6,7 +6,7 @@
 //! is written only on success.
 
 use super::boundary::{boundary, copy_out, handle, out_ptr, CResult, Failure};
-use super::status::{VsrResultKind, VsrStatus, VsrStressStatus, VsrTermination};
+use super::status::{VsrQpSolver, VsrResultKind, VsrStatus, VsrStressStatus, VsrTermination};
 use crate::mesh::Mesh;
 use crate::stress::StressResult;
 use crate::{FormFindResult, Termination};
@@ -568,6 +568,26 @@ pub unsafe extern "C" fn vsr_result_regularisation(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe { scalars(result, [("out", out)], |r| Ok([r.stress().regularisation])) }
+    })
+}
+
+/// The solver that produced the (last) stress step's forces: `VSR_QP_SOLVER_CLARABEL` when
+/// the native one was asked for but did not converge. Written only on success.
+///
+/// # Safety
+/// `result`: a valid handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_qp_solver(
+    result: *const VsrResult,
+    out: *mut VsrQpSolver,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, [("out", out)], |r| {
+                Ok([VsrQpSolver::of(r.stress().solver)])
+            })
+        }
     })
 }
 

@@ -45,6 +45,7 @@ pub struct VsrSettings {
 /// | hole mode | `VSR_HOLE_MODE_CONSTANT` |
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
+/// | QP solver | `VSR_QP_SOLVER_NATIVE` |
 /// | regularisation ε | 1e-10 |
 /// | dual edge length bounds | none |
 /// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
@@ -316,6 +317,24 @@ pub unsafe extern "C" fn vsr_settings_set_formulation(
     })
 }
 
+/// Sets the solver of the stress QP of both solves: a `VsrQpSolver`. Default
+/// `VSR_QP_SOLVER_NATIVE` (the structured interior-point method, falling back to clarabel when
+/// it does not converge); `VSR_QP_SOLVER_CLARABEL` is the reference.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_qp_solver(
+    settings: *mut VsrSettings,
+    solver: u32,
+) -> VsrStatus {
+    boundary!({
+        let solver = status::qp_solver("solver", solver)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.stress.solver = solver) }
+    })
+}
+
 /// Sets ε of the regulariser ε Σ (l_e q_e)² (dimensionless, in the solver's frame) that makes
 /// the force densities unique. Finite and >= 0. Default 1e-10; the solver retries with ε × 100
 /// (twice at most) after a numerical failure and reports the ε used.
@@ -533,7 +552,7 @@ pub unsafe extern "C" fn vsr_settings_set_progress(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{EdgeScope, Formulation, HoleMode, LoadRule, TauMode};
+    use crate::{EdgeScope, Formulation, HoleMode, LoadRule, QpSolver, TauMode};
 
     /// The defaults documented on `vsr_settings_create`. When a Rust default changes, update
     /// the table there (src/capi/settings.rs) and rewrite the header with
@@ -551,6 +570,7 @@ mod tests {
         assert_eq!(f.stress.holes, HoleMode::Constant);
         assert_eq!(f.stress.load_rule, LoadRule::Barycentric);
         assert_eq!(f.stress.formulation, Formulation::Reduced);
+        assert_eq!(f.stress.solver, QpSolver::Native);
         assert_eq!(f.stress.regularisation, 1e-10);
         let s = f.schedule;
         assert_eq!(

@@ -7,7 +7,7 @@
 use super::boundary::{CResult, Failure};
 use crate::geometry::loads::LoadRule;
 use crate::stress::airy::HoleMode;
-use crate::stress::{EdgeScope, Formulation, StressStatus, TauMode};
+use crate::stress::{EdgeScope, Formulation, QpSolver, StressStatus, TauMode};
 use crate::Termination;
 
 /// Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
@@ -207,6 +207,26 @@ pub enum VsrFormulation {
     EdgeBased = 1,
 }
 
+/// Solver of the stress QP (`vsr_settings_set_qp_solver`, `vsr_result_qp_solver`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrQpSolver {
+    /// Default: the structured interior-point method; falls back to clarabel when it does not
+    /// converge.
+    Native = 0,
+    /// clarabel's generic conic solver only: the reference.
+    Clarabel = 1,
+}
+
+impl VsrQpSolver {
+    pub(crate) fn of(s: QpSolver) -> VsrQpSolver {
+        match s {
+            QpSolver::Native => VsrQpSolver::Native,
+            QpSolver::Clarabel => VsrQpSolver::Clarabel,
+        }
+    }
+}
+
 /// Units of a force-density bound (`vsr_settings_set_q_min`, `vsr_settings_set_q_max`).
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -274,6 +294,20 @@ pub(crate) fn load_rule(name: &str, v: u32) -> CResult<LoadRule> {
             v,
             "VSR_LOAD_RULE_BARYCENTRIC (0), VSR_LOAD_RULE_VORONOI (1), VSR_LOAD_RULE_PLAN_AREA (2)",
         )),
+    })
+}
+
+pub(crate) fn qp_solver(name: &str, v: u32) -> CResult<QpSolver> {
+    Ok(match v {
+        0 => QpSolver::Native,
+        1 => QpSolver::Clarabel,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_QP_SOLVER_NATIVE (0), VSR_QP_SOLVER_CLARABEL (1)",
+            ))
+        }
     })
 }
 
