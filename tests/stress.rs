@@ -207,27 +207,37 @@ fn reduced_equals_edge_based_on_every_real_model() {
 }
 
 /// Models on which the structured interior-point method does not converge yet (it reports
-/// failure and clarabel answers): the reduced QP with free holes.
-const NATIVE_FALLS_BACK: [&str; 2] = ["cheese", "four_holes"];
+/// failure and clarabel answers): four_holes' reduced QP (free holes of 4–6 vertices).
+const NATIVE_FALLS_BACK: [&str; 1] = ["four_holes"];
 
 /// The structured interior-point solver reaches the optimum of clarabel (the reference) on
-/// every real model, in both formulations, and answers itself except where it is known to
-/// fall back.
+/// every real model, in both formulations, with plain compression and with the form-finding
+/// bound q_min, and answers itself except where it is known to fall back.
 #[test]
 fn native_solver_equals_clarabel_on_every_real_model() {
+    let plain = StressSettings::default();
+    let q_min = StressSettings {
+        q_min: QBound::Relative(0.05),
+        q_min_scope: EdgeScope::All,
+        ..Default::default()
+    };
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
         let problem = Problem::new(mesh);
-        for formulation in [Formulation::Reduced, Formulation::EdgeBased] {
+        for (formulation, base) in [
+            (Formulation::Reduced, &plain),
+            (Formulation::EdgeBased, &plain),
+            (Formulation::Reduced, &q_min),
+        ] {
             let with = |solver| StressSettings {
                 solver,
                 formulation,
-                ..Default::default()
+                ..base.clone()
             };
             let native = analyse(&problem, &with(QpSolver::Native)).unwrap();
             let reference = analyse(&problem, &with(QpSolver::Clarabel)).unwrap();
             assert_eq!(reference.solver, QpSolver::Clarabel);
-            let label = format!("{name} {formulation:?}");
+            let label = format!("{name} {formulation:?} q_min {:?}", base.q_min);
             if formulation == Formulation::EdgeBased || !NATIVE_FALLS_BACK.contains(&name) {
                 assert_eq!(native.solver, QpSolver::Native, "{label}: fell back");
                 assert_eq!(native.formulation, formulation, "{label}");
