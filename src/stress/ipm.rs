@@ -45,6 +45,9 @@ pub struct Qp<'a> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum IpmStatus {
     Solved,
+    /// The method stopped (iteration limit or numerical trouble) at a point that meets the
+    /// tolerances relaxed by `Tolerances::almost`.
+    AlmostSolved,
     MaxIterations,
     /// Factorisation failed or the iterates diverged (typically an infeasible or degenerate
     /// problem).
@@ -64,6 +67,8 @@ pub struct Tolerances {
     pub gap_abs: f64,
     pub gap_rel: f64,
     pub feas: f64,
+    /// Factor by which all tolerances are relaxed for `AlmostSolved`.
+    pub almost: f64,
     pub max_iter: u32,
 }
 
@@ -75,7 +80,10 @@ impl Default for Tolerances {
             gap_abs: 1e-12,
             gap_rel: 1e-11,
             feas: 1e-10,
-            max_iter: 100,
+            almost: 10.0,
+            // Well-posed problems converge in 15–60 iterations; beyond, the caller's fallback
+            // is cheaper than crawling on.
+            max_iter: 80,
         }
     }
 }
@@ -461,10 +469,19 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     let n = qp.c.len();
     let m_eq = qp.eq.nrows();
     let m = qp.ineq.nrows();
-    let fail = |x: Vec<f64>, iterations| IpmOutput {
-        x,
-        status: IpmStatus::NumericalError,
-        iterations,
+    // The last iterate that met the relaxed tolerances, returned if the method stops early.
+    let mut almost: Option<Vec<f64>> = None;
+    let fail = |x: Vec<f64>, iterations, almost: Option<Vec<f64>>| match almost {
+        Some(x) => IpmOutput {
+            x,
+            status: IpmStatus::AlmostSolved,
+            iterations,
+        },
+        None => IpmOutput {
+            x,
+            status: IpmStatus::NumericalError,
+            iterations,
+        },
     };
     // C = [E; G]: equality rows are constraints whose slack is pinned to zero.
     let mut cons = qp.eq.clone();
@@ -472,7 +489,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         cons.push_row(qp.ineq.row(r).collect());
     }
     let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, m_eq) else {
-        return fail(vec![0.0; n], 0);
+        return fail(vec![0.0; n], 0, None);
     };
     let with_eq_zeros = |d: &[f64]| -> Vec<f64> {
         let mut out = vec![0.0; m_eq];
@@ -489,7 +506,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         Newton::new(&normal, &cons, with_eq_zeros(&vec![1.0; m]), reg)?.solve(&minus_c, &rhs, 1e-8)
     });
     let Some([mut x, mut w]) = start else {
-        return fail(vec![0.0; n], 0);
+        return fail(vec![0.0; n], 0, None);
     };
     let s_hat = w.split_off(m_eq);
     let mut lambda: Vec<f64> = w.iter().map(|v| -v).collect();
@@ -525,7 +542,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         let gap = dot(&s, &z);
         let objective = 0.5 * dot(&x, &px) + dot(qp.c, &x) + qp.constant;
         if !objective.is_finite() || inf_norm(&x) > 1e15 {
-            return fail(x, iteration);
+            return fail(x, iteration, almost);
         }
         // Residuals are measured against the size of the terms that make them up (a backward
         // error): at the optimum E x ≈ f is often 0 while its terms are not.
@@ -536,11 +553,16 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
                 .max(inf_norm(&et_l));
         let eq_scale = 1.0 + f_norm.max(abs_row_norm(qp.eq, &x));
         let ineq_scale = 1.0 + h_norm.max(abs_row_norm(qp.ineq, &x));
-        let converged = inf_norm(&r_d) <= tol.feas * dual_scale
-            && inf_norm(&r_e) <= tol.feas * eq_scale
-            && inf_norm(&r_i) <= tol.feas * ineq_scale
-            && gap <= tol.gap_abs + tol.gap_rel * objective.abs();
-        if converged {
+        let within = |k: f64| {
+            inf_norm(&r_d) <= k * tol.feas * dual_scale
+                && inf_norm(&r_e) <= k * tol.feas * eq_scale
+                && inf_norm(&r_i) <= k * tol.feas * ineq_scale
+                && gap <= k * (tol.gap_abs + tol.gap_rel * objective.abs())
+        };
+        if within(tol.almost) {
+            almost = Some(x.clone());
+        }
+        if within(1.0) {
             return IpmOutput {
                 x,
                 status: IpmStatus::Solved,
@@ -602,11 +624,11 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
             direction(&mut newton, &r_c, precision)
         };
         let Some((dx, dl, ds, dz)) = REGULARISATION.iter().find_map(|&reg| step(reg)) else {
-            return fail(x, iteration);
+            return fail(x, iteration, almost);
         };
         let alpha = (0.99 * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
         if alpha.is_nan() || alpha <= 0.0 {
-            return fail(x, iteration);
+            return fail(x, iteration, almost);
         }
         x.iter_mut().zip(&dx).for_each(|(a, d)| *a += alpha * d);
         lambda
@@ -616,10 +638,17 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         s.iter_mut().zip(&ds).for_each(|(a, d)| *a += alpha * d);
         z.iter_mut().zip(&dz).for_each(|(a, d)| *a += alpha * d);
     }
-    IpmOutput {
-        x,
-        status: IpmStatus::MaxIterations,
-        iterations: tol.max_iter,
+    match almost {
+        Some(x) => IpmOutput {
+            x,
+            status: IpmStatus::AlmostSolved,
+            iterations: tol.max_iter,
+        },
+        None => IpmOutput {
+            x,
+            status: IpmStatus::MaxIterations,
+            iterations: tol.max_iter,
+        },
     }
 }
 

@@ -316,7 +316,8 @@ pub fn analyse_near(
                 regularisation,
             });
         }
-        // Native: only a converged answer stands. Clarabel solved or infeasible: done.
+        // Native: only a converged answer stands (at reduced accuracy it can sit at a point
+        // that is not optimal: four_holes). Clarabel solved or infeasible: done.
         // Reduced accuracy: one more try with the other form of the same problem, then keep
         // the better. Numerical failure: go down the list.
         let done = match (solver, status) {

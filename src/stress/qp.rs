@@ -385,6 +385,7 @@ pub fn solve_native(inp: &QpInput) -> QpOutput {
         tau,
         status: match out.status {
             ipm::IpmStatus::Solved => StressStatus::Solved,
+            ipm::IpmStatus::AlmostSolved => StressStatus::AlmostSolved,
             ipm::IpmStatus::MaxIterations => StressStatus::MaxIterations,
             ipm::IpmStatus::NumericalError => StressStatus::NumericalError,
         },
