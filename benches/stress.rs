@@ -1,69 +1,19 @@
-//! Stress step, reduced (de Goes et al.) and edge-based (VHWP12) side by side, on the shared
-//! real models and generated domes with a hole. Prints a table; asserts nothing.
+//! The paper's timing table (de Goes et al. 2013, Figure 7.7) with our figures beside it, then
+//! scaling to 100k vertices. Prints tables; asserts nothing.
 //!
-//!     cargo bench --bench stress              # models + generated domes of ~1.6k and ~6k vertices
-//!     cargo bench --bench stress -- --large   # also ~20k and ~50k vertices (slow)
+//!     cargo bench --bench stress              # the paper's rows + scaling to 50k vertices
+//!     cargo bench --bench stress -- --large   # also 100k vertices and its whole form finding
 //!
-//! A second table gives the whole form-finding loop with default settings per model.
+//! Every stress step is timed four ways: reduced (de Goes) and edge-based (VHWP12) unknowns,
+//! each with the native structured interior-point solver and with clarabel (the reference).
+//! Rows without a shared model use generated stand-ins of the paper's size and kind.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use voussoir::generate::{self, Domain};
 use voussoir::{
-    analyse, form_find, FormFindSettings, Formulation, HoleMode, Mesh, Problem, StressSettings,
+    analyse, form_find, FormFindSettings, Formulation, Mesh, Problem, QpSolver, StressSettings,
 };
-
-fn generated(n: usize) -> Mesh {
-    let domain = Domain {
-        outer: generate::circle([0.0, 0.0], 1.0, ((n as f64).sqrt() * 3.5) as usize),
-        holes: vec![generate::circle(
-            [0.35, 0.1],
-            0.2,
-            ((n as f64).sqrt() * 0.8) as usize,
-        )],
-    };
-    let area = 0.95 * std::f64::consts::PI / (2.0 * n as f64);
-    let (p, t) = generate::triangulate(&domain, area).expect("domain");
-    generate::lift(
-        &p,
-        &t,
-        |u| generate::spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
-        |_, outer| outer,
-    )
-    .expect("dome")
-}
-
-const MODELS: [&str; 9] = [
-    "free_vault",
-    "dome_with_doors",
-    "lilium",
-    "cheese",
-    "four_holes",
-    "neumunster",
-    "hex",
-    "three_pillar",
-    "vault_pq",
-];
-
-fn shared_model(dir: &std::path::Path, name: &str) -> Mesh {
-    voussoir::io::load_model(
-        &dir.join(format!("{name}.obj")),
-        &dir.join(format!("{name}.json")),
-    )
-    .expect("shared model")
-}
-
-/// The paper's timing table (de Goes et al. 2013, 2.2 GHz laptop): (VHWP12 s, de Goes s) for
-/// the rows that are shared models.
-fn paper(name: &str) -> Option<(f64, f64)> {
-    match name {
-        "free_vault" => Some((0.387, 0.18)),
-        "dome_with_doors" => Some((0.877, 0.368)),
-        "lilium" => Some((4.136, 0.887)),
-        "cheese" => Some((13.078, 9.8)),
-        _ => None,
-    }
-}
 
 /// Peak resident memory of this process so far, in MiB.
 fn peak_rss_mib() -> f64 {
@@ -73,83 +23,326 @@ fn peak_rss_mib() -> f64 {
     usage.ru_maxrss as f64 / 1024.0
 }
 
-fn row(name: &str, mesh: Mesh) {
-    let (v, e, f) = (mesh.positions.len(), mesh.edges.len(), mesh.faces.len());
-    let problem = Problem::new(mesh);
-    let mut cells = Vec::new();
-    for formulation in [Formulation::Reduced, Formulation::EdgeBased] {
-        let settings = StressSettings {
-            formulation,
-            holes: HoleMode::Affine,
-            ..Default::default()
-        };
-        let t = Instant::now();
-        let r = analyse(&problem, &settings).expect("valid problem");
-        cells.push((
-            t.elapsed().as_secs_f64(),
-            r.iterations,
-            r.eps_inf,
-            format!("{:?}", r.status),
-        ));
+/// Target triangle area for about `n` vertices on a domain of plan area `area`.
+fn max_area(area: f64, n: usize) -> f64 {
+    1.6 * area / (2.0 * n as f64)
+}
+
+/// A spherical dome over the unit disk with an off-centre free hole; rim anchored.
+fn dome_with_hole(n: usize) -> Mesh {
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, ((n as f64).sqrt() * 3.5) as usize),
+        holes: vec![generate::circle(
+            [0.35, 0.1],
+            0.2,
+            ((n as f64).sqrt() * 0.8) as usize,
+        )],
+    };
+    let area = std::f64::consts::PI * (1.0 - 0.04);
+    let (p, t) = generate::triangulate(&domain, max_area(area, n)).expect("domain");
+    generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .expect("dome")
+}
+
+/// A barrel vault over 2 × 3 whose crown is shifted off the centre line, anchored along its
+/// long sides, gables free.
+fn shifted_barrel_vault(n: usize) -> Mesh {
+    let k = ((n as f64) / 6.0).sqrt();
+    let domain = Domain {
+        outer: generate::rectangle(-1.0, -1.5, 1.0, 1.5, (2.0 * k) as usize, (3.0 * k) as usize),
+        holes: vec![],
+    };
+    let (p, t) = generate::triangulate(&domain, max_area(6.0, n)).expect("domain");
+    generate::lift(
+        &p,
+        &t,
+        |u| (1.3f64 * 1.3 - (u[0] - 0.2).powi(2)).sqrt() - 0.5,
+        |u, _| (u[0].abs() - 1.0).abs() < 1e-9,
+    )
+    .expect("barrel vault")
+}
+
+/// A groin vault: two crossing barrels over the square [−1, 1]², the lower of the two at each
+/// point; boundary anchored.
+fn groin_vault(n: usize) -> Mesh {
+    let k = (n as f64).sqrt();
+    let domain = Domain {
+        outer: generate::rectangle(-1.0, -1.0, 1.0, 1.0, k as usize, k as usize),
+        holes: vec![],
+    };
+    let (p, t) = generate::triangulate(&domain, max_area(4.0, n)).expect("domain");
+    let barrel = |s: f64| (1.2f64 * 1.2 - s * s).sqrt() - (1.2f64 * 1.2 - 1.0).sqrt();
+    generate::lift(&p, &t, |u| barrel(u[0]).min(barrel(u[1])), |_, outer| outer)
+        .expect("groin vault")
+}
+
+/// A 40° cap dome whose faces within half the radius carry five times the load.
+fn variable_load_dome(n: usize) -> Problem {
+    let domain = Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, ((n as f64).sqrt() * 3.5) as usize),
+        holes: vec![],
+    };
+    let (p, t) = generate::triangulate(&domain, max_area(std::f64::consts::PI, n)).expect("domain");
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 0.7, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+    .expect("dome");
+    let mut problem = Problem::new(mesh);
+    for (f, face) in problem.mesh.faces.iter().enumerate() {
+        let c = face.iter().fold([0.0, 0.0], |c, &v| {
+            let p = problem.mesh.positions[v as usize];
+            [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
+        });
+        if c[0].hypot(c[1]) < 0.5 {
+            problem.face_density[f] = 5.0;
+        }
     }
-    let (red, edge) = (&cells[0], &cells[1]);
-    let paper = paper(name).map_or("—".to_string(), |(vh, dg)| format!("{dg} / {vh}"));
+    problem
+}
+
+fn shared_model(dir: &Path, name: &str) -> Option<Problem> {
+    let mesh = voussoir::io::load_model(
+        &dir.join(format!("{name}.obj")),
+        &dir.join(format!("{name}.json")),
+    )
+    .ok()?;
+    Some(Problem::new(mesh))
+}
+
+/// One stress step: seconds, QP iterations, and the solver that answered.
+fn step(problem: &Problem, formulation: Formulation, solver: QpSolver) -> (f64, u32, QpSolver) {
+    let settings = StressSettings {
+        formulation,
+        solver,
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let r = analyse(problem, &settings).expect("valid problem");
+    (t.elapsed().as_secs_f64(), r.iterations, r.solver)
+}
+
+fn cell((s, it, solver): (f64, u32, QpSolver), native: bool) -> String {
+    // A native step that fell back to clarabel is marked with *.
+    let mark = if native && solver != QpSolver::Native {
+        "*"
+    } else {
+        ""
+    };
+    format!("{s:.3}{mark} ({it})")
+}
+
+/// A row of the paper's table: (name, V;E;F, VHWP12 s, de Goes s).
+struct PaperRow {
+    name: &'static str,
+    size: &'static str,
+    vhwp12: f64,
+    de_goes: f64,
+}
+
+const PAPER: [PaperRow; 11] = [
+    PaperRow {
+        name: "Cheese-model",
+        size: "2348;6218;3832",
+        vhwp12: 13.078,
+        de_goes: 9.8,
+    },
+    PaperRow {
+        name: "Free vault",
+        size: "360;1000;640",
+        vhwp12: 0.387,
+        de_goes: 0.18,
+    },
+    PaperRow {
+        name: "Dome with doors",
+        size: "577;1600;1024",
+        vhwp12: 0.877,
+        de_goes: 0.368,
+    },
+    PaperRow {
+        name: "Video-surface",
+        size: "1131;3194;2064",
+        vhwp12: 3.55,
+        de_goes: 0.98,
+    },
+    PaperRow {
+        name: "Cas-model",
+        size: "5951;17472;11520",
+        vhwp12: 90.1,
+        de_goes: 18.0,
+    },
+    PaperRow {
+        name: "Lilium",
+        size: "1201;3504;2304",
+        vhwp12: 4.136,
+        de_goes: 0.887,
+    },
+    PaperRow {
+        name: "Variable load",
+        size: "1156;3368;2213",
+        vhwp12: 3.65,
+        de_goes: 0.77,
+    },
+    PaperRow {
+        name: "Shifted barrel vault",
+        size: "310;836;527",
+        vhwp12: 0.24,
+        de_goes: 0.15,
+    },
+    PaperRow {
+        name: "Moebius igloo",
+        size: "702;2006;1304",
+        vhwp12: 1.3,
+        de_goes: 0.4,
+    },
+    PaperRow {
+        name: "Dome with hole",
+        size: "1656;4842;3186",
+        vhwp12: 7.7,
+        de_goes: 1.5,
+    },
+    PaperRow {
+        name: "Groin vault",
+        size: "2943;8569;5627",
+        vhwp12: 23.6,
+        de_goes: 4.1,
+    },
+];
+
+/// Our model for a paper row: the shared model where there is one, else a generated stand-in
+/// ("gen."), else none (no model of that kind).
+fn model_for(row: &PaperRow, dir: Option<&Path>) -> Option<(String, Problem)> {
+    let shared = |name: &str| dir.and_then(|d| shared_model(d, name));
+    let generated = |p: Problem| Some(("gen.".to_string(), p));
+    match row.name {
+        "Cheese-model" => shared("cheese").map(|p| ("cheese".to_string(), p)),
+        "Free vault" => shared("free_vault").map(|p| ("free_vault".to_string(), p)),
+        "Dome with doors" => shared("dome_with_doors").map(|p| ("dome_with_doors".to_string(), p)),
+        "Lilium" => shared("lilium").map(|p| ("lilium".to_string(), p)),
+        "Cas-model" => generated(Problem::new(dome_with_hole(5951))),
+        "Variable load" => generated(variable_load_dome(1156)),
+        "Shifted barrel vault" => generated(Problem::new(shifted_barrel_vault(310))),
+        "Dome with hole" => generated(Problem::new(dome_with_hole(1656))),
+        "Groin vault" => generated(Problem::new(groin_vault(2943))),
+        _ => None,
+    }
+}
+
+fn paper_table(dir: Option<&Path>) {
     println!(
-        "| {name:<16} | {v:>6} | {e:>6} | {f:>6} | {:>8.3} ({:>2} it) | {:>8.3} ({:>2} it) | {:>5.2} | {paper:>14} | {:>9.3e} | {} / {} |",
-        red.0,
-        red.1,
-        edge.0,
-        edge.1,
-        edge.0 / red.0,
-        red.2,
-        red.3,
-        edge.3
+        "Stress step (seconds, QP iterations in brackets; * = native solver fell back to clarabel)"
+    );
+    println!();
+    println!("| paper row | V;E;F (paper) | ours | V;E;F (ours) | reduced native | reduced clarabel | edge native | edge clarabel | edge/reduced native | edge/reduced clarabel | paper dG / VHWP12 | × faster than paper dG | form finding its, s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for row in &PAPER {
+        let Some((ours, problem)) = model_for(row, dir) else {
+            println!(
+                "| {} | {} | — (no model of this kind) | | | | | | | | {} / {} | | |",
+                row.name, row.size, row.de_goes, row.vhwp12
+            );
+            continue;
+        };
+        let m = &problem.mesh;
+        let size = format!("{};{};{}", m.positions.len(), m.edges.len(), m.faces.len());
+        let rn = step(&problem, Formulation::Reduced, QpSolver::Native);
+        let rc = step(&problem, Formulation::Reduced, QpSolver::Clarabel);
+        let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
+        let ec = step(&problem, Formulation::EdgeBased, QpSolver::Clarabel);
+        let t = Instant::now();
+        let ff = form_find(&problem, &FormFindSettings::default(), None).expect("valid problem");
+        let ff_s = t.elapsed().as_secs_f64();
+        println!(
+            "| {} | {} | {ours} | {size} | {} | {} | {} | {} | {:.1} | {:.1} | {} / {} | {:.0} | {} ({:?}), {ff_s:.2} |",
+            row.name,
+            row.size,
+            cell(rn, true),
+            cell(rc, false),
+            cell(en, true),
+            cell(ec, false),
+            en.0 / rn.0,
+            ec.0 / rc.0,
+            row.de_goes,
+            row.vhwp12,
+            row.de_goes / rn.0,
+            ff.iterations,
+            ff.termination,
+        );
+    }
+}
+
+/// Least-squares slope of log(t) against log(n).
+fn exponent(points: &[(f64, f64)]) -> f64 {
+    let k = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (n, t)| (a + n.ln(), b + t.ln()));
+    let (mx, my) = (sx / k, sy / k);
+    let (num, den) = points.iter().fold((0.0, 0.0), |(a, b), (n, t)| {
+        (a + (n.ln() - mx) * (t.ln() - my), b + (n.ln() - mx).powi(2))
+    });
+    num / den
+}
+
+fn scaling(large: bool) {
+    let sizes: &[usize] = if large {
+        &[10_000, 50_000, 100_000]
+    } else {
+        &[10_000, 50_000]
+    };
+    println!();
+    println!("Scaling: generated domes with a free hole, reduced unknowns, native solver");
+    println!();
+    println!("| V | E | stress step s (QP its) | solver | peak RSS after step MiB | form finding its, s |");
+    println!("|---|---|---|---|---|---|");
+    let mut points = Vec::new();
+    for &n in sizes {
+        let problem = Problem::new(dome_with_hole(n));
+        let v = problem.mesh.positions.len();
+        let (s, it, solver) = step(&problem, Formulation::Reduced, QpSolver::Native);
+        let rss = peak_rss_mib();
+        points.push((v as f64, s));
+        // The whole loop only where asked for: it dominates the run at 100k.
+        let ff = if large && n == *sizes.last().expect("sizes") {
+            let t = Instant::now();
+            let r = form_find(&problem, &FormFindSettings::default(), None).expect("valid");
+            format!(
+                "{} ({:?}), {:.1}",
+                r.iterations,
+                r.termination,
+                t.elapsed().as_secs_f64()
+            )
+        } else {
+            "—".to_string()
+        };
+        println!(
+            "| {v} | {} | {s:.2} ({it}) | {solver:?} | {rss:.0} | {ff} |",
+            problem.mesh.edges.len()
+        );
+    }
+    println!();
+    println!(
+        "fitted growth exponent of the stress step: t ∝ V^{:.2}",
+        exponent(&points)
     );
 }
 
 fn main() {
     let large = std::env::args().any(|a| a == "--large");
-    println!("| model            |      V |      E |      F | reduced s (iters) | edge-based s (iters) | ratio | paper dG / VHWP12 s | eps_inf   | status |");
-    println!("|------------------|--------|--------|--------|-------------------|----------------------|-------|---------------------|-----------|--------|");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if dir.is_dir() {
-        for name in MODELS {
-            let mesh = shared_model(&dir, name);
-            row(name, mesh);
-        }
-    } else {
-        println!("skipped: {} not found", dir.display());
+    let dir = dir.is_dir().then_some(dir);
+    if dir.is_none() {
+        println!("shared models skipped: ../shared/data/models not found (generated rows only)");
     }
-    let sizes: &[usize] = if large {
-        &[1000, 4000, 12000, 30000]
-    } else {
-        &[1000, 4000]
-    };
-    for &n in sizes {
-        let mesh = generated(n);
-        row(&format!("dome+hole {}", mesh.positions.len()), mesh);
-    }
-    println!();
-    println!("| model            |      V | form finding: termination | iterations | eps_inf   | total s | stress s | hausdorff | l2     |");
-    println!("|------------------|--------|---------------------------|------------|-----------|---------|----------|-----------|--------|");
-    if dir.is_dir() {
-        for name in MODELS {
-            let mesh = shared_model(&dir, name);
-            let v = mesh.positions.len();
-            let r = form_find(&Problem::new(mesh), &FormFindSettings::default(), None)
-                .expect("valid problem");
-            println!(
-                "| {name:<16} | {v:>6} | {:<25} | {:>10} | {:>9.2e} | {:>7.2} | {:>8.2} | {:>9.4} | {:>6.4} |",
-                format!("{:?}", r.termination).chars().take(25).collect::<String>(),
-                r.iterations,
-                r.stress.eps_inf,
-                r.total_seconds,
-                r.stress_seconds,
-                r.hausdorff,
-                r.l2
-            );
-        }
-    }
+    paper_table(dir.as_deref());
+    scaling(large);
     println!();
     println!(
         "peak resident memory of the whole run: {:.0} MiB",
