@@ -871,7 +871,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
  * | regularisation ε | 1e-10 |
  * | dual edge length bounds | none |
- * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
+ * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.2, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
@@ -1027,7 +1027,7 @@ VsrStatus vsr_settings_set_dual_length_bounds(struct VsrSettings *settings, doub
 VsrStatus vsr_settings_set_schedule_mu0(struct VsrSettings *settings, double mu0);
 
 /**
- * Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.25.
+ * Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.2.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

@@ -48,7 +48,7 @@ pub struct VsrSettings {
 /// | QP solver | `VSR_QP_SOLVER_NATIVE` |
 /// | regularisation ε | 1e-10 |
 /// | dual edge length bounds | none |
-/// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.25, 1e-9, 1e-3, 0 |
+/// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.2, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
@@ -394,7 +394,7 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_mu0(
     })
 }
 
-/// Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.25.
+/// Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.2.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -575,7 +575,7 @@ mod tests {
         let s = f.schedule;
         assert_eq!(
             [s.mu0, s.beta, s.mu_min, s.eta, s.pull],
-            [0.3, 0.25, 1e-9, 1e-3, 0.0]
+            [0.3, 0.2, 1e-9, 1e-3, 0.0]
         );
     }
 }
