@@ -2,12 +2,16 @@
 
 use std::path::PathBuf;
 
-use voussoir::{EdgeScope, FormFindSettings, Formulation, LoadRule, QBound, TauMode};
+use voussoir::{EdgeScope, FormFindSettings, Formulation, LoadRule, QBound, QpSolver, TauMode};
 
 /// The choices of the enumerated options, as spelled on the command line.
 pub const SOLVERS: [(&str, Formulation); 2] = [
     ("reduced", Formulation::Reduced),
     ("edge-based", Formulation::EdgeBased),
+];
+pub const QP_SOLVERS: [(&str, QpSolver); 2] = [
+    ("native", QpSolver::Native),
+    ("clarabel", QpSolver::Clarabel),
 ];
 pub const SCOPES: [(&str, EdgeScope); 2] =
     [("interior", EdgeScope::Interior), ("all", EdgeScope::All)];
@@ -63,6 +67,8 @@ Outputs (all written at the end of a run, or none; existing files are replaced):
 Solver:
   --stress-only          analyse the input shape only, do not move it
   --solver S             reduced | edge-based                              [{solver}]
+  --qp Q                 native | clarabel: the QP solver (native falls
+                         back to clarabel when it does not converge)       [{qp}]
   --tol T                stop when eps_inf = max|r_i| / mean load < T      [{tol:e}]
   --max-iter N           at most N stress steps                            [{max_iter}]
   --qmin X               lower bound on force densities, relative to p/L0
@@ -80,6 +86,7 @@ Exit status: 0 converged (or --stress-only solved), 3 finished without convergin
 (outputs written, the report says why), 2 bad input or options, 1 other failure.
 ",
         solver = name_of(&SOLVERS, st.formulation),
+        qp = name_of(&QP_SOLVERS, st.solver),
         tol = d.tolerance,
         max_iter = d.max_iterations,
         qmin = bound_text(Some(st.q_min)),
@@ -192,6 +199,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--pictures" => o.pictures = Some(value()?.into()),
             "--stress-only" => o.stress_only = true,
             "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
+            "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
             "--tol" => {
                 let t = number(&flag, &value()?)?;
                 if t <= 0.0 {

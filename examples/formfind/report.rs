@@ -3,7 +3,7 @@
 use serde_json::{json, Value};
 use voussoir::{QBound, StressResult, Termination};
 
-use crate::args::{name_of, Options, LOADS, SCOPES, SOLVERS, TAUS};
+use crate::args::{name_of, Options, LOADS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
 use crate::run::Outcome;
 
 /// snake_case name of an enum variant from its `Debug` text (`Stalled { .. }` → `stalled`), so
@@ -55,6 +55,7 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
         "supports": outcome.model.supports,
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),
+        "qp_solver": name_of(&QP_SOLVERS, st.solver),
         "tolerance": s.tolerance,
         "max_iterations": s.max_iterations,
         "stall_window": s.stall_window,
@@ -103,6 +104,8 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "termination": name,
         "termination_detail": detail,
         "stress_status": variant_name(&format!("{:?}", s.status)),
+        // The QP solver that answered the last stress step (clarabel after a fallback).
+        "qp_solver_used": name_of(&QP_SOLVERS, s.solver),
         "iterations": outcome.history.len(),
         "eps_inf": s.eps_inf,
         "history": outcome.history,
