@@ -2,7 +2,8 @@
 //! scaling to 100k vertices. Prints tables; asserts nothing.
 //!
 //!     cargo bench --bench stress              # the paper's rows + scaling to 50k vertices
-//!     cargo bench --bench stress -- --large   # also 100k vertices and its whole form finding
+//!     cargo bench --bench stress -- --large   # also 100k vertices
+//!     cargo bench --bench stress -- --large --large-ff   # and the whole form finding at 100k
 //!
 //! Every stress step is timed four ways: reduced (de Goes) and edge-based (VHWP12) unknowns,
 //! each with the native structured interior-point solver and with clarabel (the reference).
@@ -291,7 +292,7 @@ fn exponent(points: &[(f64, f64)]) -> f64 {
     num / den
 }
 
-fn scaling(large: bool) {
+fn scaling(large: bool, large_ff: bool) {
     let sizes: &[usize] = if large {
         &[10_000, 50_000, 100_000]
     } else {
@@ -310,7 +311,7 @@ fn scaling(large: bool) {
         let rss = peak_rss_mib();
         points.push((v as f64, s));
         // The whole loop only where asked for: it dominates the run at 100k.
-        let ff = if large && n == *sizes.last().expect("sizes") {
+        let ff = if large_ff && n == *sizes.last().expect("sizes") {
             let t = Instant::now();
             let r = form_find(&problem, &FormFindSettings::default(), None).expect("valid");
             format!(
@@ -336,13 +337,14 @@ fn scaling(large: bool) {
 
 fn main() {
     let large = std::env::args().any(|a| a == "--large");
+    let large_ff = large && std::env::args().any(|a| a == "--large-ff");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
     let dir = dir.is_dir().then_some(dir);
     if dir.is_none() {
         println!("shared models skipped: ../shared/data/models not found (generated rows only)");
     }
     paper_table(dir.as_deref());
-    scaling(large);
+    scaling(large, large_ff);
     println!();
     println!(
         "peak resident memory of the whole run: {:.0} MiB",
