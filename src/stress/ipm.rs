@@ -924,7 +924,8 @@ mod tests {
     fn bound_constrained_least_squares_finds_the_active_set() {
         let n = 400;
         let target: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 5.9).collect();
-        let quad = csr(
+        // The identity: the objective's rows and the bounds x ≥ 0.
+        let identity = csr(
             n,
             &(0..n)
                 .map(|i| vec![(i, 1.0)])
@@ -941,24 +942,15 @@ mod tests {
             .map(|i| vec![(i, 1.0), (i + 1, -1.0)])
             .collect();
         let eq = csr(n, &chain.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
-        let ineq = csr(
-            n,
-            &(0..n)
-                .map(|i| vec![(i, 1.0)])
-                .collect::<Vec<_>>()
-                .iter()
-                .map(|r| r.as_slice())
-                .collect::<Vec<_>>(),
-        );
         let out = solve(
             &Qp {
-                quad: &quad,
+                quad: &identity,
                 quad_weight: &weight,
                 c: &c,
                 constant,
                 eq: &eq,
                 f: &vec![0.0; chain.len()],
-                ineq: &ineq,
+                ineq: &identity,
                 h: &vec![0.0; n],
             },
             &Tolerances::default(),
