@@ -1018,6 +1018,19 @@ VsrStatus vsr_settings_set_regularisation(struct VsrSettings *settings, double e
 VsrStatus vsr_settings_set_dual_length_bounds(struct VsrSettings *settings, double lo, double hi);
 
 /**
+ * Sets the weight μ of the penalty μ Σ (d*_a − d*_b)² / p̄² on the variation of dual
+ * (force-diagram) edge lengths d* = q l over pairs of interior edges sharing a face: a
+ * smoother force diagram. `mu` finite and >= 0 (0, the default, turns it off). Form finding
+ * fades the weight as μ `decay`ᵏ at outer iteration k so that the loop can still converge;
+ * `decay` in [0, 1), default 0.5 (closer to 1: smoother diagram, shape further from the
+ * input, more iterations). A stress-only analysis uses μ as given.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_dual_length_smoothing(struct VsrSettings *settings, double mu, double decay);
+
+/**
  * Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
  * of the height system; dimensionless). Finite and >= 0. Default 0.3.
  *

@@ -646,6 +646,27 @@ fn settings_setters_reject_bad_values() {
     assert_ok(unsafe { vsr_settings_set_dual_length_bounds(s, 0.01, 0.5) });
     assert_ok(unsafe { vsr_settings_set_dual_length_bounds(s, 0.0, f64::INFINITY) });
     assert_failed(
+        unsafe { vsr_settings_set_dual_length_smoothing(s, -0.1, 0.5) },
+        S::InvalidArgument,
+        "mu",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_smoothing(s, f64::INFINITY, 0.5) },
+        S::NonFinite,
+        "mu",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_smoothing(s, 1.0, 1.0) },
+        S::InvalidArgument,
+        "decay",
+    );
+    assert_failed(
+        unsafe { vsr_settings_set_dual_length_smoothing(s, 1.0, f64::NAN) },
+        S::NonFinite,
+        "decay",
+    );
+    assert_ok(unsafe { vsr_settings_set_dual_length_smoothing(s, 0.0, 0.5) });
+    assert_failed(
         unsafe { vsr_settings_set_progress(null_mut(), None, null_mut()) },
         S::NullPointer,
         "settings",

@@ -283,6 +283,107 @@ fn native_solver_equals_clarabel_on_generated_meshes() {
     }
 }
 
+/// Σ (d*_a − d*_b)² over pairs of interior edges sharing a face, d* = q × plan length:
+/// recomputed here from the returned force densities.
+fn dual_variation(problem: &Problem, q: &[f64]) -> f64 {
+    let mesh = &problem.mesh;
+    let x = &mesh.positions;
+    let dual = |e: u32| {
+        let [a, b] = mesh.edges[e as usize].v.map(|v| x[v as usize]);
+        q[e as usize] * (a[0] - b[0]).hypot(a[1] - b[1])
+    };
+    let interior = |e: u32| !mesh.edges[e as usize].is_boundary();
+    let mut sum = 0.0;
+    for f in &mesh.faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            let (c, d) = (b, f[(k + 2) % 3]);
+            let (e1, e2) = (
+                mesh.edge_between(a, b).unwrap() as u32,
+                mesh.edge_between(c, d).unwrap() as u32,
+            );
+            if interior(e1) && interior(e2) {
+                sum += (dual(e1) - dual(e2)).powi(2);
+            }
+        }
+    }
+    sum
+}
+
+/// The dual-length smoothing penalty μ Σ (d*_a − d*_b)² / p̄²: every solver and formulation
+/// reaches the same optimum of ‖r‖² + μ V (recomputed here), and the optimum trades residual
+/// for a smoother force diagram.
+#[test]
+fn dual_length_smoothing_trades_residual_for_a_smoother_diagram() {
+    let mut cases = vec![(
+        "holed disk, free hole".to_string(),
+        holed_disk(3, 0.004, |_, outer| outer),
+    )];
+    if let Some(mesh) = load_model("lilium") {
+        cases.push(("lilium".to_string(), mesh));
+    }
+    let mu = 1.0;
+    for (label, mesh) in cases {
+        let problem = Problem::new(mesh);
+        // Affine hole jumps: the reduced space then holds every balanced stress of a mesh with
+        // free holes, as the edge-based one does.
+        let base = StressSettings {
+            holes: HoleMode::Affine,
+            ..Default::default()
+        };
+        let plain = analyse(&problem, &base).unwrap();
+        let smooth = |solver, formulation| {
+            let s = StressSettings {
+                dual_length_smoothing: mu,
+                solver,
+                formulation,
+                ..base.clone()
+            };
+            analyse(&problem, &s).unwrap()
+        };
+        let runs = [
+            (
+                "native reduced",
+                smooth(QpSolver::Native, Formulation::Reduced),
+            ),
+            (
+                "clarabel reduced",
+                smooth(QpSolver::Clarabel, Formulation::Reduced),
+            ),
+            (
+                "clarabel edge-based",
+                smooth(QpSolver::Clarabel, Formulation::EdgeBased),
+            ),
+        ];
+        let mesh = &problem.mesh;
+        let free: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&v| mesh.is_non_anchored(v))
+            .collect();
+        let p_bar = free.iter().map(|&v| plain.loads[v]).sum::<f64>() / free.len() as f64;
+        let total =
+            |r: &StressResult| r.objective + mu * dual_variation(&problem, &r.force_densities);
+        let reference = total(&runs[2].1);
+        for (name, r) in &runs {
+            assert!(r.status.is_solved(), "{label} {name}: {:?}", r.status);
+            let j = total(r);
+            assert!(
+                (j - reference).abs() <= 1e-6 * reference + 1e-12 * p_bar * p_bar,
+                "{label} {name}: objective {j:e} vs edge-based clarabel {reference:e}"
+            );
+        }
+        let (v0, v1) = (
+            dual_variation(&problem, &plain.force_densities),
+            dual_variation(&problem, &runs[0].1.force_densities),
+        );
+        println!(
+            "{label}: variation {v0:.3e} -> {v1:.3e}, residual {:.3e} -> {:.3e}",
+            plain.objective, runs[0].1.objective
+        );
+        assert!(v1 < 0.5 * v0, "{label}: variation {v0:e} -> {v1:e}");
+        assert!(runs[0].1.objective >= plain.objective * (1.0 - 1e-6));
+    }
+}
+
 #[test]
 fn rigid_motions_and_uniform_scaling_give_the_scaled_answer() {
     let mesh = holed_disk(7, 0.01, |u, outer| outer && u[0] < 0.5);
@@ -375,6 +476,13 @@ fn invalid_settings_are_rejected_by_name() {
                 ..Default::default()
             },
             "regularisation",
+        ),
+        (
+            StressSettings {
+                dual_length_smoothing: -1.0,
+                ..Default::default()
+            },
+            "dual_length_smoothing",
         ),
     ] {
         match analyse(&problem, &settings) {

@@ -77,6 +77,10 @@ Solver:
   --qmin-scope S         interior | all: the edges --qmin applies to       [{scope}]
   --qmax X               upper bound on force densities, as --qmin, or none [{qmax}]
   --tau M                optimize | zero: normal push at free edges        [{tau}]
+  --dual-smoothing MU    penalty MU on differences of force-diagram edge
+                         lengths at each face (a smoother force diagram)   [{smooth}]
+  --smoothing-decay D    form finding fades MU as MU D^k, 0 <= D < 1;
+                         nearer 1: smoother, further from the input        [{decay}]
   --odt N                ODT smoothing of the plan before each of the first N stress steps [0]
   --density D            weight per unit area of every face                [1]
   --load R               barycentric | voronoi | plan: face weight sharing [{load}]
@@ -93,6 +97,8 @@ Exit status: 0 converged (or --stress-only solved), 3 finished without convergin
         scope = name_of(&SCOPES, st.q_min_scope),
         qmax = bound_text(st.q_max),
         tau = name_of(&TAUS, st.tau),
+        smooth = st.dual_length_smoothing,
+        decay = d.smoothing_decay,
         load = name_of(&LOADS, st.load_rule),
     )
 }
@@ -224,6 +230,14 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 };
             }
             "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
+            "--dual-smoothing" => s.stress.dual_length_smoothing = number(&flag, &value()?)?,
+            "--smoothing-decay" => {
+                let d = number(&flag, &value()?)?;
+                if !(0.0..1.0).contains(&d) {
+                    return Err(format!("{flag}: must be in [0, 1), got {d}"));
+                }
+                s.smoothing_decay = d;
+            }
             "--odt" => {
                 let text = value()?;
                 o.odt = match text.parse::<usize>() {
@@ -265,5 +279,6 @@ fn check(o: &Options) -> Result<(), String> {
         e.to_string()
             .replace("`q_min`", "--qmin")
             .replace("`q_max`", "--qmax")
+            .replace("`dual_length_smoothing`", "--dual-smoothing")
     })
 }

@@ -66,6 +66,8 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
         "q_unit": outcome.q_unit,
         "q_unit_note": "relative bounds are multiples of q_unit = mean load / L0 (half the plan diagonal), at the final shape",
         "tau": name_of(&TAUS, st.tau),
+        "dual_length_smoothing": st.dual_length_smoothing,
+        "smoothing_decay": s.smoothing_decay,
         "holes": variant_name(&format!("{:?}", st.holes)),
         "load": name_of(&LOADS, st.load_rule),
         "density": o.density,

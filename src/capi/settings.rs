@@ -377,6 +377,37 @@ pub unsafe extern "C" fn vsr_settings_set_dual_length_bounds(
     })
 }
 
+/// Sets the weight μ of the penalty μ Σ (d*_a − d*_b)² / p̄² on the variation of dual
+/// (force-diagram) edge lengths d* = q l over pairs of interior edges sharing a face: a
+/// smoother force diagram. `mu` finite and >= 0 (0, the default, turns it off). Form finding
+/// fades the weight as μ `decay`ᵏ at outer iteration k so that the loop can still converge;
+/// `decay` in [0, 1), default 0.5 (closer to 1: smoother diagram, shape further from the
+/// input, more iterations). A stress-only analysis uses μ as given.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_dual_length_smoothing(
+    settings: *mut VsrSettings,
+    mu: f64,
+    decay: f64,
+) -> VsrStatus {
+    boundary!({
+        let mu = at_least("mu", mu, 0.0, false)?;
+        let decay = at_least("decay", decay, 0.0, false)?;
+        if decay >= 1.0 {
+            return Err(Failure::invalid("decay", format!("{decay} must be < 1")));
+        }
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            update(settings, |f| {
+                f.stress.dual_length_smoothing = mu;
+                f.smoothing_decay = decay;
+            })
+        }
+    })
+}
+
 /// Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
 /// of the height system; dimensionless). Finite and >= 0. Default 0.3.
 ///

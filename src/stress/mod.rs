@@ -230,6 +230,12 @@ pub fn analyse_near(
         })
         .collect();
 
+    let smoothing_pairs = if settings.dual_length_smoothing > 0.0 {
+        face_edge_pairs(mesh, &bounds)
+    } else {
+        Vec::new()
+    };
+
     // The native solver goes first. Interior-point methods can fail on degenerate problems
     // (straight free edges force q = 0: no strictly feasible point), and only clarabel
     // certifies infeasibility, so when it does not converge clarabel takes over: the plain
@@ -294,6 +300,8 @@ pub fn analyse_near(
             bounds: &bounds,
             regularisation,
             prior: prior_frame.as_deref(),
+            smoothing_pairs: &smoothing_pairs,
+            smoothing: settings.dual_length_smoothing,
             lift_forces,
         };
         let out = match solver {
@@ -470,6 +478,22 @@ impl StressResult {
             ..self.clone()
         }
     }
+}
+
+/// Pairs of interior edges with forces that share a face: their dual segments meet at the
+/// face's power centre.
+fn face_edge_pairs(mesh: &Mesh, bounds: &[Option<(f64, f64)>]) -> Vec<[usize; 2]> {
+    let carries = |e: u32| bounds[e as usize].is_some() && !mesh.edges[e as usize].is_boundary();
+    let mut pairs = Vec::new();
+    for fe in &mesh.face_edges {
+        for k in 0..3 {
+            let (a, b) = (fe[k], fe[(k + 1) % 3]);
+            if carries(a) && carries(b) {
+                pairs.push([a as usize, b as usize]);
+            }
+        }
+    }
+    pairs
 }
 
 /// One solve of the stress QP: the formulation, the outcome and ε.

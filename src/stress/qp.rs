@@ -2,7 +2,7 @@
 //! q = S y for their own unknowns y, and differ only in S and in which vertices need explicit
 //! horizontal balance rows.
 //!
-//!   minimise    ‖r‖² + ε Σ_e (l_e q_e)²
+//!   minimise    ‖r‖² + ε Σ_e (l_e q_e)² + μ Σ_(a,b) (l_a q_a − l_b q_b)²
 //!   subject to  r = G S y − p             (vertical residuals, lifted: keeps the KKT sparse)
 //!               H S y − τ ν = −P          (horizontal balance rows)
 //!               lower ≤ S y ≤ upper on active edges,  τ ≥ 0
@@ -38,6 +38,9 @@ pub struct QpInput<'a> {
     pub regularisation: f64,
     /// Centre q̂ of the regulariser ε Σ l_e² (q_e − q̂_e)² (per edge); None: q̂ = 0.
     pub prior: Option<&'a [f64]>,
+    /// Pairs of edges whose dual lengths l q are pulled together, and the weight μ.
+    pub smoothing_pairs: &'a [[usize; 2]],
+    pub smoothing: f64,
     /// Lift the force densities as variables (q − S y = 0, simple bounds on q). Needed when S
     /// is not a selection: bounds on combinations S y make degenerate problems (straight free
     /// edges force q = 0, so no strictly feasible point) numerically fragile.
@@ -67,6 +70,21 @@ impl Triplets {
             self.v.push(v);
         }
     }
+}
+
+/// One row l_a force_a − l_b force_b per smoothing pair (columns may repeat; they add up).
+fn smoothing_rows<'a>(
+    inp: &'a QpInput,
+    force: &'a Csr,
+) -> impl Iterator<Item = Vec<(usize, f64)>> + 'a {
+    inp.smoothing_pairs.iter().map(move |&[a, b]| {
+        let (la, lb) = (inp.length[a], inp.length[b]);
+        force
+            .row(a)
+            .map(|(c, v)| (c, la * v))
+            .chain(force.row(b).map(|(c, v)| (c, -lb * v)))
+            .collect()
+    })
 }
 
 /// The reference path: clarabel on the (optionally lifted) QP.
@@ -115,6 +133,17 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
             for (c2, v2) in force.row(e) {
                 if c1 <= c2 {
                     p.push(c1, c2, w * v1 * v2);
+                }
+            }
+        }
+    }
+    if inp.smoothing > 0.0 {
+        for row in smoothing_rows(inp, force) {
+            for &(c1, v1) in &row {
+                for &(c2, v2) in &row {
+                    if c1 <= c2 {
+                        p.push(c1, c2, 2.0 * inp.smoothing * v1 * v2);
+                    }
                 }
             }
         }
@@ -326,6 +355,12 @@ pub fn solve_native(inp: &QpInput) -> QpOutput {
                 }
                 constant += w * prior[e] * prior[e];
             }
+        }
+    }
+    if inp.smoothing > 0.0 {
+        for row in smoothing_rows(inp, inp.s) {
+            quad.push_row(row);
+            weight.push(2.0 * inp.smoothing);
         }
     }
     // Horizontal balance rows: Σ_e (u_i − u_j) S_e y − τ_i ν_i = −P_i.

@@ -88,6 +88,11 @@ pub struct StressSettings {
     /// the mean load p̄: lo ≤ q_e l_e / p̄ ≤ hi. A lower bound keeps every force-diagram edge
     /// visible, an upper bound smooths the diagram. Default none.
     pub dual_length_bounds: Option<(f64, f64)>,
+    /// Weight μ of the penalty μ Σ (d*_a − d*_b)² / p̄² on the variation of dual lengths
+    /// d* = q l over each pair of interior edges that share a face (the force-diagram edges
+    /// meeting at that face's power centre). μ > 0 trades residual in the stress step for a
+    /// smoother force diagram; form finding then shapes the vault to carry it. Default 0.
+    pub dual_length_smoothing: f64,
     /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10; when the solver
     /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is retried with ε × 100, up to twice, and the result says which ε was used.
@@ -106,6 +111,7 @@ impl Default for StressSettings {
             load_rule: LoadRule::Barycentric,
             formulation: Formulation::Reduced,
             dual_length_bounds: None,
+            dual_length_smoothing: 0.0,
             regularisation: 1e-10,
             solver: QpSolver::Native,
         }
@@ -138,6 +144,9 @@ impl StressSettings {
             if !(lo.is_finite() && lo >= 0.0 && hi > lo) {
                 return bad("dual_length_bounds", "must be finite with 0 <= lo < hi");
             }
+        }
+        if !self.dual_length_smoothing.is_finite() || self.dual_length_smoothing < 0.0 {
+            return bad("dual_length_smoothing", "must be finite and >= 0");
         }
         if !self.regularisation.is_finite() || self.regularisation < 0.0 {
             return bad("regularisation", "must be finite and >= 0");
