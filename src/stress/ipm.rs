@@ -111,6 +111,7 @@ struct Normal {
     row_slot: Vec<(usize, f64)>,
     diag: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
+    space: std::cell::RefCell<FactorSpace>,
 }
 
 /// Lower-triangle pattern (column pointers, row indices) of the products of every row's
@@ -232,6 +233,7 @@ impl Normal {
             row_start.push(row_slot.len());
         }
         let diag = (0..n).map(|i| slot(i, i)).collect();
+        let space = std::cell::RefCell::new(FactorSpace::new(&symbolic, p_values.len())?);
         Some(Normal {
             n,
             m_eq,
@@ -243,39 +245,45 @@ impl Normal {
             row_slot,
             diag,
             symbolic,
+            space,
         })
     }
 
-    /// y = P x from the stored lower triangle (x and y in the original labels).
+    /// y = P x from the stored lower triangle (x and y in the new labels).
     fn mul_p(&self, x: &[f64]) -> Vec<f64> {
-        let xn = self.to_internal(x);
-        let mut yn = vec![0.0; self.n];
+        let mut y = vec![0.0; self.n];
         for c in 0..self.n {
             let mut acc = 0.0;
             for k in self.col_ptr[c]..self.col_ptr[c + 1] {
                 let r = self.row_idx[k];
                 let v = self.p_values[k];
-                yn[r] += v * xn[c];
+                y[r] += v * x[c];
                 if r != c {
-                    acc += v * xn[r];
+                    acc += v * x[r];
                 }
             }
-            yn[c] += acc;
+            y[c] += acc;
         }
-        self.to_original(&yn)
+        y
     }
+}
 
-    fn to_internal(&self, x: &[f64]) -> Vec<f64> {
-        let mut out = vec![0.0; self.n];
-        for (i, &l) in self.label.iter().enumerate() {
-            out[l] = x[i];
-        }
-        out
+/// `m` with column j renamed `label[j]` (rows kept in column order).
+fn relabel_columns(m: &Csr, label: &[usize]) -> Csr {
+    let mut out = Csr::new(m.ncols);
+    for r in 0..m.nrows() {
+        out.push_row(m.row(r).map(|(c, v)| (label[c], v)).collect());
     }
+    out
+}
 
-    fn to_original(&self, x: &[f64]) -> Vec<f64> {
-        self.label.iter().map(|&l| x[l]).collect()
+/// `x` with entry i moved to `label[i]`.
+fn relabel_vector(x: &[f64], label: &[usize]) -> Vec<f64> {
+    let mut out = vec![0.0; x.len()];
+    for (i, &l) in label.iter().enumerate() {
+        out[l] = x[i];
     }
+    out
 }
 
 /// Regularisation δ of the constraint rows (scaled units): inequality weights z/s are capped
@@ -310,19 +318,44 @@ struct Newton<'a> {
     /// D per constraint row, and the weights 1 / (D + δ) the factor uses.
     d: Vec<f64>,
     w_reg: Vec<f64>,
+    space: std::cell::RefMut<'a, FactorSpace>,
+}
+
+/// Storage of the numeric factor and its scratch, allocated once per QP: every Newton step
+/// refactors the same pattern.
+struct FactorSpace {
+    values: Vec<f64>,
     l_values: Vec<f64>,
     buffer: MemBuffer,
+}
+
+impl FactorSpace {
+    fn new(symbolic: &SymbolicCholesky<usize>, n_values: usize) -> Option<FactorSpace> {
+        let par = Par::Seq;
+        let scratch = symbolic
+            .factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(1, par));
+        Some(FactorSpace {
+            values: vec![0.0; n_values],
+            l_values: vec![0.0; symbolic.len_val()],
+            buffer: MemBuffer::try_new(scratch).ok()?,
+        })
+    }
 }
 
 impl<'a> Newton<'a> {
     fn new(normal: &'a Normal, cons: &'a Csr, d: Vec<f64>, reg: f64) -> Option<Newton<'a>> {
         let n = normal.n;
+        // One Newton system at a time: the factor storage is shared.
+        let mut space = normal.space.borrow_mut();
+        let space_ref = &mut *space;
         let w_reg: Vec<f64> = d
             .iter()
             .enumerate()
             .map(|(r, d)| 1.0 / (d + if r < normal.m_eq { DELTA_EQ } else { DELTA }))
             .collect();
-        let mut values = normal.p_values.clone();
+        let values = &mut space_ref.values;
+        values.copy_from_slice(&normal.p_values);
         for (r, &w) in w_reg.iter().enumerate() {
             for &(slot, prod) in &normal.row_slot[normal.row_start[r]..normal.row_start[r + 1]] {
                 values[slot] += w * prod;
@@ -333,22 +366,15 @@ impl<'a> Newton<'a> {
         for &k in &normal.diag {
             values[k] += reg;
         }
-        let par = Par::Seq;
-        let mut l_values = vec![0.0; normal.symbolic.len_val()];
-        let scratch = normal
-            .symbolic
-            .factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
-            .or(normal.symbolic.solve_in_place_scratch::<f64>(1, par));
-        let mut buffer = MemBuffer::try_new(scratch).ok()?;
         let signs = vec![1i8; n];
         let matrix = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(n, n, &normal.col_ptr, None, &normal.row_idx),
-            &values,
+            &values[..],
         );
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
         let factored = normal.symbolic.factorize_numeric_ldlt(
-            &mut l_values,
+            &mut space_ref.l_values,
             matrix,
             faer::Side::Lower,
             LdltRegularization {
@@ -356,8 +382,8 @@ impl<'a> Newton<'a> {
                 dynamic_regularization_delta: 1e20,
                 dynamic_regularization_epsilon: 1e-14,
             },
-            par,
-            MemStack::new(&mut buffer),
+            Par::Seq,
+            MemStack::new(&mut space_ref.buffer),
             Default::default(),
         );
         factored.ok()?;
@@ -366,8 +392,7 @@ impl<'a> Newton<'a> {
             cons,
             d,
             w_reg,
-            l_values,
-            buffer,
+            space,
         })
     }
 
@@ -377,15 +402,14 @@ impl<'a> Newton<'a> {
         let t: Vec<f64> = b2.iter().zip(&self.w_reg).map(|(b, w)| b * w).collect();
         let mut dx = mul_t(self.cons, &t, n);
         dx.iter_mut().zip(b1).for_each(|(x, b)| *x += b);
-        let ldlt = LdltRef::new(&self.normal.symbolic, &self.l_values);
-        let mut dxn = self.normal.to_internal(&dx);
+        let space = &mut *self.space;
+        let ldlt = LdltRef::new(&self.normal.symbolic, &space.l_values);
         ldlt.solve_in_place_with_conj(
             Conj::No,
-            MatMut::from_column_major_slice_mut(&mut dxn, n, 1),
+            MatMut::from_column_major_slice_mut(&mut dx, n, 1),
             Par::Seq,
-            MemStack::new(&mut self.buffer),
+            MemStack::new(&mut space.buffer),
         );
-        let dx = self.normal.to_original(&dxn);
         let cdx = self.cons.mul(&dx);
         let w = (0..b2.len())
             .map(|i| self.w_reg[i] * (cdx[i] - b2[i]))
@@ -626,49 +650,101 @@ impl Kkt {
 const POLISH_FEAS: f64 = 1e3;
 const POLISH_GAP: f64 = 1e-5;
 
+/// A primal–dual iterate.
+#[derive(Clone, Copy)]
+struct Point<'a> {
+    x: &'a [f64],
+    lambda: &'a [f64],
+    s: &'a [f64],
+    z: &'a [f64],
+}
+
 /// The optimum for the active set the iterate suggests (inequalities with z > s held as
 /// equalities, the others dropped), accepted only if it meets every KKT condition: the
-/// inactive inequalities hold and the active ones have non-negative multipliers.
+/// inactive inequalities hold and the active ones have non-negative multipliers. It is a
+/// Newton step from the iterate, so it corrects the iterate's multipliers rather than
+/// computing new ones: when the active rows are dependent any combination would balance,
+/// and a fresh one need not be non-negative.
 fn polish(
     qp: &Qp,
     normal: &Normal,
     cons: &Csr,
-    x: &[f64],
-    s: &[f64],
-    z: &[f64],
+    point: &Point,
     tol: &Tolerances,
 ) -> Option<Vec<f64>> {
+    let Point { x, lambda, s, z } = *point;
     let (n, m_eq, m) = (x.len(), qp.eq.nrows(), s.len());
     let active: Vec<bool> = (0..m).map(|i| z[i] > s[i]).collect();
+    let z_active: Vec<f64> = (0..m).map(|i| if active[i] { z[i] } else { 0.0 }).collect();
+    let px = normal.mul_p(x);
+    let et_l = mul_t(qp.eq, lambda, n);
+    let gt_z = mul_t(qp.ineq, &z_active, n);
+    let b1: Vec<f64> = (0..n)
+        .map(|i| -(px[i] + qp.c[i] - et_l[i] - gt_z[i]))
+        .collect();
+    let mut b2: Vec<f64> = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| b - a).collect();
+    b2.extend(qp.ineq.mul(x).iter().zip(qp.h).map(|(a, b)| b - a));
     // D = 0 holds a row as an equality; a huge D drops it (its multiplier is D⁻¹ × residual).
     let mut d = vec![0.0; m_eq];
     d.extend(active.iter().map(|&a| if a { 0.0 } else { 1e30 }));
-    let px = normal.mul_p(x);
-    let b1: Vec<f64> = (0..n).map(|i| -(px[i] + qp.c[i])).collect();
-    let mut b2: Vec<f64> = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| b - a).collect();
-    b2.extend(qp.ineq.mul(x).iter().zip(qp.h).map(|(a, b)| b - a));
     let [dx, w] = REGULARISATION.iter().find_map(|&reg| {
         Newton::new(normal, cons, d.clone(), reg)?.solve(&b1, &b2, 1e-2 * tol.feas)
     })?;
     let x_new: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
-    let lambda: Vec<f64> = w[..m_eq].iter().map(|w| -w).collect();
+    let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
     let gx = qp.ineq.mul(&x_new);
     let s_new: Vec<f64> = (0..m).map(|i| (gx[i] - qp.h[i]).max(0.0)).collect();
     let z_new: Vec<f64> = (0..m)
         .map(|i| {
             if active[i] {
-                (-w[m_eq + i]).max(0.0)
+                (z_active[i] - w[m_eq + i]).max(0.0)
             } else {
                 0.0
             }
         })
         .collect();
-    Kkt::new(qp, normal, &x_new, &lambda, &s_new, &z_new)
+    Kkt::new(qp, normal, &x_new, &lambda_new, &s_new, &z_new)
         .within(tol, 1.0)
         .then_some(x_new)
 }
 
 fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
+    let n = qp.c.len();
+    // C = [E; G]: equality rows are constraints whose slack is pinned to zero.
+    let mut cons = qp.eq.clone();
+    for r in 0..qp.ineq.nrows() {
+        cons.push_row(qp.ineq.row(r).collect());
+    }
+    let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, qp.eq.nrows()) else {
+        return IpmOutput {
+            x: vec![0.0; n],
+            status: IpmStatus::NumericalError,
+            iterations: 0,
+        };
+    };
+    // The iterations work in the factor's labels: no vector is permuted per solve.
+    let label = &normal.label;
+    let (quad, eq, ineq) = (
+        relabel_columns(qp.quad, label),
+        relabel_columns(qp.eq, label),
+        relabel_columns(qp.ineq, label),
+    );
+    let cons = relabel_columns(&cons, label);
+    let c = relabel_vector(qp.c, label);
+    let relabelled = Qp {
+        quad: &quad,
+        c: &c,
+        eq: &eq,
+        ineq: &ineq,
+        ..*qp
+    };
+    let mut out = iterate(&relabelled, &normal, &cons, tol);
+    out.x = label.iter().map(|&l| out.x[l]).collect();
+    out
+}
+
+/// The interior-point iterations on a QP whose unknowns are in `normal`'s labels.
+fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput {
     let n = qp.c.len();
     let m_eq = qp.eq.nrows();
     let m = qp.ineq.nrows();
@@ -686,14 +762,6 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
             iterations,
         },
     };
-    // C = [E; G]: equality rows are constraints whose slack is pinned to zero.
-    let mut cons = qp.eq.clone();
-    for r in 0..m {
-        cons.push_row(qp.ineq.row(r).collect());
-    }
-    let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, m_eq) else {
-        return fail(vec![0.0; n], 0, None);
-    };
     let with_eq_zeros = |d: &[f64]| -> Vec<f64> {
         let mut out = vec![0.0; m_eq];
         out.extend_from_slice(d);
@@ -706,7 +774,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     let mut rhs = qp.f.to_vec();
     rhs.extend_from_slice(qp.h);
     let start = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(&normal, &cons, with_eq_zeros(&vec![1.0; m]), reg)?.solve(&minus_c, &rhs, 1e-8)
+        Newton::new(normal, cons, with_eq_zeros(&vec![1.0; m]), reg)?.solve(&minus_c, &rhs, 1e-8)
     });
     let Some([mut x, mut w]) = start else {
         return fail(vec![0.0; n], 0, None);
@@ -729,7 +797,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     z.iter_mut().for_each(|v| *v += dz.max(1e-8));
 
     for iteration in 0..tol.max_iter {
-        let kkt = Kkt::new(qp, &normal, &x, &lambda, &s, &z);
+        let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
         if !kkt.objective.is_finite() || inf_norm(&x) > 1e15 {
             return fail(x, iteration, almost);
         }
@@ -747,7 +815,13 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         // the iterations the gap would otherwise need to creep down to the tolerance, which
         // near a zero objective is at the edge of double precision.
         if kkt.near(tol) {
-            if let Some(x) = polish(qp, &normal, &cons, &x, &s, &z, tol) {
+            let point = Point {
+                x: &x,
+                lambda: &lambda,
+                s: &s,
+                z: &z,
+            };
+            if let Some(x) = polish(qp, normal, cons, &point, tol) {
                 return IpmOutput {
                     x,
                     status: IpmStatus::Solved,
@@ -799,7 +873,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         // The corrector needs an accuracy just ahead of the iterate's own.
         let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
         let step = |reg: f64| {
-            let mut newton = Newton::new(&normal, &cons, with_eq_zeros(&d), reg)?;
+            let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg)?;
             let sol = newton.approximate(&minus_rd, &rhs(&r_aff));
             let (_, _, ds_a, dz_a) = split(sol, &r_aff);
             let alpha_a = step_length(&ds_a, &dz_a);

@@ -51,6 +51,7 @@ impl Csr {
         self.start.push(w);
     }
 
+    #[inline]
     pub fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
         let range = self.start[r]..self.start[r + 1];
         self.col[range.clone()]
