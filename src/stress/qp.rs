@@ -409,7 +409,7 @@ pub fn solve_native(inp: &QpInput) -> QpOutput {
             ineq: &ineq,
             h: &h,
         },
-        &ipm::Tolerances::default(),
+        &ipm::Tolerances::for_size(n),
     );
     let tau = tau_col
         .iter()
