@@ -362,7 +362,13 @@ fn dual_length_smoothing_trades_residual_for_a_smoother_diagram() {
         let p_bar = free.iter().map(|&v| plain.loads[v]).sum::<f64>() / free.len() as f64;
         let total =
             |r: &StressResult| r.objective + mu * dual_variation(&problem, &r.force_densities);
+        assert_eq!(runs[0].1.solver, QpSolver::Native, "{label}: fell back");
         let reference = total(&runs[2].1);
+        // The plain optimum is feasible for the smoothed problem: no better than its optimum.
+        assert!(
+            reference <= total(&plain) * (1.0 + 1e-6),
+            "{label}: not a minimum"
+        );
         for (name, r) in &runs {
             assert!(r.status.is_solved(), "{label} {name}: {:?}", r.status);
             let j = total(r);

@@ -160,7 +160,9 @@ pub fn form_find(
             // not reach ε∞ → 0: the weight fades, the shape adapts to the smoother stress of
             // the early steps and the proximal term keeps it.
             let mut faded = settings.stress.clone();
-            faded.dual_length_smoothing *= settings.smoothing_decay.powi(k as i32);
+            let factor = settings.smoothing_decay.powi(k as i32);
+            // Once negligible, drop the term (and its Hessian rows) altogether.
+            faded.dual_length_smoothing *= if factor > 1e-12 { factor } else { 0.0 };
             analyse_near(problem, &positions, &faded, prior)?
         } else {
             analyse_near(problem, &positions, &settings.stress, prior)?

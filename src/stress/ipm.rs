@@ -66,8 +66,8 @@ pub struct IpmOutput {
     pub iterations: u32,
 }
 
-/// Tolerances: the gap sᵀz must fall below `gap_abs + gap_rel |objective|` and every
-/// residual below `feas` relative to its data.
+/// Tolerances: the gap sᵀz must fall below `gap_abs + gap_rel |objective|`, the primal
+/// residuals below `feas` and the dual one below `dual_feas`, each relative to its data.
 #[derive(Debug, Clone, Copy)]
 pub struct Tolerances {
     pub gap_abs: f64,
@@ -75,8 +75,9 @@ pub struct Tolerances {
     pub feas: f64,
     /// The same for the dual residual P x + c − Eᵀλ − Gᵀz, times √(n / 10⁴) from 10⁴
     /// unknowns on: its floor is rounding in sums over the unknowns, which grows with their
-    /// number (at 97k unknowns it hovered at 1e-10 – 4e-9 for 35 iterations after the gap
-    /// had closed). A flat 1e-9 let four_holes stop 0.2% above its optimum.
+    /// number (at 97k unknowns it hovered between 1e-10 and 8e-9 of its scale for 10–35
+    /// iterations after the gap had closed). A flat 1e-9 let four_holes stop 0.2% above its
+    /// optimum.
     pub dual_feas: f64,
     /// Factor by which all tolerances are relaxed for `AlmostSolved`.
     pub almost: f64,
@@ -286,7 +287,7 @@ impl Normal {
     }
 }
 
-/// `m` with column j renamed `label[j]` (rows kept in column order).
+/// `m` with column j renamed `label[j]` (each row re-sorted by the new labels).
 fn relabel_columns(m: &Csr, label: &[usize]) -> Csr {
     let mut out = Csr::new(m.ncols);
     for r in 0..m.nrows() {
@@ -343,6 +344,8 @@ struct Newton<'a> {
 /// refactors the same pattern.
 struct FactorSpace {
     values: Vec<f64>,
+    /// Expected pivot signs (all positive) for faer's dynamic regularisation.
+    signs: Vec<i8>,
     l_values: Vec<f64>,
     buffer: MemBuffer,
 }
@@ -355,6 +358,7 @@ impl FactorSpace {
             .or(symbolic.solve_in_place_scratch::<f64>(1, par));
         Some(FactorSpace {
             values: vec![0.0; n_values],
+            signs: vec![1; symbolic.nrows()],
             l_values: vec![0.0; symbolic.len_val()],
             buffer: MemBuffer::try_new(scratch).ok()?,
         })
@@ -384,7 +388,6 @@ impl<'a> Newton<'a> {
         for &k in &normal.diag {
             values[k] += reg;
         }
-        let signs = vec![1i8; n];
         let matrix = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(n, n, &normal.col_ptr, None, &normal.row_idx),
             &values[..],
@@ -396,7 +399,7 @@ impl<'a> Newton<'a> {
             matrix,
             faer::Side::Lower,
             LdltRegularization {
-                dynamic_regularization_signs: Some(&signs),
+                dynamic_regularization_signs: Some(&space_ref.signs),
                 dynamic_regularization_delta: 1e20,
                 dynamic_regularization_epsilon: 1e-14,
             },
@@ -743,15 +746,14 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     };
     // The iterations work in the factor's labels: no vector is permuted per solve.
     let label = &normal.label;
-    let (quad, eq, ineq) = (
-        relabel_columns(qp.quad, label),
+    // `quad` is left as it is: the iterations use P only through `normal`.
+    let (eq, ineq) = (
         relabel_columns(qp.eq, label),
         relabel_columns(qp.ineq, label),
     );
     let cons = relabel_columns(&cons, label);
     let c = relabel_vector(qp.c, label);
     let relabelled = Qp {
-        quad: &quad,
         c: &c,
         eq: &eq,
         ineq: &ineq,

@@ -121,7 +121,8 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     let r_start = n_base + n_tau;
     let n = r_start + inp.residual_vertices.len();
 
-    // Objective: ½ xᵀ P x with P = 2 (ε Sᵀ D S ⊕ 0 ⊕ I), upper triangle.
+    // Objective: ½ xᵀ P x with P = 2 (ε Sᵀ D S + μ Σ_pairs a aᵀ ⊕ 0 ⊕ I), upper triangle
+    // (a: the smoothing row l_a S_a − l_b S_b).
     let mut p = Triplets {
         i: vec![],
         j: vec![],
@@ -320,7 +321,8 @@ pub fn solve_native(inp: &QpInput) -> QpOutput {
             ev[0] as usize
         }
     };
-    // ‖B y − p‖² with B = G S (one row per residual vertex) and ε Σ l² (S_e y − q̂_e)².
+    // ‖B y − p‖² with B = G S (one row per residual vertex), ε Σ l² (S_e y − q̂_e)² and the
+    // smoothing rows μ (l_a S_a y − l_b S_b y)².
     let mut quad = Csr::new(n);
     let mut weight = Vec::new();
     let mut c = vec![0.0; n];
