@@ -130,7 +130,6 @@ struct Normal {
     row_slot: Vec<(usize, f64)>,
     diag: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
-    space: std::cell::RefCell<FactorSpace>,
 }
 
 /// Lower-triangle pattern (column pointers, row indices) of the products of every row's
@@ -252,7 +251,6 @@ impl Normal {
             row_start.push(row_slot.len());
         }
         let diag = (0..n).map(|i| slot(i, i)).collect();
-        let space = std::cell::RefCell::new(FactorSpace::new(&symbolic, p_values.len())?);
         Some(Normal {
             n,
             m_eq,
@@ -264,7 +262,6 @@ impl Normal {
             row_slot,
             diag,
             symbolic,
-            space,
         })
     }
 
@@ -337,7 +334,7 @@ struct Newton<'a> {
     /// D per constraint row, and the weights 1 / (D + δ) the factor uses.
     d: Vec<f64>,
     w_reg: Vec<f64>,
-    space: std::cell::RefMut<'a, FactorSpace>,
+    space: &'a mut FactorSpace,
 }
 
 /// Storage of the numeric factor and its scratch, allocated once per QP: every Newton step
@@ -366,17 +363,20 @@ impl FactorSpace {
 }
 
 impl<'a> Newton<'a> {
-    fn new(normal: &'a Normal, cons: &'a Csr, d: Vec<f64>, reg: f64) -> Option<Newton<'a>> {
+    fn new(
+        normal: &'a Normal,
+        cons: &'a Csr,
+        d: Vec<f64>,
+        reg: f64,
+        space: &'a mut FactorSpace,
+    ) -> Option<Newton<'a>> {
         let n = normal.n;
-        // One Newton system at a time: the factor storage is shared.
-        let mut space = normal.space.borrow_mut();
-        let space_ref = &mut *space;
         let w_reg: Vec<f64> = d
             .iter()
             .enumerate()
             .map(|(r, d)| 1.0 / (d + if r < normal.m_eq { DELTA_EQ } else { DELTA }))
             .collect();
-        let values = &mut space_ref.values;
+        let values = &mut space.values;
         values.copy_from_slice(&normal.p_values);
         for (r, &w) in w_reg.iter().enumerate() {
             for &(slot, prod) in &normal.row_slot[normal.row_start[r]..normal.row_start[r + 1]] {
@@ -395,16 +395,16 @@ impl<'a> Newton<'a> {
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
         let factored = normal.symbolic.factorize_numeric_ldlt(
-            &mut space_ref.l_values,
+            &mut space.l_values,
             matrix,
             faer::Side::Lower,
             LdltRegularization {
-                dynamic_regularization_signs: Some(&space_ref.signs),
+                dynamic_regularization_signs: Some(&space.signs),
                 dynamic_regularization_delta: 1e20,
                 dynamic_regularization_epsilon: 1e-14,
             },
             Par::Seq,
-            MemStack::new(&mut space_ref.buffer),
+            MemStack::new(&mut space.buffer),
             Default::default(),
         );
         factored.ok()?;
@@ -693,6 +693,7 @@ fn polish(
     cons: &Csr,
     point: &Point,
     tol: &Tolerances,
+    space: &mut FactorSpace,
 ) -> Option<Vec<f64>> {
     let Point { x, lambda, s, z } = *point;
     let (n, m_eq, m) = (x.len(), qp.eq.nrows(), s.len());
@@ -710,7 +711,7 @@ fn polish(
     let mut d = vec![0.0; m_eq];
     d.extend(active.iter().map(|&a| if a { 0.0 } else { 1e30 }));
     let [dx, w] = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(normal, cons, d.clone(), reg)?.solve(&b1, &b2, 1e-2 * tol.feas)
+        Newton::new(normal, cons, d.clone(), reg, space)?.solve(&b1, &b2, 1e-2 * tol.feas)
     })?;
     let x_new: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
     let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
@@ -794,8 +795,13 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
     let minus_c: Vec<f64> = qp.c.iter().map(|c| -c).collect();
     let mut rhs = qp.f.to_vec();
     rhs.extend_from_slice(qp.h);
+    // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
+    let Some(mut space) = FactorSpace::new(&normal.symbolic, normal.p_values.len()) else {
+        return fail(vec![0.0; n], 0, None);
+    };
     let start = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(normal, cons, with_eq_zeros(&vec![1.0; m]), reg)?.solve(&minus_c, &rhs, 1e-8)
+        Newton::new(normal, cons, with_eq_zeros(&vec![1.0; m]), reg, &mut space)?
+            .solve(&minus_c, &rhs, 1e-8)
     });
     let Some([mut x, mut w]) = start else {
         return fail(vec![0.0; n], 0, None);
@@ -842,7 +848,7 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
                 s: &s,
                 z: &z,
             };
-            if let Some(x) = polish(qp, normal, cons, &point, tol) {
+            if let Some(x) = polish(qp, normal, cons, &point, tol, &mut space) {
                 return IpmOutput {
                     x,
                     status: IpmStatus::Solved,
@@ -893,8 +899,8 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
         let d: Vec<f64> = (0..m).map(|i| s[i] / z[i]).collect();
         // The corrector needs an accuracy just ahead of the iterate's own.
         let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
-        let step = |reg: f64| {
-            let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg)?;
+        let mut step = |reg: f64| {
+            let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg, &mut space)?;
             let sol = newton.approximate(&minus_rd, &rhs(&r_aff));
             let (_, _, ds_a, dz_a) = split(sol, &r_aff);
             let alpha_a = step_length(&ds_a, &dz_a);
