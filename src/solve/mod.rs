@@ -155,18 +155,22 @@ pub fn form_find(
                 weight: settings.proximal_weight,
                 lifted_first: s.lifted,
             });
-        let stress = if settings.stress.dual_length_smoothing > 0.0 {
-            // A fixed weight would keep trading residual for smoothness, so the loop could
-            // not reach ε∞ → 0: the weight fades, the shape adapts to the smoother stress of
-            // the early steps and the proximal term keeps it.
-            let mut faded = settings.stress.clone();
+        // A fixed smoothing weight would keep trading residual for smoothness, so the loop
+        // could not reach ε∞ → 0: the weight fades (and is dropped once negligible), the shape
+        // adapts to the smoother stress of the early steps and the proximal term keeps it.
+        let faded;
+        let stress_settings = if settings.stress.dual_length_smoothing > 0.0 {
             let factor = settings.smoothing_decay.powi(k as i32);
-            // Once negligible, drop the term (and its Hessian rows) altogether.
-            faded.dual_length_smoothing *= if factor > 1e-12 { factor } else { 0.0 };
-            analyse_near(problem, &positions, &faded, prior)?
+            faded = StressSettings {
+                dual_length_smoothing: settings.stress.dual_length_smoothing
+                    * if factor > 1e-12 { factor } else { 0.0 },
+                ..settings.stress.clone()
+            };
+            &faded
         } else {
-            analyse_near(problem, &positions, &settings.stress, prior)?
+            &settings.stress
         };
+        let stress = analyse_near(problem, &positions, stress_settings, prior)?;
         stress_s += t.elapsed().as_secs_f64();
         history.push(stress.eps_inf);
         let status = stress.status;

@@ -73,11 +73,7 @@ pub struct Tolerances {
     pub gap_abs: f64,
     pub gap_rel: f64,
     pub feas: f64,
-    /// The same for the dual residual P x + c − Eᵀλ − Gᵀz, times √(n / 10⁴) from 10⁴
-    /// unknowns on: its floor is rounding in sums over the unknowns, which grows with their
-    /// number (at 97k unknowns it hovered between 1e-10 and 8e-9 of its scale for 10–35
-    /// iterations after the gap had closed). A flat 1e-9 let four_holes stop 0.2% above its
-    /// optimum.
+    /// The same for the dual residual P x + c − Eᵀλ − Gᵀz (see `for_size`).
     pub dual_feas: f64,
     /// Factor by which all tolerances are relaxed for `AlmostSolved`.
     pub almost: f64,
@@ -85,13 +81,20 @@ pub struct Tolerances {
 }
 
 impl Tolerances {
-    /// The defaults with an iteration budget for `n` unknowns: the fallback (clarabel) costs
-    /// about what 100 native iterations do at a thousand unknowns but thousands at 20k and
-    /// more (a 20k-vertex QP: 2 s native, 120 s clarabel), so large problems get more.
+    /// The defaults adapted to `n` unknowns.
+    /// - The dual tolerance grows as √(n / 10⁴) from 10⁴ unknowns on: its floor is rounding
+    ///   in sums over the unknowns (at 97k unknowns the dual residual hovered between 1e-10
+    ///   and 8e-9 of its scale for 10–35 iterations after the gap had closed). A flat 1e-9
+    ///   let four_holes stop 0.2% above its optimum.
+    /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
+    ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
+    ///   native, 120 s clarabel), so large problems get more.
     pub fn for_size(n: usize) -> Tolerances {
+        let base = Tolerances::default();
         Tolerances {
+            dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
             max_iter: if n > 20_000 { 150 } else { 80 },
-            ..Tolerances::default()
+            ..base
         }
     }
 }
@@ -291,6 +294,15 @@ fn relabel_columns(m: &Csr, label: &[usize]) -> Csr {
         out.push_row(m.row(r).map(|(c, v)| (label[c], v)).collect());
     }
     out
+}
+
+/// C = [E; G]: equality rows are constraints whose slack is pinned to zero.
+fn stacked(eq: &Csr, ineq: &Csr) -> Csr {
+    let mut cons = eq.clone();
+    for r in 0..ineq.nrows() {
+        cons.push_row(ineq.row(r).collect());
+    }
+    cons
 }
 
 /// `x` with entry i moved to `label[i]`.
@@ -650,8 +662,7 @@ impl Kkt {
     }
 
     fn feasible(&self, tol: &Tolerances, k: f64) -> bool {
-        let size = (self.r_d.len() as f64 / 1e4).sqrt().max(1.0);
-        inf_norm(&self.r_d) <= k * tol.dual_feas * size * self.dual_scale
+        inf_norm(&self.r_d) <= k * tol.dual_feas * self.dual_scale
             && inf_norm(&self.r_e) <= k * tol.feas * self.eq_scale
             && inf_norm(&self.r_i) <= k * tol.feas * self.ineq_scale
     }
@@ -733,11 +744,7 @@ fn polish(
 
 fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     let n = qp.c.len();
-    // C = [E; G]: equality rows are constraints whose slack is pinned to zero.
-    let mut cons = qp.eq.clone();
-    for r in 0..qp.ineq.nrows() {
-        cons.push_row(qp.ineq.row(r).collect());
-    }
+    let cons = stacked(qp.eq, qp.ineq);
     let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, qp.eq.nrows()) else {
         return IpmOutput {
             x: vec![0.0; n],
@@ -752,7 +759,7 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         relabel_columns(qp.eq, label),
         relabel_columns(qp.ineq, label),
     );
-    let cons = relabel_columns(&cons, label);
+    let cons = stacked(&eq, &ineq);
     let c = relabel_vector(qp.c, label);
     let relabelled = Qp {
         c: &c,

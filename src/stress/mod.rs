@@ -231,7 +231,7 @@ pub fn analyse_near(
         .collect();
 
     let smoothing_pairs = if settings.dual_length_smoothing > 0.0 {
-        face_edge_pairs(mesh, &bounds)
+        face_edge_pairs(mesh)
     } else {
         Vec::new()
     };
@@ -480,15 +480,15 @@ impl StressResult {
     }
 }
 
-/// Pairs of interior edges with forces that share a face: their dual segments meet at the
-/// face's power centre.
-fn face_edge_pairs(mesh: &Mesh, bounds: &[Option<(f64, f64)>]) -> Vec<[usize; 2]> {
-    let carries = |e: u32| bounds[e as usize].is_some() && !mesh.edges[e as usize].is_boundary();
+/// Pairs of interior edges (all of which carry force) that share a face: their dual segments
+/// meet at the face's power centre.
+fn face_edge_pairs(mesh: &Mesh) -> Vec<[usize; 2]> {
+    let interior = |e: u32| !mesh.edges[e as usize].is_boundary();
     let mut pairs = Vec::new();
     for fe in &mesh.face_edges {
         for k in 0..3 {
             let (a, b) = (fe[k], fe[(k + 1) % 3]);
-            if carries(a) && carries(b) {
+            if interior(a) && interior(b) {
                 pairs.push([a as usize, b as usize]);
             }
         }
