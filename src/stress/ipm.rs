@@ -469,11 +469,8 @@ impl<'a> Newton<'a> {
     ) -> Option<[Vec<f64>; 2]> {
         let n = self.normal.n;
         // Equality rows count as they are (their violation is what matters), inequality rows
-        // as they enter dx (times their weight z/s): inactive ones carry huge right-hand sides
-        // whose rounding does not matter. The weight is capped at 1: active rows count as
-        // equalities. Uncapped (up to 1/δ), their slowly converging errors stopped the
-        // refinement before the dual residual was reached, which then stalled 5× above its
-        // tolerance on free_vault from some starting points.
+        // as they enter dx (times their weight): inactive ones carry huge right-hand sides
+        // whose rounding does not matter.
         let m_eq = self.normal.m_eq;
         let w_reg = self.w_reg.clone();
         let weighted = |b1: &[f64], b2: &[f64]| {
@@ -481,11 +478,7 @@ impl<'a> Newton<'a> {
                 .zip(&w_reg)
                 .enumerate()
                 .fold(inf_norm(b1), |a, (r, (b, w))| {
-                    a.max(if r < m_eq {
-                        b.abs()
-                    } else {
-                        (b * w.min(1.0)).abs()
-                    })
+                    a.max(if r < m_eq { b.abs() } else { (b * w).abs() })
                 })
         };
         let b_norm = weighted(b1, b2);
@@ -783,7 +776,8 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
 /// weight 1 pulls every force density towards its bound, so that nearly every constraint
 /// starts out looking active; measured on generated domes with a hole, 100 took the iterations
 /// from 29 to 22 at 6k unknowns, 34 to 31 at 20k, 46 to 34 at 50k and 79 to 39 at 100k, and
-/// cost the shared models 0 to 6 more (11–25 in all). 10 and 1000 did less well at 100k.
+/// cost the shared models 0 to 6 more (11–25 in all). 10 and 1000 did less well at 100k; 30
+/// left free_vault's dual residual 5× above its tolerance (it fell back to clarabel).
 const START_PENALTY: f64 = 100.0;
 
 /// The interior-point iterations on a QP whose unknowns are in `normal`'s labels.
