@@ -206,7 +206,8 @@ enum VsrQpSolver
  {
   /**
    * Default: the structured interior-point method; falls back to clarabel when it does not
-   * converge.
+   * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
+   * with status VSR_STRESS_STATUS_ALMOST_SOLVED).
    */
   VSR_QP_SOLVER_NATIVE = 0,
   /**

@@ -212,7 +212,8 @@ pub enum VsrFormulation {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VsrQpSolver {
     /// Default: the structured interior-point method; falls back to clarabel when it does not
-    /// converge.
+    /// converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
+    /// with status VSR_STRESS_STATUS_ALMOST_SOLVED).
     Native = 0,
     /// clarabel's generic conic solver only: the reference.
     Clarabel = 1,

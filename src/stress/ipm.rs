@@ -88,15 +88,22 @@ impl Tolerances {
     ///   let four_holes stop 0.2% above its optimum.
     /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
     ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
-    ///   native, 120 s clarabel), so large problems get more.
+    ///   native, 120 s clarabel), so large problems get more (see `fallback_is_costly`).
     pub fn for_size(n: usize) -> Tolerances {
         let base = Tolerances::default();
         Tolerances {
             dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
-            max_iter: if n > 20_000 { 150 } else { 80 },
+            max_iter: if fallback_is_costly(n) { 150 } else { 80 },
             ..base
         }
     }
+}
+
+/// Whether clarabel, the fallback, costs thousands of native iterations on a QP with `n`
+/// unknowns (a 20k-vertex QP: 2 s native, 120 s clarabel; at 100k a form-finding step ran
+/// for more than 10 minutes in clarabel where the native method had taken 20–75 s).
+pub fn fallback_is_costly(n: usize) -> bool {
+    n > 20_000
 }
 
 impl Default for Tolerances {

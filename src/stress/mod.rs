@@ -312,6 +312,7 @@ pub fn analyse_near(
             }
         };
         let status = out.status;
+        let n_unknowns = out.y.len();
         if best
             .as_ref()
             .is_none_or(|b| status.rank() < b.out.status.rank())
@@ -325,10 +326,12 @@ pub fn analyse_near(
             });
         }
         // Native: only a converged answer stands (at reduced accuracy it can sit at a point
-        // that is not optimal: four_holes). Clarabel solved or infeasible: done.
-        // Reduced accuracy: one more try with the other form of the same problem, then keep
-        // the better. Numerical failure: go down the list.
+        // that is not optimal: four_holes), except on large problems, where the fallback
+        // would take many minutes: there reduced accuracy is kept and reported as such.
+        // Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other
+        // form of the same problem, then keep the better. Numerical failure: go down the list.
         let done = match (solver, status) {
+            (Native, StressStatus::AlmostSolved) => ipm::fallback_is_costly(n_unknowns),
             (Native, s) => s == StressStatus::Solved,
             (_, StressStatus::Solved | StressStatus::Infeasible) => true,
             (_, StressStatus::AlmostSolved | StressStatus::MaxIterations) => clarabel_tries >= 2,
