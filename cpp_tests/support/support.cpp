@@ -587,11 +587,25 @@ CheckReport reference_check(const MeshData &mesh, const Solution &sol,
                 }
         bbox_diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1]);
     }
+    // A hole counts as stress-free when its jump cannot move a power centre beyond the
+    // tolerance of (a) below: shifting one weight by 2c moves a face's centre by at most
+    // 2c / (2 h) for its smallest altitude h. (A threshold on c alone, relative to q_max and
+    // the diagonal, let a c of 5e-8 on free_vault move centres 450× the tolerance.)
+    double min_altitude = INFINITY;
+    for (std::size_t t = 0; t < nf; ++t) {
+        const Point2 p[3] = {plan(mesh.triangles[3 * t]), plan(mesh.triangles[3 * t + 1]),
+                             plan(mesh.triangles[3 * t + 2])};
+        const double area2 = std::abs(CGAL::area(p[0], p[1], p[2])) * 2;
+        double longest = 0;
+        for (int k = 0; k < 3; ++k)
+            longest = std::max(longest, std::sqrt(CGAL::squared_distance(p[k], p[(k + 1) % 3])));
+        if (longest > 0) min_altitude = std::min(min_altitude, area2 / longest);
+    }
+    const double jump_tolerance = 0.1 * options.dual_tolerance * q_max * bbox_diag * min_altitude;
     for (std::size_t h = 0; h < sol.holes.size() / 3; ++h) {
         const double c = std::abs(sol.holes[3 * h]);
         const double a = std::hypot(sol.holes[3 * h + 1], sol.holes[3 * h + 2]);
-        if (c > 1e-9 * q_max * bbox_diag * bbox_diag || a > 1e-9 * q_max * bbox_diag)
-            rep.holes_zero = false;
+        if (c > jump_tolerance || a * bbox_diag > jump_tolerance) rep.holes_zero = false;
     }
 
     // --- (a) Power centres of the weighted plan points (CGAL) give q = d*/l on interior edges.
