@@ -74,7 +74,7 @@ pub struct Tolerances {
     pub gap_rel: f64,
     pub feas: f64,
     /// The same for the dual residual P x + c − Eᵀλ − Gᵀz, or its rounding floor when that
-    /// is larger (see `DUAL_ROUNDING`).
+    /// is larger (see `for_size` and `DUAL_ROUNDING`).
     pub dual_feas: f64,
     /// Factor by which all tolerances are relaxed for `AlmostSolved`.
     pub almost: f64,
@@ -82,14 +82,20 @@ pub struct Tolerances {
 }
 
 impl Tolerances {
-    /// The defaults adapted to `n` unknowns: the iteration budget. The fallback (clarabel)
-    /// costs about what 100 native iterations do at a thousand unknowns but thousands at 20k
-    /// and more (a 20k-vertex QP: 2 s native, 120 s clarabel), so large problems get more
-    /// (see `fallback_is_costly`).
+    /// The defaults adapted to `n` unknowns.
+    /// - The dual tolerance grows as √(n / 10⁴) from 10⁴ unknowns on, besides its rounding
+    ///   floor (`DUAL_ROUNDING`): at 100k unknowns form-finding steps whose residual hovered
+    ///   1–3× above 1e-10 of its scale stayed above the floor as well, and without the growth
+    ///   they fell back to clarabel. A flat 1e-9 let four_holes stop 0.2% above its optimum.
+    /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
+    ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
+    ///   native, 120 s clarabel), so large problems get more (see `fallback_is_costly`).
     pub fn for_size(n: usize) -> Tolerances {
+        let base = Tolerances::default();
         Tolerances {
+            dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
             max_iter: if fallback_is_costly(n) { 150 } else { 80 },
-            ..Tolerances::default()
+            ..base
         }
     }
 }
@@ -111,8 +117,9 @@ impl Default for Tolerances {
             feas: 1e-10,
             dual_feas: 1e-10,
             almost: 10.0,
-            // Well-posed problems converge in 15–60 iterations (up to 80 at 100k unknowns);
-            // beyond, the caller's fallback is cheaper than crawling on: see `for_size`.
+            // Well-posed problems converge in 11–40 iterations (form-finding steps at 100k
+            // unknowns took up to 130); beyond, the caller's fallback is cheaper than crawling
+            // on: see `for_size`.
             max_iter: 80,
         }
     }
@@ -729,8 +736,7 @@ impl Kkt {
 /// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding. Weights and Airy values can be
 /// 10⁶–10⁷ in the scaled unknowns while P x is O(1) (100k-vertex form finding: Σ|P||x| 1.75e7
 /// against |P x| 2.7), and the residual then hovered at 0.5–1.5 ulps of those terms, 2–4×
-/// above the relative tolerance, for 50 iterations. This floor replaces a tolerance that grew
-/// as √(n/10⁴), a guess at the same rounding.
+/// above the relative tolerance, for 50 iterations.
 const DUAL_ROUNDING: f64 = 10.0;
 
 /// When `Kkt::near` holds: residuals within this many times the tolerance, relative gap
