@@ -279,34 +279,25 @@ impl Normal {
 
     /// y = |P| |x| (entrywise absolute values): the size of the terms summed in P x.
     fn mul_p_abs(&self, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; self.n];
-        for c in 0..self.n {
-            let xc = x[c].abs();
-            let mut acc = 0.0;
-            for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                let r = self.row_idx[k];
-                let v = self.p_values[k].abs();
-                y[r] += v * xc;
-                if r != c {
-                    acc += v * x[r].abs();
-                }
-            }
-            y[c] += acc;
-        }
-        y
+        self.sum_p_terms(x, |p, x| (p * x).abs())
     }
 
     /// y = P x from the stored lower triangle (x and y in the new labels).
     fn mul_p(&self, x: &[f64]) -> Vec<f64> {
+        self.sum_p_terms(x, |p, x| p * x)
+    }
+
+    /// y_r = Σ_c term(P_rc, x_c) over the full symmetric P, from its lower triangle.
+    fn sum_p_terms(&self, x: &[f64], term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
         let mut y = vec![0.0; self.n];
         for c in 0..self.n {
             let mut acc = 0.0;
             for k in self.col_ptr[c]..self.col_ptr[c + 1] {
                 let r = self.row_idx[k];
                 let v = self.p_values[k];
-                y[r] += v * x[c];
+                y[r] += term(v, x[c]);
                 if r != c {
-                    acc += v * x[r];
+                    acc += term(v, x[r]);
                 }
             }
             y[c] += acc;
@@ -558,21 +549,20 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// Aᵀ y for a Csr A with `n` columns.
 fn mul_t(a: &Csr, y: &[f64], n: usize) -> Vec<f64> {
-    let mut out = vec![0.0; n];
-    for (r, &yr) in y.iter().enumerate() {
-        for k in a.start[r]..a.start[r + 1] {
-            out[a.col[k]] += a.val[k] * yr;
-        }
-    }
-    out
+    sum_t_terms(a, y, n, |a, y| a * y)
 }
 
 /// |A|ᵀ |y| for a Csr A with `n` columns.
 fn abs_mul_t(a: &Csr, y: &[f64], n: usize) -> Vec<f64> {
+    sum_t_terms(a, y, n, |a, y| (a * y).abs())
+}
+
+/// out_c = Σ_r term(a_rc, y_r) for a Csr A with `n` columns.
+fn sum_t_terms(a: &Csr, y: &[f64], n: usize, term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
     let mut out = vec![0.0; n];
     for (r, &yr) in y.iter().enumerate() {
         for k in a.start[r]..a.start[r + 1] {
-            out[a.col[k]] += (a.val[k] * yr).abs();
+            out[a.col[k]] += term(a.val[k], yr);
         }
     }
     out
