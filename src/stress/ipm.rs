@@ -1164,6 +1164,64 @@ mod tests {
         assert!((out.x[1] - 2.3).abs() < 1e-8, "{:?}", out.x);
     }
 
+    /// min (x0 − 2)² + (x1 + 10⁻⁶)² subject to x1 ≥ 0: the bound is active at the optimum
+    /// (2, 0) with the tiny multiplier 2·10⁻⁶. At an iterate that has not told it apart yet
+    /// (s = 10⁻³ > z = 10⁻⁷) the plain guess drops it and its step lands at x1 = −10⁻⁶,
+    /// violating it; the corrected guess must find the optimum.
+    #[test]
+    fn polishing_corrects_a_wrongly_dropped_row() {
+        let quad = csr(2, &[&[(0, 1.0)], &[(1, 1.0)]]);
+        let weight = [2.0, 2.0];
+        let c = [-4.0, 2e-6];
+        let eq = csr(2, &[]);
+        let ineq = csr(2, &[&[(1, 1.0)]]);
+        let qp = Qp {
+            quad: &quad,
+            quad_weight: &weight,
+            c: &c,
+            constant: 4.0 + 1e-12,
+            eq: &eq,
+            f: &[],
+            ineq: &ineq,
+            h: &[0.0],
+        };
+        let cons = stacked(qp.eq, qp.ineq);
+        let normal = Normal::new(qp.quad, qp.quad_weight, &cons, 0).expect("normal matrix");
+        let label = &normal.label;
+        let (eq, ineq) = (
+            relabel_columns(qp.eq, label),
+            relabel_columns(qp.ineq, label),
+        );
+        let cons = stacked(&eq, &ineq);
+        let c = relabel_vector(qp.c, label);
+        let qp = Qp {
+            c: &c,
+            eq: &eq,
+            ineq: &ineq,
+            ..qp
+        };
+        let mut space =
+            FactorSpace::new(&normal.symbolic, normal.p_values.len()).expect("factor space");
+        let x = relabel_vector(&[2.0, 1e-3], label);
+        let point = Point {
+            x: &x,
+            lambda: &[],
+            s: &[1e-3],
+            z: &[1e-7],
+        };
+        let polished = polish(
+            &qp,
+            &normal,
+            &cons,
+            &point,
+            &Tolerances::default(),
+            &mut space,
+        )
+        .expect("the corrected guess is optimal");
+        let x: Vec<f64> = label.iter().map(|&l| polished[l]).collect();
+        assert!((x[0] - 2.0).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
+    }
+
     /// min Σ (x_{i+1} − x_i − t_i)² subject to x_{i+1} ≥ x_i and x_0 = 10⁷: the differences
     /// come out at max(t_i, 0) while every unknown is near 10⁷, so P x sums terms of 10⁷ to
     /// O(1) results and its rounding (~1e-9) exceeds 1e-10 of the dual residual's scale. The
