@@ -873,23 +873,40 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         };
     };
     // The iterations work in the factor's labels: no vector is permuted per solve.
-    let label = &normal.label;
-    // `quad` is left as it is: the iterations use P only through `normal`.
-    let (eq, ineq) = (
-        relabel_columns(qp.eq, label),
-        relabel_columns(qp.ineq, label),
-    );
-    let cons = stacked(&eq, &ineq);
-    let c = relabel_vector(qp.c, label);
-    let relabelled = Qp {
-        c: &c,
-        eq: &eq,
-        ineq: &ineq,
-        ..*qp
-    };
-    let mut out = iterate(&relabelled, &normal, &cons, tol);
-    out.x = label.iter().map(|&l| out.x[l]).collect();
+    let relabelled = Relabelled::new(qp, &normal.label);
+    let mut out = iterate(&relabelled.qp(qp), &normal, &relabelled.cons, tol);
+    out.x = normal.label.iter().map(|&l| out.x[l]).collect();
     out
+}
+
+/// The constraints and linear term of a QP with its unknowns relabelled (`quad` is left as
+/// it is: the iterations use P only through `Normal`), and C = [E; G] in the new labels.
+struct Relabelled {
+    eq: Csr,
+    ineq: Csr,
+    cons: Csr,
+    c: Vec<f64>,
+}
+
+impl Relabelled {
+    fn new(qp: &Qp, label: &[usize]) -> Relabelled {
+        let (eq, ineq) = (
+            relabel_columns(qp.eq, label),
+            relabel_columns(qp.ineq, label),
+        );
+        let cons = stacked(&eq, &ineq);
+        let c = relabel_vector(qp.c, label);
+        Relabelled { eq, ineq, cons, c }
+    }
+
+    fn qp<'a>(&'a self, qp: &Qp<'a>) -> Qp<'a> {
+        Qp {
+            c: &self.c,
+            eq: &self.eq,
+            ineq: &self.ineq,
+            ..*qp
+        }
+    }
 }
 
 /// Weight 1 / START_PENALTY of the constraint term of the starting point's problem. CVXOPT's
@@ -1185,21 +1202,11 @@ mod tests {
             ineq: &ineq,
             h: &[0.0],
         };
-        let cons = stacked(qp.eq, qp.ineq);
-        let normal = Normal::new(qp.quad, qp.quad_weight, &cons, 0).expect("normal matrix");
+        let normal = Normal::new(qp.quad, qp.quad_weight, &stacked(qp.eq, qp.ineq), 0)
+            .expect("normal matrix");
         let label = &normal.label;
-        let (eq, ineq) = (
-            relabel_columns(qp.eq, label),
-            relabel_columns(qp.ineq, label),
-        );
-        let cons = stacked(&eq, &ineq);
-        let c = relabel_vector(qp.c, label);
-        let qp = Qp {
-            c: &c,
-            eq: &eq,
-            ineq: &ineq,
-            ..qp
-        };
+        let relabelled = Relabelled::new(&qp, label);
+        let (qp, cons) = (relabelled.qp(&qp), &relabelled.cons);
         let mut space =
             FactorSpace::new(&normal.symbolic, normal.p_values.len()).expect("factor space");
         let x = relabel_vector(&[2.0, 1e-3], label);
@@ -1212,7 +1219,7 @@ mod tests {
         let polished = polish(
             &qp,
             &normal,
-            &cons,
+            cons,
             &point,
             &Tolerances::default(),
             &mut space,
