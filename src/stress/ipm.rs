@@ -774,7 +774,9 @@ fn polish(
     let mut active: Vec<bool> = (0..m).map(|i| z[i] > s[i]).collect();
     for _ in 0..POLISH_ROUNDS {
         let step = polish_step(qp, normal, cons, point, &active, tol, space)?;
-        let kkt = Kkt::new(qp, normal, &step.x, &step.lambda, &step.s, &step.z);
+        let clipped = |v: &[f64]| v.iter().map(|v| v.max(0.0)).collect::<Vec<f64>>();
+        let (s_new, z_new) = (clipped(&step.slack), clipped(&step.multiplier));
+        let kkt = Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new);
         if kkt.within(tol, 1.0) {
             return Some(step.x);
         }
@@ -799,14 +801,11 @@ fn polish(
     None
 }
 
-/// The Newton step of `polish` for one guess of the active set: the new point, with slacks
-/// and multipliers clipped at 0, and the unclipped values that show where the guess was
-/// wrong.
+/// The Newton step of `polish` for one guess of the active set. Slacks and multipliers are
+/// left unclipped: their signs show where the guess was wrong.
 struct PolishStep {
     x: Vec<f64>,
     lambda: Vec<f64>,
-    s: Vec<f64>,
-    z: Vec<f64>,
     /// G x − h per inequality row.
     slack: Vec<f64>,
     /// The multiplier of each active row before clipping (0 on inactive rows).
@@ -855,8 +854,6 @@ fn polish_step(
     Some(PolishStep {
         x: x_new,
         lambda: lambda_new,
-        s: slack.iter().map(|v| v.max(0.0)).collect(),
-        z: multiplier.iter().map(|v| v.max(0.0)).collect(),
         slack,
         multiplier,
     })
