@@ -602,6 +602,24 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Per inequality row, the factor that turns its scaled slack back into the caller's units,
+/// up to one common factor (the median row scale). The starting point is built in those units:
+/// the stress QPs' rows bound force densities (and τ), commensurate in the caller's units, while the
+/// unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
+/// times larger than an interior edge's (a combination of Airy values). Mehrotra's uniform
+/// shift in the scaled units then started the boundary edges' slacks hundreds of times below
+/// their optimum (Cas-size dome: 65 against 3600; 50k: against 55 000), and the iterations
+/// spent 15 steps of 0.2–0.7 letting them grow. The iterates are otherwise invariant to the
+/// row scaling, which stays for the linear algebra.
+fn caller_units(row_scale: &[f64]) -> Vec<f64> {
+    let mut sorted = row_scale.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2) else {
+        return Vec::new();
+    };
+    row_scale.iter().map(|r| median / r).collect()
+}
+
 /// Solves the QP after equilibration: variables scaled so that the normal matrix at W = I has
 /// a unit diagonal, constraint rows scaled to unit norm. Weights and Airy values, boundary-edge
 /// forces and hole coefficients differ by orders of magnitude; unscaled, the factorisation
@@ -626,6 +644,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     let ones_q = vec![1.0; qp.quad.nrows()];
     let re = unit_rows(qp.eq, &d);
     let ri = unit_rows(qp.ineq, &d);
+    let start_units = caller_units(&ri);
     let quad = scaled(qp.quad, &d, &ones_q);
     let eq = scaled(qp.eq, &d, &re);
     let ineq = scaled(qp.ineq, &d, &ri);
@@ -643,6 +662,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances) -> IpmOutput {
             ineq: &ineq,
             h: &h,
         },
+        &start_units,
         tol,
     );
     out.x.iter_mut().zip(&d).for_each(|(x, d)| *x *= d);
@@ -859,7 +879,7 @@ fn polish_step(
     })
 }
 
-fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
+fn solve_scaled(qp: &Qp, start_units: &[f64], tol: &Tolerances) -> IpmOutput {
     let n = qp.c.len();
     let cons = stacked(qp.eq, qp.ineq);
     let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, qp.eq.nrows()) else {
@@ -871,7 +891,13 @@ fn solve_scaled(qp: &Qp, tol: &Tolerances) -> IpmOutput {
     };
     // The iterations work in the factor's labels: no vector is permuted per solve.
     let relabelled = Relabelled::new(qp, &normal.label);
-    let mut out = iterate(&relabelled.qp(qp), &normal, &relabelled.cons, tol);
+    let mut out = iterate(
+        &relabelled.qp(qp),
+        &normal,
+        &relabelled.cons,
+        start_units,
+        tol,
+    );
     out.x = normal.label.iter().map(|&l| out.x[l]).collect();
     out
 }
@@ -914,8 +940,16 @@ impl Relabelled {
 /// left free_vault's dual residual 5× above its tolerance (it fell back to clarabel).
 const START_PENALTY: f64 = 100.0;
 
-/// The interior-point iterations on a QP whose unknowns are in `normal`'s labels.
-fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput {
+/// The interior-point iterations on a QP whose unknowns are in `normal`'s labels; the
+/// starting point is built with inequality row i's slack multiplied by `start_units[i]` (see
+/// `caller_units`).
+fn iterate(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    start_units: &[f64],
+    tol: &Tolerances,
+) -> IpmOutput {
     let n = qp.c.len();
     let m_eq = qp.eq.nrows();
     let m = qp.ineq.nrows();
@@ -940,8 +974,9 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
     };
 
     // Starting point (as CVXOPT, with the constraint term weighted down by START_PENALTY):
-    // minimise ½xᵀPx + cᵀx + ½‖Gx − h‖² / START_PENALTY subject to Ex = f, take the slacks
-    // s = Gx − h and the duals z = −s, then shift both into the positive orthant.
+    // minimise ½xᵀPx + cᵀx + ½‖U(Gx − h)‖² / START_PENALTY subject to Ex = f, take the slacks
+    // s = Gx − h and the duals z = −s, then shift both into the positive orthant; all in the
+    // caller's units (U = diag(start_units)), converted back at the end.
     let minus_c: Vec<f64> = qp.c.iter().map(|c| -c).collect();
     let mut rhs = qp.f.to_vec();
     rhs.extend_from_slice(qp.h);
@@ -949,24 +984,24 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
     let Some(mut space) = FactorSpace::new(&normal.symbolic, normal.p_values.len()) else {
         return fail(vec![0.0; n], 0, None);
     };
+    let penalty: Vec<f64> = start_units
+        .iter()
+        .map(|u| START_PENALTY / (u * u))
+        .collect();
     let start = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(
-            normal,
-            cons,
-            with_eq_zeros(&vec![START_PENALTY; m]),
-            reg,
-            &mut space,
-        )?
-        .solve(&minus_c, &rhs, 1e-8)
+        Newton::new(normal, cons, with_eq_zeros(&penalty), reg, &mut space)?
+            .solve(&minus_c, &rhs, 1e-8)
     });
     let Some([mut x, mut w]) = start else {
         return fail(vec![0.0; n], 0, None);
     };
-    // The solve returns w = (Gx − h) / START_PENALTY on the inequality rows.
+    // The solve returns w = (Gx − h) / penalty on the inequality rows.
     let s_hat: Vec<f64> = w
         .split_off(m_eq)
         .iter()
-        .map(|v| v * START_PENALTY)
+        .zip(&penalty)
+        .zip(start_units)
+        .map(|((w, p), u)| w * p * u)
         .collect();
     let mut lambda: Vec<f64> = w.iter().map(|v| -v).collect();
     // Mehrotra's shift: into the positive orthant, then balanced so that s ∘ z starts centred.
@@ -981,8 +1016,12 @@ fn iterate(qp: &Qp, normal: &Normal, cons: &Csr, tol: &Tolerances) -> IpmOutput 
     let (sum_s, sum_z) = (s.iter().sum::<f64>(), z.iter().sum::<f64>());
     let ds = if sum_z > 0.0 { 0.5 * sz / sum_z } else { 1.0 };
     let dz = if sum_s > 0.0 { 0.5 * sz / sum_s } else { 1.0 };
-    s.iter_mut().for_each(|v| *v += ds.max(1e-8));
-    z.iter_mut().for_each(|v| *v += dz.max(1e-8));
+    s.iter_mut()
+        .zip(start_units)
+        .for_each(|(v, u)| *v = (*v + ds.max(1e-8)) / u);
+    z.iter_mut()
+        .zip(start_units)
+        .for_each(|(v, u)| *v = (*v + dz.max(1e-8)) * u);
 
     for iteration in 0..tol.max_iter {
         let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
