@@ -604,8 +604,8 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
 
 /// Per inequality row, the factor that turns its scaled slack back into the caller's units,
 /// up to one common factor (the median row scale). The starting point is built in those units:
-/// the stress QPs' rows bound force densities (and τ), commensurate in the caller's units, while the
-/// unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
+/// the stress QPs' rows bound force densities (and τ), commensurate as the caller states them,
+/// while the unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
 /// times larger than an interior edge's (a combination of Airy values). Mehrotra's uniform
 /// shift in the scaled units then started the boundary edges' slacks hundreds of times below
 /// their optimum (Cas-size dome: 65 against 3600; 50k: against 55 000), and the iterations
@@ -792,8 +792,9 @@ fn polish(
     let Point { s, z, .. } = *point;
     let m = s.len();
     let mut active: Vec<bool> = (0..m).map(|i| z[i] > s[i]).collect();
+    let from = PolishFrom::new(qp, normal, point);
     for _ in 0..POLISH_ROUNDS {
-        let step = polish_step(qp, normal, cons, point, &active, tol, space)?;
+        let step = polish_step(qp, normal, cons, &from, &active, tol, space)?;
         let clipped = |v: &[f64]| v.iter().map(|v| v.max(0.0)).collect::<Vec<f64>>();
         let (s_new, z_new) = (clipped(&step.slack), clipped(&step.multiplier));
         let kkt = Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new);
@@ -832,31 +833,53 @@ struct PolishStep {
     multiplier: Vec<f64>,
 }
 
+/// The iterate `polish` starts from, with the parts of its Newton right-hand side that do not
+/// depend on the active-set guess, computed once for all its rounds.
+struct PolishFrom<'a> {
+    point: Point<'a>,
+    /// P x + c − Eᵀλ: the dual residual before the active rows' Gᵀz.
+    dual_before_g: Vec<f64>,
+    /// The constraint rows: f − E x, then h − G x.
+    b2: Vec<f64>,
+}
+
+impl<'a> PolishFrom<'a> {
+    fn new(qp: &Qp, normal: &Normal, point: &Point<'a>) -> PolishFrom<'a> {
+        let Point { x, lambda, .. } = *point;
+        let n = x.len();
+        let px = normal.mul_p(x);
+        let et_l = mul_t(qp.eq, lambda, n);
+        let dual_before_g = (0..n).map(|i| px[i] + qp.c[i] - et_l[i]).collect();
+        let mut b2: Vec<f64> = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| b - a).collect();
+        b2.extend(qp.ineq.mul(x).iter().zip(qp.h).map(|(a, b)| b - a));
+        PolishFrom {
+            point: *point,
+            dual_before_g,
+            b2,
+        }
+    }
+}
+
 fn polish_step(
     qp: &Qp,
     normal: &Normal,
     cons: &Csr,
-    point: &Point,
+    from: &PolishFrom,
     active: &[bool],
     tol: &Tolerances,
     space: &mut FactorSpace,
 ) -> Option<PolishStep> {
-    let Point { x, lambda, z, .. } = *point;
+    let Point { x, lambda, z, .. } = from.point;
     let (n, m_eq, m) = (x.len(), qp.eq.nrows(), z.len());
     let z_active: Vec<f64> = (0..m).map(|i| if active[i] { z[i] } else { 0.0 }).collect();
-    let px = normal.mul_p(x);
-    let et_l = mul_t(qp.eq, lambda, n);
     let gt_z = mul_t(qp.ineq, &z_active, n);
-    let b1: Vec<f64> = (0..n)
-        .map(|i| -(px[i] + qp.c[i] - et_l[i] - gt_z[i]))
-        .collect();
-    let mut b2: Vec<f64> = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| b - a).collect();
-    b2.extend(qp.ineq.mul(x).iter().zip(qp.h).map(|(a, b)| b - a));
+    let b1: Vec<f64> = (0..n).map(|i| -(from.dual_before_g[i] - gt_z[i])).collect();
+    let b2 = &from.b2;
     // D = 0 holds a row as an equality; a huge D drops it (its multiplier is D⁻¹ × residual).
     let mut d = vec![0.0; m_eq];
     d.extend(active.iter().map(|&a| if a { 0.0 } else { 1e30 }));
     let [dx, w] = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(normal, cons, d.clone(), reg, space)?.solve(&b1, &b2, 1e-2 * tol.feas)
+        Newton::new(normal, cons, d.clone(), reg, space)?.solve(&b1, b2, 1e-2 * tol.feas)
     })?;
     let x_new: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
     let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
@@ -934,7 +957,8 @@ impl Relabelled {
 
 /// Weight 1 / START_PENALTY of the constraint term of the starting point's problem. CVXOPT's
 /// weight 1 pulls every force density towards its bound, so that nearly every constraint
-/// starts out looking active; measured on generated domes with a hole, 100 took the iterations
+/// starts out looking active; measured on generated domes with a hole (with the start still in
+/// the unit-norm row scaling, before `caller_units`), 100 took the iterations
 /// from 29 to 22 at 6k unknowns, 34 to 31 at 20k, 46 to 34 at 50k and 79 to 39 at 100k, and
 /// cost the shared models 0 to 6 more (11–25 in all). 10 and 1000 did less well at 100k; 30
 /// left free_vault's dual residual 5× above its tolerance (it fell back to clarabel).
