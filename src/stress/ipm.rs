@@ -769,6 +769,24 @@ struct Point<'a> {
 const POLISH_ROUNDS: usize = 3;
 const POLISH_CORRECTABLE: usize = 200;
 
+/// Why `polish` did not reach the optimum, which decides when it is worth another attempt
+/// (each costs a factorisation and several solves).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PolishFailure {
+    /// The guess had more wrong rows than a round may correct, or kept finding new ones. One
+    /// more iteration usually settles it (lilium, groin), and where the gap stalls at its
+    /// rounding floor (the last form-finding steps on cheese, objective ~0) a later guess
+    /// is the way out: retried at the next iteration.
+    EarlyGuess,
+    /// No row was wrong, yet the step missed the tolerances (or its solve failed): the active
+    /// set is right but the factor cannot resolve it that finely. At 100k unknowns this
+    /// repeated at every iteration from the 21st to the 27th: retried only once the gap has
+    /// fallen by `INEXACT_RETRY`.
+    Inexact,
+}
+
+const INEXACT_RETRY: f64 = 1e-2;
+
 /// The optimum for the active set the iterate suggests (inequalities with z > s held as
 /// equalities, the others dropped), accepted only if it meets every KKT condition: the
 /// inactive inequalities hold and the active ones have non-negative multipliers. It is a
@@ -788,18 +806,19 @@ fn polish(
     point: &Point,
     tol: &Tolerances,
     space: &mut FactorSpace,
-) -> Option<Vec<f64>> {
+) -> Result<Vec<f64>, PolishFailure> {
     let Point { s, z, .. } = *point;
     let m = s.len();
     let mut active: Vec<bool> = (0..m).map(|i| z[i] > s[i]).collect();
     let from = PolishFrom::new(qp, normal, point);
     for _ in 0..POLISH_ROUNDS {
-        let step = polish_step(qp, normal, cons, &from, &active, tol, space)?;
+        let step = polish_step(qp, normal, cons, &from, &active, tol, space)
+            .ok_or(PolishFailure::Inexact)?;
         let clipped = |v: &[f64]| v.iter().map(|v| v.max(0.0)).collect::<Vec<f64>>();
         let (s_new, z_new) = (clipped(&step.slack), clipped(&step.multiplier));
         let kkt = Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new);
         if kkt.within(tol, 1.0) {
-            return Some(step.x);
+            return Ok(step.x);
         }
         let (violation, negative) = (tol.feas * kkt.ineq_scale, tol.dual_feas * kkt.dual_scale);
         let wrong: Vec<usize> = (0..m)
@@ -812,14 +831,17 @@ fn polish(
             })
             .collect();
         let n_active = active.iter().filter(|&&a| a).count();
-        if wrong.is_empty() || wrong.len() > 3.max(n_active / POLISH_CORRECTABLE) {
-            return None;
+        if wrong.is_empty() {
+            return Err(PolishFailure::Inexact);
+        }
+        if wrong.len() > 3.max(n_active / POLISH_CORRECTABLE) {
+            return Err(PolishFailure::EarlyGuess);
         }
         for i in wrong {
             active[i] = !active[i];
         }
     }
-    None
+    Err(PolishFailure::EarlyGuess)
 }
 
 /// The Newton step of `polish` for one guess of the active set. Slacks and multipliers are
@@ -1047,6 +1069,8 @@ fn iterate(
         .zip(start_units)
         .for_each(|(v, u)| *v = (*v + dz.max(1e-8)) * u);
 
+    // Polishing is tried only while the gap is below this (see `PolishFailure`).
+    let mut polish_below = f64::INFINITY;
     for iteration in 0..tol.max_iter {
         let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
         if !kkt.objective.is_finite() || inf_norm(&x) > 1e15 {
@@ -1065,19 +1089,23 @@ fn iterate(
         // Close to the optimum the active set is plain to see: solving for it directly ends
         // the iterations the gap would otherwise need to creep down to the tolerance, which
         // near a zero objective is at the edge of double precision.
-        if kkt.near(tol) {
+        if kkt.near(tol) && kkt.gap <= polish_below {
             let point = Point {
                 x: &x,
                 lambda: &lambda,
                 s: &s,
                 z: &z,
             };
-            if let Some(x) = polish(qp, normal, cons, &point, tol, &mut space) {
-                return IpmOutput {
-                    x,
-                    status: IpmStatus::Solved,
-                    iterations: iteration + 1,
-                };
+            match polish(qp, normal, cons, &point, tol, &mut space) {
+                Ok(x) => {
+                    return IpmOutput {
+                        x,
+                        status: IpmStatus::Solved,
+                        iterations: iteration + 1,
+                    }
+                }
+                Err(PolishFailure::EarlyGuess) => polish_below = f64::INFINITY,
+                Err(PolishFailure::Inexact) => polish_below = INEXACT_RETRY * kkt.gap,
             }
         }
         let Kkt {
@@ -1241,6 +1269,32 @@ mod tests {
         assert!((out.x[1] - 2.3).abs() < 1e-8, "{:?}", out.x);
     }
 
+    /// `polish` from the iterate (x, s, z) (no equality rows), in the caller's labels.
+    fn polish_at(
+        qp: &Qp,
+        x: &[f64],
+        s: &[f64],
+        z: &[f64],
+        tol: &Tolerances,
+    ) -> Result<Vec<f64>, PolishFailure> {
+        let normal = Normal::new(qp.quad, qp.quad_weight, &stacked(qp.eq, qp.ineq), 0)
+            .expect("normal matrix");
+        let label = &normal.label;
+        let relabelled = Relabelled::new(qp, label);
+        let (qp, cons) = (relabelled.qp(qp), &relabelled.cons);
+        let mut space =
+            FactorSpace::new(&normal.symbolic, normal.p_values.len()).expect("factor space");
+        let x = relabel_vector(x, label);
+        let point = Point {
+            x: &x,
+            lambda: &[],
+            s,
+            z,
+        };
+        let polished = polish(&qp, &normal, cons, &point, tol, &mut space)?;
+        Ok(label.iter().map(|&l| polished[l]).collect())
+    }
+
     /// min (x0 − 2)² + (x1 + 10⁻⁶)² subject to x1 ≥ 0: the bound is active at the optimum
     /// (2, 0) with the tiny multiplier 2·10⁻⁶. At an iterate that has not told it apart yet
     /// (s = 10⁻³ > z = 10⁻⁷) the plain guess drops it and its step lands at x1 = −10⁻⁶,
@@ -1248,45 +1302,64 @@ mod tests {
     #[test]
     fn polishing_corrects_a_wrongly_dropped_row() {
         let quad = csr(2, &[&[(0, 1.0)], &[(1, 1.0)]]);
-        let weight = [2.0, 2.0];
-        let c = [-4.0, 2e-6];
-        let eq = csr(2, &[]);
-        let ineq = csr(2, &[&[(1, 1.0)]]);
         let qp = Qp {
             quad: &quad,
-            quad_weight: &weight,
-            c: &c,
+            quad_weight: &[2.0, 2.0],
+            c: &[-4.0, 2e-6],
             constant: 4.0 + 1e-12,
-            eq: &eq,
+            eq: &csr(2, &[]),
             f: &[],
-            ineq: &ineq,
+            ineq: &csr(2, &[&[(1, 1.0)]]),
             h: &[0.0],
         };
-        let normal = Normal::new(qp.quad, qp.quad_weight, &stacked(qp.eq, qp.ineq), 0)
-            .expect("normal matrix");
-        let label = &normal.label;
-        let relabelled = Relabelled::new(&qp, label);
-        let (qp, cons) = (relabelled.qp(&qp), &relabelled.cons);
-        let mut space =
-            FactorSpace::new(&normal.symbolic, normal.p_values.len()).expect("factor space");
-        let x = relabel_vector(&[2.0, 1e-3], label);
-        let point = Point {
-            x: &x,
-            lambda: &[],
-            s: &[1e-3],
-            z: &[1e-7],
-        };
-        let polished = polish(
-            &qp,
-            &normal,
-            cons,
-            &point,
-            &Tolerances::default(),
-            &mut space,
-        )
-        .expect("the corrected guess is optimal");
-        let x: Vec<f64> = label.iter().map(|&l| polished[l]).collect();
+        let x = polish_at(&qp, &[2.0, 1e-3], &[1e-3], &[1e-7], &Tolerances::default())
+            .expect("the corrected guess is optimal");
         assert!((x[0] - 2.0).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
+    }
+
+    /// min Σ (x_i + 1)² subject to x ≥ 0 (four rows): every bound is active at the optimum
+    /// x = 0, with multiplier 2.
+    fn four_active_bounds<R>(run: impl FnOnce(&Qp) -> R) -> R {
+        let identity: Vec<Vec<(usize, f64)>> = (0..4).map(|i| vec![(i, 1.0)]).collect();
+        let rows: Vec<&[(usize, f64)]> = identity.iter().map(|r| r.as_slice()).collect();
+        let quad = csr(4, &rows);
+        run(&Qp {
+            quad: &quad,
+            quad_weight: &[2.0; 4],
+            c: &[2.0; 4],
+            constant: 4.0,
+            eq: &csr(4, &[]),
+            f: &[],
+            ineq: &quad,
+            h: &[0.0; 4],
+        })
+    }
+
+    /// A guess that drops all four active bounds has more wrong rows than a round may correct
+    /// (at most three here): the iterate was early, and the caller may retry next iteration.
+    #[test]
+    fn polishing_a_guess_with_too_many_wrong_rows_reports_an_early_guess() {
+        let failure = four_active_bounds(|qp| {
+            polish_at(qp, &[0.1; 4], &[0.1; 4], &[1e-3; 4], &Tolerances::default())
+        });
+        assert_eq!(failure, Err(PolishFailure::EarlyGuess));
+    }
+
+    /// The right guess with a tolerance no step can meet (a negative gap) has no wrong row,
+    /// so it is the precision that failed: the caller waits for the gap to fall before
+    /// retrying. The same guess meets the default tolerances.
+    #[test]
+    fn polishing_the_right_guess_beyond_reach_reports_inexact() {
+        let at = |tol: Tolerances| {
+            four_active_bounds(|qp| polish_at(qp, &[0.1; 4], &[1e-3; 4], &[1.0; 4], &tol))
+        };
+        let unreachable = Tolerances {
+            gap_abs: -1.0,
+            ..Tolerances::default()
+        };
+        assert_eq!(at(unreachable), Err(PolishFailure::Inexact));
+        let x = at(Tolerances::default()).expect("the right guess is optimal");
+        assert!(x.iter().all(|v| v.abs() < 1e-12), "{x:?}");
     }
 
     /// min Σ (x_{i+1} − x_i − t_i)² subject to x_{i+1} ≥ x_i and x_0 = 10⁷: the differences
