@@ -30,7 +30,7 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
     SymmetricOrdering,
 };
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::{amd, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
@@ -145,16 +145,15 @@ struct Normal {
 }
 
 /// Lower-triangle pattern (column pointers, row indices) of the products of every row's
-/// entries with each other, unknowns relabelled by `label`. Built column by column with a
-/// marker array: sorting all products at once dominated the setup.
-fn product_pattern(rows: [&Csr; 2], label: &[usize]) -> (Vec<usize>, Vec<usize>) {
-    let n = label.len();
-    // Rows holding each unknown, by its new label.
+/// entries with each other, for `n` unknowns. Built column by column with a marker array:
+/// sorting all products at once dominated the setup.
+fn product_pattern(rows: [&Csr; 2], n: usize) -> (Vec<usize>, Vec<usize>) {
+    // Rows holding each unknown.
     let mut holders: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
     for (k, m) in rows.iter().enumerate() {
         for r in 0..m.nrows() {
             for &a in &m.col[m.start[r]..m.start[r + 1]] {
-                holders[label[a]].push((k, r));
+                holders[a].push((k, r));
             }
         }
     }
@@ -168,10 +167,9 @@ fn product_pattern(rows: [&Csr; 2], label: &[usize]) -> (Vec<usize>, Vec<usize>)
         for &(k, r) in &holders[c] {
             let m = rows[k];
             for &b in &m.col[m.start[r]..m.start[r + 1]] {
-                let lb = label[b];
-                if lb > c && seen[lb] != c {
-                    seen[lb] = c;
-                    row_idx.push(lb);
+                if b > c && seen[b] != c {
+                    seen[b] = c;
+                    row_idx.push(b);
                 }
             }
         }
@@ -179,6 +177,57 @@ fn product_pattern(rows: [&Csr; 2], label: &[usize]) -> (Vec<usize>, Vec<usize>)
         col_ptr.push(row_idx.len());
     }
     (col_ptr, row_idx)
+}
+
+/// The new label of every unknown in the approximate-minimum-degree order of a symmetric
+/// pattern (its lower triangle, rows sorted in each column).
+fn amd_labels(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
+    let (mut order, mut label) = (vec![0; n], vec![0; n]);
+    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(n, row_idx.len())).ok()?;
+    amd::order(
+        &mut order,
+        &mut label,
+        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
+        amd::Control::default(),
+        MemStack::new(&mut buffer),
+    )
+    .ok()?;
+    Some(label)
+}
+
+/// The lower triangle of a symmetric pattern (given by its lower triangle) with its unknowns
+/// relabelled, rows sorted in each column.
+fn relabelled_lower(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    label: &[usize],
+) -> (Vec<usize>, Vec<usize>) {
+    let entries = || {
+        (0..n).flat_map(move |c| {
+            row_idx[col_ptr[c]..col_ptr[c + 1]].iter().map(move |&r| {
+                let (a, b) = (label[r], label[c]);
+                (a.min(b), a.max(b))
+            })
+        })
+    };
+    let mut ptr = vec![0; n + 1];
+    for (col, _) in entries() {
+        ptr[col + 1] += 1;
+    }
+    for c in 0..n {
+        ptr[c + 1] += ptr[c];
+    }
+    let mut next = ptr.clone();
+    let mut idx = vec![0; row_idx.len()];
+    for (col, row) in entries() {
+        idx[next[col]] = row;
+        next[col] += 1;
+    }
+    for c in 0..n {
+        idx[ptr[c]..ptr[c + 1]].sort_unstable();
+    }
+    (ptr, idx)
 }
 
 /// The pattern of the transpose of an n × n compressed-column pattern (rows stay sorted).
@@ -201,16 +250,17 @@ fn transpose(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> (Vec<usize>, Vec
     (ptr, idx)
 }
 
+/// The symbolic factorisation of a pattern already in its elimination order (given as an
+/// upper triangle: without an ordering faer reads it so, whatever the side).
 fn symbolic_cholesky(
     n: usize,
     col_ptr: &[usize],
     row_idx: &[usize],
-    ordering: SymmetricOrdering<'_, usize>,
 ) -> Option<SymbolicCholesky<usize>> {
     factorize_symbolic_cholesky(
         SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
         faer::Side::Lower,
-        ordering,
+        SymmetricOrdering::Identity,
         CholeskySymbolicParams {
             // The simplicial variant is several times slower on these two-ring matrices
             // even at a thousand unknowns.
@@ -225,17 +275,13 @@ impl Normal {
     /// `cons` = [E; G] with `m_eq` equality rows first.
     fn new(quad: &Csr, quad_weight: &[f64], cons: &Csr, m_eq: usize) -> Option<Normal> {
         let n = cons.ncols;
-        let identity: Vec<usize> = (0..n).collect();
-        let (col_ptr, row_idx) = product_pattern([quad, cons], &identity);
-        let amd = symbolic_cholesky(n, &col_ptr, &row_idx, SymmetricOrdering::Amd)?;
-        let label = match amd.perm() {
-            Some(perm) => perm.arrays().1.to_vec(),
-            None => identity,
-        };
-        let (col_ptr, row_idx) = product_pattern([quad, cons], &label);
-        // Without an ordering faer reads the pattern as an upper triangle, whatever the side.
+        let (col_ptr, row_idx) = product_pattern([quad, cons], n);
+        // One symbolic analysis in the new labels: the ordering alone comes from AMD, so
+        // that the pattern is not analysed twice.
+        let label = amd_labels(n, &col_ptr, &row_idx)?;
+        let (col_ptr, row_idx) = relabelled_lower(n, &col_ptr, &row_idx, &label);
         let (up_ptr, up_idx) = transpose(n, &col_ptr, &row_idx);
-        let symbolic = symbolic_cholesky(n, &up_ptr, &up_idx, SymmetricOrdering::Identity)?;
+        let symbolic = symbolic_cholesky(n, &up_ptr, &up_idx)?;
         let slot = |a: usize, b: usize| -> usize {
             let (col, row) = (label[a].min(label[b]), label[a].max(label[b]));
             let range = col_ptr[col]..col_ptr[col + 1];
