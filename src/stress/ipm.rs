@@ -203,14 +203,43 @@ fn relabelled_lower(
     row_idx: &[usize],
     label: &[usize],
 ) -> (Vec<usize>, Vec<usize>) {
-    let entries = || {
-        (0..n).flat_map(move |c| {
-            row_idx[col_ptr[c]..col_ptr[c + 1]].iter().map(move |&r| {
-                let (a, b) = (label[r], label[c]);
-                (a.min(b), a.max(b))
-            })
+    let (ptr, mut idx) = bucketed(n, row_idx.len(), || {
+        entries(col_ptr, row_idx).map(|(r, c)| {
+            let (a, b) = (label[r], label[c]);
+            (a.min(b), a.max(b))
         })
-    };
+    });
+    for c in 0..n {
+        idx[ptr[c]..ptr[c + 1]].sort_unstable();
+    }
+    (ptr, idx)
+}
+
+/// The pattern of the transpose of an n × n compressed-column pattern (rows stay sorted: the
+/// entries come column by column).
+fn transpose(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> (Vec<usize>, Vec<usize>) {
+    bucketed(n, row_idx.len(), || entries(col_ptr, row_idx))
+}
+
+/// The (row, column) entries of a compressed-column pattern, column by column.
+fn entries<'a>(
+    col_ptr: &'a [usize],
+    row_idx: &'a [usize],
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    (0..col_ptr.len() - 1).flat_map(move |c| {
+        row_idx[col_ptr[c]..col_ptr[c + 1]]
+            .iter()
+            .map(move |&r| (r, c))
+    })
+}
+
+/// A compressed-column pattern of n columns from `nnz` (column, row) entries, rows in the
+/// order the entries come (`entries` is called twice: to count, then to fill).
+fn bucketed<I: Iterator<Item = (usize, usize)>>(
+    n: usize,
+    nnz: usize,
+    entries: impl Fn() -> I,
+) -> (Vec<usize>, Vec<usize>) {
     let mut ptr = vec![0; n + 1];
     for (col, _) in entries() {
         ptr[col + 1] += 1;
@@ -219,33 +248,10 @@ fn relabelled_lower(
         ptr[c + 1] += ptr[c];
     }
     let mut next = ptr.clone();
-    let mut idx = vec![0; row_idx.len()];
+    let mut idx = vec![0; nnz];
     for (col, row) in entries() {
         idx[next[col]] = row;
         next[col] += 1;
-    }
-    for c in 0..n {
-        idx[ptr[c]..ptr[c + 1]].sort_unstable();
-    }
-    (ptr, idx)
-}
-
-/// The pattern of the transpose of an n × n compressed-column pattern (rows stay sorted).
-fn transpose(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> (Vec<usize>, Vec<usize>) {
-    let mut ptr = vec![0; n + 1];
-    for &r in row_idx {
-        ptr[r + 1] += 1;
-    }
-    for c in 0..n {
-        ptr[c + 1] += ptr[c];
-    }
-    let mut next = ptr.clone();
-    let mut idx = vec![0; row_idx.len()];
-    for c in 0..n {
-        for &r in &row_idx[col_ptr[c]..col_ptr[c + 1]] {
-            idx[next[r]] = c;
-            next[r] += 1;
-        }
     }
     (ptr, idx)
 }
