@@ -864,7 +864,7 @@ fn polish(
 ) -> Result<Vec<f64>, PolishFailure> {
     let Point { s, z, .. } = *point;
     let m = s.len();
-    let mut active: Vec<bool> = (0..m).map(|i| z[i] > s[i]).collect();
+    let mut active = active_guess(s, z);
     let from = PolishFrom::new(qp, normal, point);
     for _ in 0..POLISH_ROUNDS {
         let step = polish_step(qp, normal, cons, &from, &active, tol, space)
@@ -897,6 +897,12 @@ fn polish(
         }
     }
     Err(PolishFailure::EarlyGuess)
+}
+
+/// The active set an iterate suggests: the inequality rows whose multiplier exceeds their
+/// slack.
+fn active_guess(s: &[f64], z: &[f64]) -> Vec<bool> {
+    s.iter().zip(z).map(|(s, z)| z > s).collect()
 }
 
 /// The Newton step of `polish` for one guess of the active set. Slacks and multipliers are
@@ -1126,6 +1132,10 @@ fn iterate(
 
     // Polishing is tried only while the gap is below this (see `PolishFailure`).
     let mut polish_below = f64::INFINITY;
+    // The guess of the last attempt that failed with an early guess: the same guess from
+    // another iterate leads to the same step (a QP's Newton step lands on the optimum for its
+    // active set wherever it starts), so it fails again (dome with doors: iterations 14, 15).
+    let mut failed_guess: Option<Vec<bool>> = None;
     for iteration in 0..tol.max_iter {
         let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
         if !kkt.objective.is_finite() || inf_norm(&x) > 1e15 {
@@ -1144,7 +1154,10 @@ fn iterate(
         // Close to the optimum the active set is plain to see: solving for it directly ends
         // the iterations the gap would otherwise need to creep down to the tolerance, which
         // near a zero objective is at the edge of double precision.
-        if kkt.near(tol) && kkt.gap <= polish_below {
+        if kkt.near(tol)
+            && kkt.gap <= polish_below
+            && failed_guess.as_deref() != Some(&active_guess(&s, &z)[..])
+        {
             let point = Point {
                 x: &x,
                 lambda: &lambda,
@@ -1159,8 +1172,14 @@ fn iterate(
                         iterations: iteration + 1,
                     }
                 }
-                Err(PolishFailure::EarlyGuess) => polish_below = f64::INFINITY,
-                Err(PolishFailure::Inexact) => polish_below = INEXACT_RETRY * kkt.gap,
+                Err(PolishFailure::EarlyGuess) => {
+                    polish_below = f64::INFINITY;
+                    failed_guess = Some(active_guess(&s, &z));
+                }
+                Err(PolishFailure::Inexact) => {
+                    polish_below = INEXACT_RETRY * kkt.gap;
+                    failed_guess = None;
+                }
             }
         }
         let Kkt {
