@@ -806,12 +806,11 @@ const DUAL_ROUNDING: f64 = 10.0;
 const POLISH_FEAS: f64 = 1e3;
 const POLISH_GAP: f64 = 1e-5;
 
-/// A primal–dual iterate.
+/// The iterate polishing starts from (its slacks only enter through the active-set guess).
 #[derive(Clone, Copy)]
 struct Point<'a> {
     x: &'a [f64],
     lambda: &'a [f64],
-    s: &'a [f64],
     z: &'a [f64],
 }
 
@@ -842,8 +841,8 @@ enum PolishFailure {
 /// instead of every one from 20 to 27; 41 → 37 factorisations, as counted).
 const INEXACT_RETRY: f64 = 1e-2;
 
-/// The optimum for the active set the iterate suggests (inequalities with z > s held as
-/// equalities, the others dropped), accepted only if it meets every KKT condition: the
+/// The optimum for the active set `guess` (see `active_guess`: inequalities with z > s held
+/// as equalities, the others dropped), accepted only if it meets every KKT condition: the
 /// inactive inequalities hold and the active ones have non-negative multipliers. It is a
 /// Newton step from the iterate, so it corrects the iterate's multipliers rather than
 /// computing new ones: when the active rows are dependent any combination would balance,
@@ -859,12 +858,12 @@ fn polish(
     normal: &Normal,
     cons: &Csr,
     point: &Point,
+    guess: &[bool],
     tol: &Tolerances,
     space: &mut FactorSpace,
 ) -> Result<Vec<f64>, PolishFailure> {
-    let Point { s, z, .. } = *point;
-    let m = s.len();
-    let mut active = active_guess(s, z);
+    let m = guess.len();
+    let mut active = guess.to_vec();
     let from = PolishFrom::new(qp, normal, point);
     for _ in 0..POLISH_ROUNDS {
         let step = polish_step(qp, normal, cons, &from, &active, tol, space)
@@ -1154,17 +1153,14 @@ fn iterate(
         // Close to the optimum the active set is plain to see: solving for it directly ends
         // the iterations the gap would otherwise need to creep down to the tolerance, which
         // near a zero objective is at the edge of double precision.
-        if kkt.near(tol)
-            && kkt.gap <= polish_below
-            && failed_guess.as_deref() != Some(&active_guess(&s, &z)[..])
-        {
+        let guess = (kkt.near(tol) && kkt.gap <= polish_below).then(|| active_guess(&s, &z));
+        if let Some(guess) = guess.filter(|g| failed_guess.as_ref() != Some(g)) {
             let point = Point {
                 x: &x,
                 lambda: &lambda,
-                s: &s,
                 z: &z,
             };
-            match polish(qp, normal, cons, &point, tol, &mut space) {
+            match polish(qp, normal, cons, &point, &guess, tol, &mut space) {
                 Ok(x) => {
                     return IpmOutput {
                         x,
@@ -1174,7 +1170,7 @@ fn iterate(
                 }
                 Err(PolishFailure::EarlyGuess) => {
                     polish_below = f64::INFINITY;
-                    failed_guess = Some(active_guess(&s, &z));
+                    failed_guess = Some(guess);
                 }
                 Err(PolishFailure::Inexact) => {
                     polish_below = INEXACT_RETRY * kkt.gap;
@@ -1362,10 +1358,10 @@ mod tests {
         let point = Point {
             x: &x,
             lambda: &[],
-            s,
             z,
         };
-        let polished = polish(&qp, &normal, cons, &point, tol, &mut space)?;
+        let guess = active_guess(s, z);
+        let polished = polish(&qp, &normal, cons, &point, &guess, tol, &mut space)?;
         Ok(label.iter().map(|&l| polished[l]).collect())
     }
 
