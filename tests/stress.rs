@@ -513,3 +513,44 @@ fn native_qp_is_not_slowed_by_a_free_hole_rim() {
     assert_eq!(r.solver, QpSolver::Native);
     assert!(r.iterations <= 19, "{} QP iterations", r.iterations);
 }
+
+/// One cache across stress steps gives exactly the answers of fresh ones: reused for a moved
+/// shape of the same mesh, replaced when the structure changes (an upper bound adds rows,
+/// another mesh), and reused again after that.
+#[test]
+fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
+    let dome = Problem::new(polar_cap(10, 1.3));
+    let lowered: Vec<[f64; 3]> = dome
+        .mesh
+        .positions
+        .iter()
+        .map(|p| [p[0], p[1], 0.8 * p[2]])
+        .collect();
+    let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
+    let plain = StressSettings {
+        solver: QpSolver::Native,
+        ..StressSettings::default()
+    };
+    let bounded = StressSettings {
+        q_max: Some(QBound::Relative(1.0)),
+        ..plain.clone()
+    };
+    let steps = [
+        (&dome, &dome.mesh.positions, &plain),
+        (&dome, &lowered, &plain),
+        (&dome, &lowered, &bounded),
+        (&arc, &arc.mesh.positions, &plain),
+        (&dome, &dome.mesh.positions, &plain),
+        (&dome, &lowered, &plain),
+    ];
+    let mut cache = stress::StressCache::default();
+    for (k, &(problem, positions, settings)) in steps.iter().enumerate() {
+        let cached =
+            stress::analyse_cached(problem, positions, settings, None, &mut cache).unwrap();
+        let fresh = stress::analyse_at(problem, positions, settings).unwrap();
+        assert_eq!(cached.solver, QpSolver::Native, "step {k}");
+        assert_eq!(cached.iterations, fresh.iterations, "step {k}");
+        assert_eq!(cached.force_densities, fresh.force_densities, "step {k}");
+        assert_eq!(cached.residuals, fresh.residuals, "step {k}");
+    }
+}

@@ -5,7 +5,8 @@ use crate::error::Result;
 use crate::problem::Problem;
 use crate::shape::{Schedule, ShapeStep};
 use crate::stress::{
-    analyse_near, EdgeScope, Prior, QBound, StressResult, StressSettings, StressStatus,
+    analyse_cached, EdgeScope, Prior, QBound, StressCache, StressResult, StressSettings,
+    StressStatus,
 };
 use std::time::Instant;
 
@@ -140,6 +141,8 @@ pub fn form_find(
     let mut last: Option<StressResult> = None;
     let mut termination = Termination::MaxIterations;
     let fans = crate::smooth::vertex_faces(mesh);
+    // The mesh keeps its connectivity: the steps share one ordering and symbolic analysis.
+    let mut cache = StressCache::default();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
             let t = Instant::now();
@@ -170,7 +173,7 @@ pub fn form_find(
         } else {
             &settings.stress
         };
-        let stress = analyse_near(problem, &positions, stress_settings, prior)?;
+        let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         stress_s += t.elapsed().as_secs_f64();
         history.push(stress.eps_inf);
         let status = stress.status;

@@ -125,23 +125,67 @@ impl Default for Tolerances {
     }
 }
 
-/// The normal matrix P + Cᵀ W C (lower triangle, compressed columns) with the value slot of
-/// every product c_ia c_ib of each constraint row precomputed, and its symbolic factorisation.
-/// It is stored with its unknowns relabelled in fill-reducing order (`label[i]` is the new
-/// index of unknown i), so that no numeric factorisation has to permute it again.
-struct Normal {
+/// The structure of the normal matrix P + Cᵀ W C (lower triangle, compressed columns): its
+/// fill-reducing relabelling (`label[i]` is the new index of unknown i, so that no numeric
+/// factorisation has to permute it again), its symbolic factorisation and the value slot of
+/// every product q_ka q_kb and c_ia c_ib. It depends only on where P's rows and C have entries,
+/// which form finding keeps from step to step, so a `PatternCache` carries it across steps.
+struct Pattern {
+    /// Row starts and columns of P's rows and of C, and C's equality row count: the input
+    /// this pattern was built from.
+    key: [Vec<usize>; 5],
     n: usize,
     m_eq: usize,
     label: Vec<usize>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    /// Values of P alone.
-    p_values: Vec<f64>,
-    /// Per constraint row: (slot, c_ia c_ib) for its products.
+    /// Slot of each product of P's rows, in the order `products` visits them.
+    quad_slot: Vec<usize>,
+    /// Per constraint row, from `row_start[r]`: the slot of each of its products.
     row_start: Vec<usize>,
-    row_slot: Vec<(usize, f64)>,
+    row_slot: Vec<usize>,
     diag: Vec<usize>,
     symbolic: SymbolicCholesky<usize>,
+}
+
+/// The normal matrix's structure, kept between QPs of the same structure (the steps of one
+/// form finding): its ordering and symbolic analysis are then done once per loop instead of
+/// once per step. Empty by default; a QP of another structure replaces what it holds.
+#[derive(Default)]
+pub struct PatternCache(Option<Pattern>);
+
+impl PatternCache {
+    /// The pattern of P + Cᵀ W C for these matrices: the one held if it was built from the
+    /// same structure, else a new one (None if the ordering or analysis failed).
+    fn pattern(&mut self, quad: &Csr, cons: &Csr, m_eq: usize) -> Option<&Pattern> {
+        let key = Pattern::key(quad, cons, m_eq);
+        if self.0.as_ref().is_none_or(|p| p.key != key) {
+            self.0 = None;
+            self.0 = Some(Pattern::new(key, quad, cons, m_eq)?);
+        }
+        self.0.as_ref()
+    }
+}
+
+/// The normal matrix: the values of P and of each constraint row's products, on a `Pattern`.
+struct Normal<'p> {
+    pattern: &'p Pattern,
+    /// Values of P alone, in the pattern's slots.
+    p_values: Vec<f64>,
+    /// c_ia c_ib for the slots `pattern.row_slot`.
+    row_prod: Vec<f64>,
+}
+
+/// Every pair of entries (a, v_a), (b, v_b) with b ≤ a of each row r of `m`, as
+/// (r, a, b, v_a, v_b), row by row: the order of `Pattern::quad_slot` and `row_slot`.
+fn products(m: &Csr) -> impl Iterator<Item = (usize, usize, usize, f64, f64)> + '_ {
+    (0..m.nrows()).flat_map(move |r| {
+        m.row(r).flat_map(move |(a, va)| {
+            m.row(r)
+                .filter(move |&(b, _)| b <= a)
+                .map(move |(b, vb)| (r, a, b, va, vb))
+        })
+    })
 }
 
 /// Lower-triangle pattern (column pointers, row indices) of the products of every row's
@@ -277,9 +321,19 @@ fn symbolic_cholesky(
     .ok()
 }
 
-impl Normal {
+impl Pattern {
+    fn key(quad: &Csr, cons: &Csr, m_eq: usize) -> [Vec<usize>; 5] {
+        [
+            quad.start.clone(),
+            quad.col.clone(),
+            cons.start.clone(),
+            cons.col.clone(),
+            vec![m_eq, cons.ncols],
+        ]
+    }
+
     /// `cons` = [E; G] with `m_eq` equality rows first.
-    fn new(quad: &Csr, quad_weight: &[f64], cons: &Csr, m_eq: usize) -> Option<Normal> {
+    fn new(key: [Vec<usize>; 5], quad: &Csr, cons: &Csr, m_eq: usize) -> Option<Pattern> {
         let n = cons.ncols;
         let (col_ptr, row_idx) = product_pattern([quad, cons], n);
         // One symbolic analysis in the new labels: the ordering alone comes from AMD, so
@@ -296,37 +350,50 @@ impl Normal {
                     .binary_search(&row)
                     .expect("entry in the pattern")
         };
-        let mut p_values = vec![0.0; row_idx.len()];
-        for (r, &w) in quad_weight.iter().enumerate() {
-            for (a, va) in quad.row(r) {
-                for (b, vb) in quad.row(r).filter(|&(b, _)| b <= a) {
-                    p_values[slot(a, b)] += w * va * vb;
-                }
-            }
-        }
-        let mut row_start = vec![0];
+        let quad_slot = products(quad).map(|(_, a, b, ..)| slot(a, b)).collect();
         let mut row_slot = Vec::new();
+        let mut row_start = vec![0];
         for r in 0..cons.nrows() {
-            for (a, va) in cons.row(r) {
-                for (b, vb) in cons.row(r).filter(|&(b, _)| b <= a) {
-                    row_slot.push((slot(a, b), va * vb));
-                }
+            for (a, _) in cons.row(r) {
+                row_slot.extend(
+                    cons.row(r)
+                        .filter(|&(b, _)| b <= a)
+                        .map(|(b, _)| slot(a, b)),
+                );
             }
             row_start.push(row_slot.len());
         }
         let diag = (0..n).map(|i| slot(i, i)).collect();
-        Some(Normal {
+        Some(Pattern {
+            key,
             n,
             m_eq,
             label,
             col_ptr,
             row_idx,
-            p_values,
+            quad_slot,
             row_start,
             row_slot,
             diag,
             symbolic,
         })
+    }
+}
+
+impl<'p> Normal<'p> {
+    /// The values of P (rows of `quad` weighted by `quad_weight`) and of C's products on
+    /// `pattern`, which was built from the same structure.
+    fn new(pattern: &'p Pattern, quad: &Csr, quad_weight: &[f64], cons: &Csr) -> Normal<'p> {
+        let mut p_values = vec![0.0; pattern.row_idx.len()];
+        for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(products(quad)) {
+            p_values[slot] += quad_weight[r] * va * vb;
+        }
+        let row_prod = products(cons).map(|(.., va, vb)| va * vb).collect();
+        Normal {
+            pattern,
+            p_values,
+            row_prod,
+        }
     }
 
     /// y = |P| |x| (entrywise absolute values): the size of the terms summed in P x.
@@ -341,12 +408,14 @@ impl Normal {
 
     /// y_r = Σ_c term(P_rc, x_c) over the full symmetric P, from its lower triangle.
     fn sum_p_terms(&self, x: &[f64], term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
-        let mut y = vec![0.0; self.n];
-        for c in 0..self.n {
+        let mut y = vec![0.0; self.pattern.n];
+        let Pattern {
+            col_ptr, row_idx, ..
+        } = self.pattern;
+        for c in 0..self.pattern.n {
             let mut acc = 0.0;
-            for k in self.col_ptr[c]..self.col_ptr[c + 1] {
-                let r = self.row_idx[k];
-                let v = self.p_values[k];
+            let range = col_ptr[c]..col_ptr[c + 1];
+            for (&r, &v) in row_idx[range.clone()].iter().zip(&self.p_values[range]) {
                 y[r] += term(v, x[c]);
                 if r != c {
                     acc += term(v, x[r]);
@@ -412,7 +481,7 @@ const REGULARISATION: [f64; 3] = [1e-12, 1e-9, 1e-6];
 ///
 /// solved with the factor of P + Cᵀ (D + δ)⁻¹ C, then refined against the exact system.
 struct Newton<'a> {
-    normal: &'a Normal,
+    normal: &'a Normal<'a>,
     cons: &'a Csr,
     /// D per constraint row, and the weights 1 / (D + δ) the factor uses.
     d: Vec<f64>,
@@ -447,37 +516,42 @@ impl FactorSpace {
 
 impl<'a> Newton<'a> {
     fn new(
-        normal: &'a Normal,
+        normal: &'a Normal<'a>,
         cons: &'a Csr,
         d: Vec<f64>,
         reg: f64,
         space: &'a mut FactorSpace,
     ) -> Option<Newton<'a>> {
-        let n = normal.n;
+        let pattern = normal.pattern;
+        let n = pattern.n;
         let w_reg: Vec<f64> = d
             .iter()
             .enumerate()
-            .map(|(r, d)| 1.0 / (d + if r < normal.m_eq { DELTA_EQ } else { DELTA }))
+            .map(|(r, d)| 1.0 / (d + if r < pattern.m_eq { DELTA_EQ } else { DELTA }))
             .collect();
         let values = &mut space.values;
         values.copy_from_slice(&normal.p_values);
         for (r, &w) in w_reg.iter().enumerate() {
-            for &(slot, prod) in &normal.row_slot[normal.row_start[r]..normal.row_start[r + 1]] {
+            let range = pattern.row_start[r]..pattern.row_start[r + 1];
+            for (&slot, &prod) in pattern.row_slot[range.clone()]
+                .iter()
+                .zip(&normal.row_prod[range])
+            {
                 values[slot] += w * prod;
             }
         }
         // A static regularisation keeps columns that only inactive bounds hold (pivots
         // ~ z/s → 0) away from zero; refinement removes its effect.
-        for &k in &normal.diag {
+        for &k in &pattern.diag {
             values[k] += reg;
         }
         let matrix = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &normal.col_ptr, None, &normal.row_idx),
+            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx),
             &values[..],
         );
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
-        let factored = normal.symbolic.factorize_numeric_ldlt(
+        let factored = pattern.symbolic.factorize_numeric_ldlt(
             &mut space.l_values,
             matrix,
             faer::Side::Lower,
@@ -502,12 +576,12 @@ impl<'a> Newton<'a> {
 
     /// One solve with the regularised factor.
     fn approximate(&mut self, b1: &[f64], b2: &[f64]) -> [Vec<f64>; 2] {
-        let n = self.normal.n;
+        let n = self.normal.pattern.n;
         let t: Vec<f64> = b2.iter().zip(&self.w_reg).map(|(b, w)| b * w).collect();
         let mut dx = mul_t(self.cons, &t, n);
         dx.iter_mut().zip(b1).for_each(|(x, b)| *x += b);
         let space = &mut *self.space;
-        let ldlt = LdltRef::new(&self.normal.symbolic, &space.l_values);
+        let ldlt = LdltRef::new(&self.normal.pattern.symbolic, &space.l_values);
         ldlt.solve_in_place_with_conj(
             Conj::No,
             MatMut::from_column_major_slice_mut(&mut dx, n, 1),
@@ -538,11 +612,11 @@ impl<'a> Newton<'a> {
         b2: &[f64],
         tol: f64,
     ) -> Option<[Vec<f64>; 2]> {
-        let n = self.normal.n;
+        let n = self.normal.pattern.n;
         // Equality rows count as they are (their violation is what matters), inequality rows
         // as they enter dx (times their weight): inactive ones carry huge right-hand sides
         // whose rounding does not matter.
-        let m_eq = self.normal.m_eq;
+        let m_eq = self.normal.pattern.m_eq;
         let w_reg = self.w_reg.clone();
         let weighted = |b1: &[f64], b2: &[f64]| {
             b2.iter()
@@ -675,8 +749,9 @@ fn caller_units(row_scale: &[f64]) -> Vec<f64> {
 /// Solves the QP after equilibration: variables scaled so that the normal matrix at W = I has
 /// a unit diagonal, constraint rows scaled to unit norm. Weights and Airy values, boundary-edge
 /// forces and hole coefficients differ by orders of magnitude; unscaled, the factorisation
-/// loses the accuracy the last iterations need.
-pub fn solve(qp: &Qp, tol: &Tolerances) -> IpmOutput {
+/// loses the accuracy the last iterations need. `cache` holds the normal matrix's structure
+/// from an earlier QP of the same structure, and is left holding this one's.
+pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
     let n = qp.c.len();
     let mut diag = vec![0.0; n];
     for (r, &w) in qp.quad_weight.iter().enumerate() {
@@ -716,6 +791,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances) -> IpmOutput {
         },
         &start_units,
         tol,
+        cache,
     );
     out.x.iter_mut().zip(&d).for_each(|(x, d)| *x *= d);
     out
@@ -984,18 +1060,24 @@ fn polish_step(
     })
 }
 
-fn solve_scaled(qp: &Qp, start_units: &[f64], tol: &Tolerances) -> IpmOutput {
+fn solve_scaled(
+    qp: &Qp,
+    start_units: &[f64],
+    tol: &Tolerances,
+    cache: &mut PatternCache,
+) -> IpmOutput {
     let n = qp.c.len();
     let cons = stacked(qp.eq, qp.ineq);
-    let Some(normal) = Normal::new(qp.quad, qp.quad_weight, &cons, qp.eq.nrows()) else {
+    let Some(pattern) = cache.pattern(qp.quad, &cons, qp.eq.nrows()) else {
         return IpmOutput {
             x: vec![0.0; n],
             status: IpmStatus::NumericalError,
             iterations: 0,
         };
     };
+    let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
     // The iterations work in the factor's labels: no vector is permuted per solve.
-    let relabelled = Relabelled::new(qp, &normal.label);
+    let relabelled = Relabelled::new(qp, &normal.pattern.label);
     let mut out = iterate(
         &relabelled.qp(qp),
         &normal,
@@ -1003,7 +1085,7 @@ fn solve_scaled(qp: &Qp, start_units: &[f64], tol: &Tolerances) -> IpmOutput {
         start_units,
         tol,
     );
-    out.x = normal.label.iter().map(|&l| out.x[l]).collect();
+    out.x = normal.pattern.label.iter().map(|&l| out.x[l]).collect();
     out
 }
 
@@ -1087,7 +1169,7 @@ fn iterate(
     let mut rhs = qp.f.to_vec();
     rhs.extend_from_slice(qp.h);
     // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
-    let Some(mut space) = FactorSpace::new(&normal.symbolic, normal.p_values.len()) else {
+    let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
         return fail(vec![0.0; n], 0, None);
     };
     let penalty: Vec<f64> = start_units
@@ -1333,6 +1415,7 @@ mod tests {
                 h: &[1.8],
             },
             &Tolerances::default(),
+            &mut PatternCache::default(),
         );
         assert_eq!(out.status, IpmStatus::Solved);
         assert!((out.x[0] - 1.8).abs() < 1e-8, "{:?}", out.x);
@@ -1347,13 +1430,15 @@ mod tests {
         z: &[f64],
         tol: &Tolerances,
     ) -> Result<Vec<f64>, PolishFailure> {
-        let normal = Normal::new(qp.quad, qp.quad_weight, &stacked(qp.eq, qp.ineq), 0)
-            .expect("normal matrix");
-        let label = &normal.label;
+        let cons = stacked(qp.eq, qp.ineq);
+        let mut cache = PatternCache::default();
+        let pattern = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+        let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
+        let label = &normal.pattern.label;
         let relabelled = Relabelled::new(qp, label);
         let (qp, cons) = (relabelled.qp(qp), &relabelled.cons);
-        let mut space =
-            FactorSpace::new(&normal.symbolic, normal.p_values.len()).expect("factor space");
+        let mut space = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len())
+            .expect("factor space");
         let x = relabel_vector(x, label);
         let point = Point {
             x: &x,
@@ -1466,6 +1551,7 @@ mod tests {
                 h: &vec![0.0; n - 1],
             },
             &Tolerances::default(),
+            &mut PatternCache::default(),
         );
         assert_eq!(out.status, IpmStatus::Solved);
         for (i, t) in target.iter().enumerate() {
@@ -1515,6 +1601,7 @@ mod tests {
                 h: &vec![0.0; n],
             },
             &Tolerances::default(),
+            &mut PatternCache::default(),
         );
         assert_eq!(out.status, IpmStatus::Solved);
         for block in 0..n / 4 {

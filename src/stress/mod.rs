@@ -170,6 +170,34 @@ pub fn analyse_near(
     settings: &StressSettings,
     prior: Option<Prior>,
 ) -> Result<StressResult> {
+    analyse_cached(
+        problem,
+        positions,
+        settings,
+        prior,
+        &mut StressCache::default(),
+    )
+}
+
+/// What a stress step leaves for the next one on the same mesh: the structure of the native
+/// solver's normal matrix (its fill-reducing ordering and symbolic factorisation), which
+/// depends on the mesh's connectivity and the settings but not on the positions. Opaque;
+/// `Default` is empty, and a step of another structure replaces what it holds.
+#[derive(Default)]
+pub struct StressCache {
+    normal: ipm::PatternCache,
+}
+
+/// [`analyse_near`] reusing, and updating, `cache`: form finding's steps keep one cache, so
+/// that only the first step (and the first with a proximal centre) orders and analyses the
+/// normal matrix. The results are the same as without the cache.
+pub fn analyse_cached(
+    problem: &Problem,
+    positions: &[[f64; 3]],
+    settings: &StressSettings,
+    prior: Option<Prior>,
+    cache: &mut StressCache,
+) -> Result<StressResult> {
     settings.validate()?;
     let start = Instant::now();
     let mesh = &problem.mesh;
@@ -305,7 +333,7 @@ pub fn analyse_near(
             lift_forces,
         };
         let out = match solver {
-            Native => qp::solve_native(&input),
+            Native => qp::solve_native(&input, &mut cache.normal),
             Clarabel => {
                 clarabel_tries += 1;
                 qp::solve_clarabel(&input)

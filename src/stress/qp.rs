@@ -294,8 +294,8 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
 
 /// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
 /// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
-/// matrix lives in y space. `lift_forces` does not apply.
-pub fn solve_native(inp: &QpInput) -> QpOutput {
+/// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`.
+pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
     let n_y = inp.s.ncols;
     let n_vertices = inp.u.len();
     let mut tau_col = vec![None; n_vertices];
@@ -412,6 +412,7 @@ pub fn solve_native(inp: &QpInput) -> QpOutput {
             h: &h,
         },
         &ipm::Tolerances::for_size(n),
+        cache,
     );
     let tau = tau_col
         .iter()
