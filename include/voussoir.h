@@ -776,7 +776,8 @@ VsrStatus vsr_result_eps_history(const struct VsrResult *result, double *out, si
 /**
  * Summary of the (last) stress step: `status` (a `VsrStressStatus`), `eps_inf` = max |r_i| /
  * mean p_i over non-anchored vertices (dimensionless), `objective` = Σ r_i² (force²), and
- * `qp_iterations` of the interior-point solver. All four pointers required; written only on
+ * `qp_iterations` of the interior-point solver (0 when a form-finding step was solved from
+ * the previous step's active set alone). All four pointers required; written only on
  * success.
  *
  * # Safety

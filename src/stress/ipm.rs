@@ -64,6 +64,8 @@ pub struct IpmOutput {
     pub x: Vec<f64>,
     pub status: IpmStatus,
     pub iterations: u32,
+    /// Per inequality row, whether it is active at `x` (empty unless solved).
+    pub active: Vec<bool>,
 }
 
 /// Tolerances: the gap sᵀz must fall below `gap_abs + gap_rel |objective|`, the primal
@@ -152,18 +154,23 @@ struct Pattern {
 /// form finding): its ordering and symbolic analysis are then done once per loop instead of
 /// once per step. Empty by default; a QP of another structure replaces what it holds.
 #[derive(Default)]
-pub struct PatternCache(Option<Pattern>);
+pub struct PatternCache {
+    pattern: Option<Pattern>,
+    /// The last answer on this pattern, in the caller's units, and its active set.
+    last: Option<(Vec<f64>, Vec<bool>)>,
+}
 
 impl PatternCache {
     /// The pattern of P + Cᵀ W C for these matrices: the one held if it was built from the
-    /// same structure, else a new one (None if the ordering or analysis failed).
-    fn pattern(&mut self, quad: &Csr, cons: &Csr, m_eq: usize) -> Option<&Pattern> {
+    /// same structure (true), else a new one (false; None if the ordering or analysis failed).
+    fn pattern(&mut self, quad: &Csr, cons: &Csr, m_eq: usize) -> Option<(&Pattern, bool)> {
         let key = Pattern::key(quad, cons, m_eq);
-        if self.0.as_ref().is_none_or(|p| p.key != key) {
-            self.0 = None;
-            self.0 = Some(Pattern::new(key, quad, cons, m_eq)?);
+        let reused = self.pattern.as_ref().is_some_and(|p| p.key == key);
+        if !reused {
+            self.pattern = None;
+            self.pattern = Some(Pattern::new(key, quad, cons, m_eq)?);
         }
-        self.0.as_ref()
+        self.pattern.as_ref().map(|p| (p, reused))
     }
 }
 
@@ -772,6 +779,10 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
     let re = unit_rows(qp.eq, &d);
     let ri = unit_rows(qp.ineq, &d);
     let start_units = caller_units(&ri);
+    let warm = cache.last.take().map(|(x, active)| {
+        let x: Vec<f64> = x.iter().zip(&d).map(|(x, d)| x / d).collect();
+        (x, active)
+    });
     let quad = scaled(qp.quad, &d, &ones_q);
     let eq = scaled(qp.eq, &d, &re);
     let ineq = scaled(qp.ineq, &d, &ri);
@@ -792,8 +803,12 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
         &start_units,
         tol,
         cache,
+        warm,
     );
     out.x.iter_mut().zip(&d).for_each(|(x, d)| *x *= d);
+    if out.status == IpmStatus::Solved {
+        cache.last = Some((out.x.clone(), out.active.clone()));
+    }
     out
 }
 
@@ -890,11 +905,27 @@ struct Point<'a> {
     z: &'a [f64],
 }
 
-/// Rounds of active-set correction in `polish`, and the share of the active rows a round
-/// may correct: more wrong rows than that mean dependent active rows or an early guess, and
-/// further rounds only chased them (cheese: each round made more rows wrong).
+/// How many wrong rows `polish` corrects, and for how many rounds (rows the step violates
+/// join the active set, rows whose multiplier comes out negative leave it).
+#[derive(Clone, Copy)]
+enum Corrections {
+    /// From an iterate's guess: a few rows, up to `POLISH_ROUNDS` times; more wrong rows
+    /// than a share 1 / `POLISH_CORRECTABLE` of the active ones mean dependent active rows
+    /// or an early guess, and further rounds only chased them (cheese: each round made more
+    /// rows wrong).
+    Few,
+    /// From the previous form-finding step's active set (a primal–dual active-set method):
+    /// every wrong row, up to `WARM_ROUNDS` times, while their number at least halves each
+    /// round. Between late steps tens to hundreds of rows change, mostly bounds to release:
+    /// on the Cas-size dome and lilium the last 6–7 steps converged this way in 1–4 rounds
+    /// (Cas: 234 → 25 → 10 → 1 wrong rows), while on early steps the count fell by less
+    /// than half or grew from the second round on, and an attempt then costs two
+    /// factorisations.
+    AllWhileFewer,
+}
 const POLISH_ROUNDS: usize = 3;
 const POLISH_CORRECTABLE: usize = 200;
+const WARM_ROUNDS: usize = 8;
 
 /// Why `polish` did not reach the optimum, which decides when it is worth another attempt
 /// (each costs a factorisation and several solves).
@@ -924,9 +955,8 @@ const INEXACT_RETRY: f64 = 1e-2;
 /// computing new ones: when the active rows are dependent any combination would balance,
 /// and a fresh one need not be non-negative.
 ///
-/// A guess with a few wrong rows is corrected, up to `POLISH_ROUNDS` times: rows the step
-/// violates join the active set, rows whose multiplier comes out negative leave it. The
-/// plain guess goes wrong on degenerate rows (s and z both tending to 0): on the generated
+/// A guess with wrong rows is corrected as `corrections` says. An iterate's plain guess goes
+/// wrong on degenerate rows (s and z both tending to 0): on the generated
 /// groin vault one row with s = 7e-4, z = 2e-8 was violated by 1e-2 at every attempt, and
 /// the gap needed five more iterations to close.
 fn polish(
@@ -934,21 +964,26 @@ fn polish(
     normal: &Normal,
     cons: &Csr,
     point: &Point,
-    guess: &[bool],
+    (guess, corrections): (&[bool], Corrections),
     tol: &Tolerances,
     space: &mut FactorSpace,
-) -> Result<Vec<f64>, PolishFailure> {
+) -> Result<(Vec<f64>, Vec<bool>), PolishFailure> {
     let m = guess.len();
     let mut active = guess.to_vec();
     let from = PolishFrom::new(qp, normal, point);
-    for _ in 0..POLISH_ROUNDS {
+    let rounds = match corrections {
+        Corrections::Few => POLISH_ROUNDS,
+        Corrections::AllWhileFewer => WARM_ROUNDS,
+    };
+    let mut last_wrong = usize::MAX;
+    for _ in 0..rounds {
         let step = polish_step(qp, normal, cons, &from, &active, tol, space)
             .ok_or(PolishFailure::Inexact)?;
         let clipped = |v: &[f64]| v.iter().map(|v| v.max(0.0)).collect::<Vec<f64>>();
         let (s_new, z_new) = (clipped(&step.slack), clipped(&step.multiplier));
         let kkt = Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new);
         if kkt.within(tol, 1.0) {
-            return Ok(step.x);
+            return Ok((step.x, active));
         }
         let (violation, negative) = (tol.feas * kkt.ineq_scale, tol.dual_feas * kkt.dual_scale);
         let wrong: Vec<usize> = (0..m)
@@ -960,13 +995,20 @@ fn polish(
                 }
             })
             .collect();
-        let n_active = active.iter().filter(|&&a| a).count();
         if wrong.is_empty() {
             return Err(PolishFailure::Inexact);
         }
-        if wrong.len() > 3.max(n_active / POLISH_CORRECTABLE) {
+        let correctable = match corrections {
+            Corrections::Few => {
+                let n_active = active.iter().filter(|&&a| a).count();
+                3.max(n_active / POLISH_CORRECTABLE)
+            }
+            Corrections::AllWhileFewer => last_wrong / 2,
+        };
+        if wrong.len() > correctable {
             return Err(PolishFailure::EarlyGuess);
         }
+        last_wrong = wrong.len();
         for i in wrong {
             active[i] = !active[i];
         }
@@ -1065,25 +1107,31 @@ fn solve_scaled(
     start_units: &[f64],
     tol: &Tolerances,
     cache: &mut PatternCache,
+    warm: Option<(Vec<f64>, Vec<bool>)>,
 ) -> IpmOutput {
     let n = qp.c.len();
     let cons = stacked(qp.eq, qp.ineq);
-    let Some(pattern) = cache.pattern(qp.quad, &cons, qp.eq.nrows()) else {
+    let Some((pattern, reused)) = cache.pattern(qp.quad, &cons, qp.eq.nrows()) else {
         return IpmOutput {
             x: vec![0.0; n],
             status: IpmStatus::NumericalError,
             iterations: 0,
+            active: Vec::new(),
         };
     };
     let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
     // The iterations work in the factor's labels: no vector is permuted per solve.
     let relabelled = Relabelled::new(qp, &normal.pattern.label);
+    let warm = warm
+        .filter(|_| reused)
+        .map(|(x, active)| (relabel_vector(&x, &normal.pattern.label), active));
     let mut out = iterate(
         &relabelled.qp(qp),
         &normal,
         &relabelled.cons,
         start_units,
         tol,
+        warm.as_ref().map(|(x, a)| (&x[..], &a[..])),
     );
     out.x = normal.pattern.label.iter().map(|&l| out.x[l]).collect();
     out
@@ -1137,6 +1185,7 @@ fn iterate(
     cons: &Csr,
     start_units: &[f64],
     tol: &Tolerances,
+    warm: Option<(&[f64], &[bool])>,
 ) -> IpmOutput {
     let n = qp.c.len();
     let m_eq = qp.eq.nrows();
@@ -1148,11 +1197,13 @@ fn iterate(
             x,
             status: IpmStatus::AlmostSolved,
             iterations,
+            active: Vec::new(),
         },
         None => IpmOutput {
             x,
             status: IpmStatus::NumericalError,
             iterations,
+            active: Vec::new(),
         },
     };
     let with_eq_zeros = |d: &[f64]| -> Vec<f64> {
@@ -1172,6 +1223,35 @@ fn iterate(
     let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
         return fail(vec![0.0; n], 0, None);
     };
+    // A form-finding step first tries the previous step's active set: where it is nearly
+    // right, a few active-set corrections reach the optimum for a fraction of the
+    // iterations' cost. Only x and the active set are carried over: the step computes the
+    // multipliers afresh, from zero.
+    if let Some((x0, guess)) = warm {
+        let (lambda0, z0) = (vec![0.0; m_eq], vec![0.0; m]);
+        let point = Point {
+            x: x0,
+            lambda: &lambda0,
+            z: &z0,
+        };
+        let warm = polish(
+            qp,
+            normal,
+            cons,
+            &point,
+            (guess, Corrections::AllWhileFewer),
+            tol,
+            &mut space,
+        );
+        if let Ok((x, active)) = warm {
+            return IpmOutput {
+                x,
+                status: IpmStatus::Solved,
+                iterations: 0,
+                active,
+            };
+        }
+    }
     let penalty: Vec<f64> = start_units
         .iter()
         .map(|u| START_PENALTY / (u * u))
@@ -1230,6 +1310,7 @@ fn iterate(
                 x,
                 status: IpmStatus::Solved,
                 iterations: iteration,
+                active: active_guess(&s, &z),
             };
         }
         // Close to the optimum the active set is plain to see: solving for it directly ends
@@ -1242,12 +1323,21 @@ fn iterate(
                 lambda: &lambda,
                 z: &z,
             };
-            match polish(qp, normal, cons, &point, &guess, tol, &mut space) {
-                Ok(x) => {
+            match polish(
+                qp,
+                normal,
+                cons,
+                &point,
+                (&guess, Corrections::Few),
+                tol,
+                &mut space,
+            ) {
+                Ok((x, active)) => {
                     return IpmOutput {
                         x,
                         status: IpmStatus::Solved,
                         iterations: iteration + 1,
+                        active,
                     }
                 }
                 Err(PolishFailure::EarlyGuess) => {
@@ -1372,11 +1462,13 @@ fn iterate(
             x,
             status: IpmStatus::AlmostSolved,
             iterations: tol.max_iter,
+            active: Vec::new(),
         },
         None => IpmOutput {
             x,
             status: IpmStatus::MaxIterations,
             iterations: tol.max_iter,
+            active: Vec::new(),
         },
     }
 }
@@ -1432,7 +1524,7 @@ mod tests {
     ) -> Result<Vec<f64>, PolishFailure> {
         let cons = stacked(qp.eq, qp.ineq);
         let mut cache = PatternCache::default();
-        let pattern = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+        let (pattern, _) = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
         let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
         let label = &normal.pattern.label;
         let relabelled = Relabelled::new(qp, label);
@@ -1446,7 +1538,15 @@ mod tests {
             z,
         };
         let guess = active_guess(s, z);
-        let polished = polish(&qp, &normal, cons, &point, &guess, tol, &mut space)?;
+        let (polished, _) = polish(
+            &qp,
+            &normal,
+            cons,
+            &point,
+            (&guess, Corrections::Few),
+            tol,
+            &mut space,
+        )?;
         Ok(label.iter().map(|&l| polished[l]).collect())
     }
 

@@ -91,6 +91,8 @@ pub struct StressResult {
     /// Σ r_i² over non-anchored vertices.
     pub objective: f64,
     pub force_diagram: ForceDiagram,
+    /// Iterations of the QP solver; 0 when the native solver reached the optimum from the
+    /// previous step's active set alone (see [`analyse_cached`]).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
     /// every reduced attempt failed numerically.
@@ -181,8 +183,9 @@ pub fn analyse_near(
 
 /// What a stress step leaves for the next one on the same mesh: the structure of the native
 /// solver's normal matrix (its fill-reducing ordering and symbolic factorisation), which
-/// depends on the mesh's connectivity and the settings but not on the positions. Opaque;
-/// `Default` is empty, and a step of another structure replaces what it holds.
+/// depends on the mesh's connectivity and the settings but not on the positions, and the last
+/// answer with its active bounds. Opaque; `Default` is empty, and a step of another
+/// structure replaces what it holds.
 #[derive(Default)]
 pub struct StressCache {
     normal: ipm::PatternCache,
@@ -190,7 +193,11 @@ pub struct StressCache {
 
 /// [`analyse_near`] reusing, and updating, `cache`: form finding's steps keep one cache, so
 /// that only the first step (and the first with a proximal centre) orders and analyses the
-/// normal matrix. The results are the same as without the cache.
+/// normal matrix, and each later step first tries the previous step's active set (bounds
+/// held as equalities), corrected a few times; only if that does not meet the solver's
+/// tolerances do the interior-point iterations run. Either way the answer meets the same
+/// optimality tolerances as without the cache (the optimum itself, not necessarily the same
+/// point where the optimum is not unique).
 pub fn analyse_cached(
     problem: &Problem,
     positions: &[[f64; 3]],
