@@ -514,18 +514,21 @@ fn native_qp_is_not_slowed_by_a_free_hole_rim() {
     assert!(r.iterations <= 19, "{} QP iterations", r.iterations);
 }
 
+/// The mesh's positions with every height multiplied by `factor`.
+fn heights_scaled(mesh: &Mesh, factor: f64) -> Vec<[f64; 3]> {
+    mesh.positions
+        .iter()
+        .map(|p| [p[0], p[1], factor * p[2]])
+        .collect()
+}
+
 /// One cache across stress steps gives the answers of fresh ones: reused for a moved shape of
 /// the same mesh (the solve then starts from the previous step's active set), replaced when
 /// the structure changes (an upper bound adds rows, another mesh), and reused after that.
 #[test]
 fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     let dome = Problem::new(polar_cap(10, 1.3));
-    let lowered: Vec<[f64; 3]> = dome
-        .mesh
-        .positions
-        .iter()
-        .map(|p| [p[0], p[1], 0.8 * p[2]])
-        .collect();
+    let lowered = heights_scaled(&dome.mesh, 0.8);
     let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
     let plain = StressSettings {
         solver: QpSolver::Native,
@@ -569,12 +572,7 @@ fn a_slightly_moved_shape_is_solved_from_the_previous_active_set() {
     let first =
         stress::analyse_cached(&dome, &dome.mesh.positions, &settings, None, &mut cache).unwrap();
     assert!(first.iterations > 0);
-    let raised: Vec<[f64; 3]> = dome
-        .mesh
-        .positions
-        .iter()
-        .map(|p| [p[0], p[1], 1.01 * p[2]])
-        .collect();
+    let raised = heights_scaled(&dome.mesh, 1.01);
     let warm = stress::analyse_cached(&dome, &raised, &settings, None, &mut cache).unwrap();
     let cold = stress::analyse_at(&dome, &raised, &settings).unwrap();
     assert_eq!(warm.solver, QpSolver::Native);
