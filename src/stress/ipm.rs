@@ -133,9 +133,9 @@ impl Default for Tolerances {
 /// every product q_ka q_kb and c_ia c_ib. It depends only on where P's rows and C have entries,
 /// which form finding keeps from step to step, so a `PatternCache` carries it across steps.
 struct Pattern {
-    /// Row starts and columns of P's rows and of C, and C's equality row count: the input
-    /// this pattern was built from.
-    key: [Vec<usize>; 5],
+    /// Row starts and columns of P's rows and of C: with `n` and `m_eq`, the structure this
+    /// pattern was built from.
+    built_from: [Vec<usize>; 4],
     n: usize,
     m_eq: usize,
     label: Vec<usize>,
@@ -164,11 +164,13 @@ impl PatternCache {
     /// The pattern of P + Cᵀ W C for these matrices: the one held if it was built from the
     /// same structure (true), else a new one (false; None if the ordering or analysis failed).
     fn pattern(&mut self, quad: &Csr, cons: &Csr, m_eq: usize) -> Option<(&Pattern, bool)> {
-        let key = Pattern::key(quad, cons, m_eq);
-        let reused = self.pattern.as_ref().is_some_and(|p| p.key == key);
+        let reused = self
+            .pattern
+            .as_ref()
+            .is_some_and(|p| p.fits(quad, cons, m_eq));
         if !reused {
             self.pattern = None;
-            self.pattern = Some(Pattern::new(key, quad, cons, m_eq)?);
+            self.pattern = Some(Pattern::new(quad, cons, m_eq)?);
         }
         self.pattern.as_ref().map(|p| (p, reused))
     }
@@ -329,18 +331,17 @@ fn symbolic_cholesky(
 }
 
 impl Pattern {
-    fn key(quad: &Csr, cons: &Csr, m_eq: usize) -> [Vec<usize>; 5] {
-        [
-            quad.start.clone(),
-            quad.col.clone(),
-            cons.start.clone(),
-            cons.col.clone(),
-            vec![m_eq, cons.ncols],
-        ]
+    /// Whether the pattern was built from matrices with entries where `quad` and `cons` have
+    /// them (compared in place: no copy per step).
+    fn fits(&self, quad: &Csr, cons: &Csr, m_eq: usize) -> bool {
+        let [quad_start, quad_col, cons_start, cons_col] = &self.built_from;
+        (self.n, self.m_eq) == (cons.ncols, m_eq)
+            && (quad_start, quad_col) == (&quad.start, &quad.col)
+            && (cons_start, cons_col) == (&cons.start, &cons.col)
     }
 
     /// `cons` = [E; G] with `m_eq` equality rows first.
-    fn new(key: [Vec<usize>; 5], quad: &Csr, cons: &Csr, m_eq: usize) -> Option<Pattern> {
+    fn new(quad: &Csr, cons: &Csr, m_eq: usize) -> Option<Pattern> {
         let n = cons.ncols;
         let (col_ptr, row_idx) = product_pattern([quad, cons], n);
         // One symbolic analysis in the new labels: the ordering alone comes from AMD, so
@@ -358,21 +359,23 @@ impl Pattern {
                     .expect("entry in the pattern")
         };
         let quad_slot = products(quad).map(|(_, a, b, ..)| slot(a, b)).collect();
-        let mut row_slot = Vec::new();
+        let row_slot: Vec<usize> = products(cons).map(|(_, a, b, ..)| slot(a, b)).collect();
+        // A row's columns are distinct (`Csr::push_row` merges repeats): k entries, k(k+1)/2
+        // products.
         let mut row_start = vec![0];
         for r in 0..cons.nrows() {
-            for (a, _) in cons.row(r) {
-                row_slot.extend(
-                    cons.row(r)
-                        .filter(|&(b, _)| b <= a)
-                        .map(|(b, _)| slot(a, b)),
-                );
-            }
-            row_start.push(row_slot.len());
+            let k = cons.start[r + 1] - cons.start[r];
+            row_start.push(row_start[r] + k * (k + 1) / 2);
         }
+        debug_assert_eq!(row_start[cons.nrows()], row_slot.len());
         let diag = (0..n).map(|i| slot(i, i)).collect();
         Some(Pattern {
-            key,
+            built_from: [
+                quad.start.clone(),
+                quad.col.clone(),
+                cons.start.clone(),
+                cons.col.clone(),
+            ],
             n,
             m_eq,
             label,
