@@ -750,9 +750,10 @@ fn abs_mul_t(a: &Csr, y: &[f64], n: usize) -> Vec<f64> {
 /// out_c = Σ_r term(a_rc, y_r) for a Csr A with `n` columns.
 fn sum_t_terms(a: &Csr, y: &[f64], n: usize, term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
     let mut out = vec![0.0; n];
-    for (r, &yr) in y.iter().enumerate() {
-        for k in a.start[r]..a.start[r + 1] {
-            out[a.col[k]] += term(a.val[k], yr);
+    for (bounds, &yr) in a.start.windows(2).zip(y) {
+        let range = bounds[0]..bounds[1];
+        for (&c, &v) in a.col[range.clone()].iter().zip(&a.val[range]) {
+            out[c] += term(v, yr);
         }
     }
     out
