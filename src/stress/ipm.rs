@@ -1543,6 +1543,44 @@ mod tests {
         m
     }
 
+    /// Every product of a row's entries lands in the slot of its (row, column) pair in the
+    /// relabelled lower triangle, for rows of several lengths over a shuffled set of columns.
+    #[test]
+    fn product_slots_point_at_their_entries() {
+        let n = 40;
+        // A deterministic scramble of columns: rows of 1–12 distinct entries.
+        let mut seed = 12345u64;
+        let mut next = |k: usize| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 33) as usize % k
+        };
+        let mut rows = |count: usize| {
+            let mut m = Csr::new(n);
+            for _ in 0..count {
+                let len = 1 + next(12);
+                m.push_row((0..len).map(|_| (next(n), 1.0 + next(5) as f64)).collect());
+            }
+            m
+        };
+        let (quad, cons) = (rows(30), rows(25));
+        let pattern = Pattern::new(&quad, &cons, 3).expect("pattern");
+        for (m, slots) in [(&quad, &pattern.quad_slot), (&cons, &pattern.row_slot)] {
+            let pairs: Vec<(usize, usize)> = products(m).map(|(_, a, b, ..)| (a, b)).collect();
+            assert_eq!(pairs.len(), slots.len());
+            for (&(a, b), &slot) in pairs.iter().zip(slots.iter()) {
+                let (col, row) = (pattern.label[a], pattern.label[b]);
+                let (col, row) = (col.min(row), col.max(row));
+                assert!((pattern.col_ptr[col]..pattern.col_ptr[col + 1]).contains(&slot));
+                assert_eq!(pattern.row_idx[slot], row, "product ({a}, {b})");
+            }
+        }
+        for (i, &slot) in pattern.diag.iter().enumerate() {
+            assert_eq!(pattern.row_idx[slot], pattern.label[i]);
+        }
+    }
+
     /// min (x0 − 1)² + (x1 − 2)² + (x0 + x1 − 4)²  s.t. x0 − x1 = −0.5, x0 ≥ 1.8: on the
     /// line x1 = x0 + 0.5 the objective is least at x0 = 19/12 < 1.8, so the bound binds.
     #[test]
