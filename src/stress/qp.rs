@@ -386,8 +386,10 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
     // S_e y ≥ lower, −S_e y ≥ −upper, τ ≥ 0.
     let mut ineq = Csr::new(n);
     let mut h = Vec::new();
+    let mut lower_row = vec![usize::MAX; inp.edges.len()];
     for (e, bound) in inp.bounds.iter().enumerate() {
         if let Some((lower, upper)) = bound {
+            lower_row[e] = ineq.nrows();
             ineq.push_row(inp.s.row(e).collect());
             h.push(*lower);
             if upper.is_finite() {
@@ -400,6 +402,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
         ineq.push_row(vec![(*col, 1.0)]);
         h.push(0.0);
     }
+    let groups = balanced_stars(inp, &incident, &lower_row);
     let out = ipm::solve(
         &ipm::Qp {
             quad: &quad,
@@ -410,6 +413,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
             f: &f,
             ineq: &ineq,
             h: &h,
+            groups: &groups,
         },
         &ipm::Tolerances::for_size(n),
         cache,
@@ -429,4 +433,55 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
         },
         iterations: out.iterations,
     }
+}
+
+/// The lower-bound rows of the edges around each vertex where Σ_e (u_i − u_j) S_e = 0 holds
+/// identically, with the edge vectors as coefficients (see `ipm::RowGroups`): every interior
+/// vertex in reduced coordinates, none in the edge-based formulation (checked numerically,
+/// not assumed: the identity must hold to rounding in every column).
+fn balanced_stars(inp: &QpInput, incident: &[Vec<usize>], lower_row: &[usize]) -> ipm::RowGroups {
+    let mut groups = ipm::RowGroups {
+        start: vec![0],
+        ..Default::default()
+    };
+    // Per column: the two sums and the size of their terms, over the columns touched.
+    let mut sum = vec![[0.0f64; 3]; inp.s.ncols];
+    let mut touched = Vec::new();
+    for (i, edges) in incident.iter().enumerate() {
+        if edges.len() < 3 {
+            continue;
+        }
+        touched.clear();
+        for &e in edges {
+            let [a, b] = inp.edges[e];
+            let j = if a as usize == i { b } else { a } as usize;
+            let d = [inp.u[i][0] - inp.u[j][0], inp.u[i][1] - inp.u[j][1]];
+            for (col, v) in inp.s.row(e) {
+                if sum[col][2] == 0.0 {
+                    touched.push(col);
+                }
+                sum[col][0] += d[0] * v;
+                sum[col][1] += d[1] * v;
+                sum[col][2] += (d[0].abs() + d[1].abs()) * v.abs();
+            }
+        }
+        let balanced = touched
+            .iter()
+            .all(|&col| sum[col][0].abs().max(sum[col][1].abs()) <= 1e-9 * sum[col][2]);
+        for &col in &touched {
+            sum[col] = [0.0; 3];
+        }
+        if balanced {
+            for &e in edges {
+                let [a, b] = inp.edges[e];
+                let j = if a as usize == i { b } else { a } as usize;
+                groups.row.push(lower_row[e]);
+                groups
+                    .coef
+                    .push([inp.u[i][0] - inp.u[j][0], inp.u[i][1] - inp.u[j][1]]);
+            }
+            groups.start.push(groups.row.len());
+        }
+    }
+    groups
 }
