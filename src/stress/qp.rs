@@ -444,6 +444,12 @@ fn balanced_stars(inp: &QpInput, incident: &[Vec<usize>], lower_row: &[usize]) -
         start: vec![0],
         ..Default::default()
     };
+    // u_i − u_j for the edge e = ij.
+    let from = |i: usize, e: usize| {
+        let [a, b] = inp.edges[e];
+        let j = if a as usize == i { b } else { a } as usize;
+        [inp.u[i][0] - inp.u[j][0], inp.u[i][1] - inp.u[j][1]]
+    };
     // Per column: the two sums and the size of their terms, over the columns touched.
     let mut sum = vec![[0.0f64; 3]; inp.s.ncols];
     let mut touched = Vec::new();
@@ -453,9 +459,7 @@ fn balanced_stars(inp: &QpInput, incident: &[Vec<usize>], lower_row: &[usize]) -
         }
         touched.clear();
         for &e in edges {
-            let [a, b] = inp.edges[e];
-            let j = if a as usize == i { b } else { a } as usize;
-            let d = [inp.u[i][0] - inp.u[j][0], inp.u[i][1] - inp.u[j][1]];
+            let d = from(i, e);
             for (col, v) in inp.s.row(e) {
                 if sum[col][2] == 0.0 {
                     touched.push(col);
@@ -473,12 +477,8 @@ fn balanced_stars(inp: &QpInput, incident: &[Vec<usize>], lower_row: &[usize]) -
         }
         if balanced {
             for &e in edges {
-                let [a, b] = inp.edges[e];
-                let j = if a as usize == i { b } else { a } as usize;
                 groups.row.push(lower_row[e]);
-                groups
-                    .coef
-                    .push([inp.u[i][0] - inp.u[j][0], inp.u[i][1] - inp.u[j][1]]);
+                groups.coef.push(from(i, e));
             }
             groups.start.push(groups.row.len());
         }
