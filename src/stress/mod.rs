@@ -360,18 +360,7 @@ pub fn analyse_cached(
                 regularisation,
             });
         }
-        // Native: only a converged answer stands (at reduced accuracy it can sit at a point
-        // that is not optimal: four_holes), except on large problems, where the fallback
-        // would take many minutes: there reduced accuracy is kept and reported as such.
-        // Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other
-        // form of the same problem, then keep the better. Numerical failure: go down the list.
-        let done = match (solver, status) {
-            (Native, StressStatus::AlmostSolved) => ipm::fallback_is_costly(n_unknowns),
-            (Native, s) => s == StressStatus::Solved,
-            (_, StressStatus::Solved | StressStatus::Infeasible) => true,
-            (_, StressStatus::AlmostSolved | StressStatus::MaxIterations) => clarabel_tries >= 2,
-            (_, StressStatus::NumericalError) => false,
-        };
+        let done = attempt_is_final(solver, status, n_unknowns, clarabel_tries);
         if done {
             break;
         }
@@ -643,4 +632,52 @@ pub fn equilibrium(
         }
     }
     (r, h)
+}
+
+/// Whether an attempt's answer ends the list of attempts in `analyse_cached`.
+/// - Native: only a converged answer stands (at reduced accuracy it can sit at a point that
+///   is not optimal: four_holes), except on large problems, where the fallback would take
+///   many minutes: there an answer at reduced accuracy or at the iteration limit is kept and
+///   reported as such (at 100k vertices a form-finding step whose native iterations stalled
+///   at the limit then ran in clarabel for over 20 minutes).
+/// - Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other form
+///   of the same problem, then keep the better. Numerical failure: go down the list.
+fn attempt_is_final(
+    solver: QpSolver,
+    status: StressStatus,
+    n_unknowns: usize,
+    clarabel_tries: usize,
+) -> bool {
+    use QpSolver::Native;
+    match (solver, status) {
+        (Native, StressStatus::AlmostSolved | StressStatus::MaxIterations) => {
+            ipm::fallback_is_costly(n_unknowns)
+        }
+        (Native, s) => s == StressStatus::Solved,
+        (_, StressStatus::Solved | StressStatus::Infeasible) => true,
+        (_, StressStatus::AlmostSolved | StressStatus::MaxIterations) => clarabel_tries >= 2,
+        (_, StressStatus::NumericalError) => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn large_native_answers_short_of_the_optimum_are_kept() {
+        use QpSolver::{Clarabel, Native};
+        use StressStatus::*;
+        let (small, large) = (5_000, 100_000);
+        for status in [AlmostSolved, MaxIterations] {
+            assert!(!attempt_is_final(Native, status, small, 0));
+            assert!(attempt_is_final(Native, status, large, 0));
+            assert!(!attempt_is_final(Clarabel, status, large, 1));
+            assert!(attempt_is_final(Clarabel, status, large, 2));
+        }
+        // Only clarabel certifies infeasibility: a failed native solve falls back at any size.
+        assert!(!attempt_is_final(Native, NumericalError, large, 0));
+        assert!(attempt_is_final(Native, Solved, small, 0));
+        assert!(attempt_is_final(Clarabel, Infeasible, large, 1));
+    }
 }

@@ -67,7 +67,8 @@ pub enum QpSolver {
     /// The structured interior-point method (sparse LDLᵀ of the two-ring Newton matrix, one
     /// symbolic analysis); when it does not converge the step falls back to clarabel, except
     /// beyond 20k unknowns, where an answer at tenfold relaxed tolerances is kept as
-    /// `AlmostSolved` (clarabel would take many minutes there).
+    /// `AlmostSolved`, and the last iterate at the iteration limit as `MaxIterations`
+    /// (clarabel would take many minutes there).
     #[default]
     Native,
     /// clarabel's generic conic interior-point method only: the reference.
