@@ -207,7 +207,8 @@ enum VsrQpSolver
   /**
    * Default: the structured interior-point method; falls back to clarabel when it does not
    * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
-   * with status VSR_STRESS_STATUS_ALMOST_SOLVED).
+   * with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
+   * limit with status VSR_STRESS_STATUS_MAX_ITERATIONS).
    */
   VSR_QP_SOLVER_NATIVE = 0,
   /**

@@ -213,7 +213,8 @@ pub enum VsrFormulation {
 pub enum VsrQpSolver {
     /// Default: the structured interior-point method; falls back to clarabel when it does not
     /// converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
-    /// with status VSR_STRESS_STATUS_ALMOST_SOLVED).
+    /// with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
+    /// limit with status VSR_STRESS_STATUS_MAX_ITERATIONS).
     Native = 0,
     /// clarabel's generic conic solver only: the reference.
     Clarabel = 1,
