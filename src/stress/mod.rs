@@ -360,8 +360,7 @@ pub fn analyse_cached(
                 regularisation,
             });
         }
-        let done = attempt_is_final(solver, status, n_unknowns, clarabel_tries);
-        if done {
+        if attempt_is_final(solver, status, n_unknowns, clarabel_tries) {
             break;
         }
     }
