@@ -76,6 +76,14 @@ fn run(label: &str, problem: &Problem) -> FormFindResult {
         r.history
     );
     let eps = certify(label, problem, &r);
+    // One ε∞ per stress step, plus the last shape step's certificate when it converged there.
+    assert!(
+        r.history.len() == r.iterations || r.history.len() == r.iterations + 1,
+        "{label}: {} history entries for {} stress steps",
+        r.history.len(),
+        r.iterations
+    );
+    assert_eq!(r.history.last(), Some(&r.stress.eps_inf), "{label}");
     // Issue 3: at most 20 outer iterations with default settings, models and generated cases.
     assert!(r.iterations <= 20, "{label}: {} iterations", r.iterations);
     println!(
@@ -91,10 +99,19 @@ fn run(label: &str, problem: &Problem) -> FormFindResult {
 
 #[test]
 fn every_shared_model_converges_with_default_settings() {
+    let mut certified_after_shape = 0;
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
-        run(name, &Problem::new(mesh));
+        let r = run(name, &Problem::new(mesh));
+        certified_after_shape += usize::from(r.history.len() > r.iterations);
     }
+    // Late shape steps balance their forces: most loops end on that certificate, without a
+    // confirming stress step (7 of the 9 models when this was written).
+    assert!(
+        certified_after_shape * 2 > MODELS.len(),
+        "{certified_after_shape} of {} loops ended on a shape step's certificate",
+        MODELS.len()
+    );
 }
 
 #[test]

@@ -219,7 +219,7 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             say!(
                 "{} after {} iterations: ε∞ = {:.2e} (tolerance {:e}), from {:.2e} at the input",
                 phrase(&report["termination"]),
-                outcome.history.len(),
+                outcome.iterations,
                 s.eps_inf,
                 outcome.tolerance,
                 outcome.before.eps_inf

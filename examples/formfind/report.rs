@@ -108,7 +108,7 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "stress_status": variant_name(&format!("{:?}", s.status)),
         // The QP solver that answered the last stress step (clarabel after a fallback).
         "qp_solver_used": name_of(&QP_SOLVERS, s.solver),
-        "iterations": outcome.history.len(),
+        "iterations": outcome.iterations,
         "eps_inf": s.eps_inf,
         "history": outcome.history,
         "edges": mesh.edges.iter().map(|e| e.v).collect::<Vec<_>>(),

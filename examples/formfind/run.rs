@@ -20,7 +20,10 @@ pub struct Outcome {
     pub stress: StressResult,
     /// Stress analysis of the input shape.
     pub before: StressResult,
+    /// ε∞ per stress step (plus the final certificate, see `FormFindResult::history`).
     pub history: Vec<f64>,
+    /// Stress steps taken.
+    pub iterations: usize,
     pub hausdorff: f64,
     pub l2: f64,
     pub stress_seconds: f64,
@@ -84,6 +87,7 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
             positions: model.mesh.positions.clone(),
             stress: before.clone(),
             history: vec![before.eps_inf],
+            iterations: 1,
             hausdorff: 0.0,
             l2: 0.0,
             stress_seconds: before.seconds,
@@ -115,6 +119,7 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
             stress: r.stress,
             before,
             history: r.history,
+            iterations: r.iterations,
             hausdorff: r.hausdorff,
             l2: r.l2,
             stress_seconds: r.stress_seconds,

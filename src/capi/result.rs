@@ -497,7 +497,9 @@ pub unsafe extern "C" fn vsr_result_force_diagram_segment_edges(
     })
 }
 
-/// ε∞ per form-finding iteration, one double per stress step (dimensionless). For an
+/// ε∞ per form-finding iteration, one double per stress step (dimensionless), plus a last
+/// one when the loop converged on the last shape step's certificate: the previous forces
+/// recomputed at the new heights (the result's forces and residuals are then those). For an
 /// analysis result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
 ///
 /// # Safety
