@@ -448,7 +448,9 @@ typedef struct VsrSettings VsrSettings;
 
 /**
  * Progress callback of `vsr_form_find`, called once per iteration after its stress step with
- * the 0-based iteration number and that step's ε∞ (max |r_i| / mean load, dimensionless).
+ * the 0-based iteration number and the ε∞ the loop goes on with (max |r_i| / mean load,
+ * dimensionless): that step's, or the previous forces' when the step is not taken (see
+ * `vsr_result_eps_history`).
  * Return 0 to continue, non-zero to cancel (the result then reports
  * `VSR_TERMINATION_CANCELLED` and holds the state reached). It runs on the thread that called
  * `vsr_form_find`; it must not unwind (throw a C++ exception or longjmp) out of the call, and
@@ -693,8 +695,8 @@ VsrStatus vsr_result_tau(const struct VsrResult *result, double *out, size_t len
 VsrStatus vsr_result_external_horizontal(const struct VsrResult *result, double *out, size_t len, size_t *needed);
 
 /**
- * Vertical load per vertex used by the (last) stress step, #V doubles (force, downward
- * positive): face weights shared by the load rule plus extra loads, at the result's shape.
+ * Vertical load per vertex, #V doubles (force, downward positive): face weights shared by
+ * the load rule plus extra loads, at the result's shape (for form finding, the final one).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -768,8 +770,10 @@ VsrStatus vsr_result_force_diagram_segment_edges(const struct VsrResult *result,
 /**
  * ε∞ per form-finding iteration, one double per stress step (dimensionless), plus a last
  * one when the loop converged on the last shape step's certificate: the previous forces
- * recomputed at the new heights (the result's forces and residuals are then those). For an
- * analysis result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
+ * recomputed at the new heights (the result's forces and residuals are then those). A step
+ * that stopped short of its optimum and balanced the shape worse than the previous forces
+ * at the same heights is not taken, and its entry is those forces' ε∞. For an analysis
+ * result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -777,10 +781,12 @@ VsrStatus vsr_result_force_diagram_segment_edges(const struct VsrResult *result,
 VsrStatus vsr_result_eps_history(const struct VsrResult *result, double *out, size_t len, size_t *needed);
 
 /**
- * Summary of the (last) stress step: `status` (a `VsrStressStatus`), `eps_inf` = max |r_i| /
- * mean p_i over non-anchored vertices (dimensionless), `objective` = Σ r_i² (force²), and
- * `qp_iterations` of the interior-point solver (0 when a form-finding step was solved from
- * the previous step's active set alone). All four pointers required; written only on
+ * Summary of the result's forces: `status` (a `VsrStressStatus`) and `qp_iterations` of the
+ * interior-point solver of the stress step that produced them (0 when a form-finding step
+ * was solved from the previous step's active set alone), `eps_inf` = max |r_i| / mean p_i
+ * over non-anchored vertices (dimensionless) and `objective` = Σ r_i² (force²), both at the
+ * result's shape (for form finding, the final one: the forces may come from an earlier step
+ * than the shape). All four pointers required; written only on
  * success.
  *
  * # Safety
@@ -789,7 +795,8 @@ VsrStatus vsr_result_eps_history(const struct VsrResult *result, double *out, si
 VsrStatus vsr_result_stress_summary(const struct VsrResult *result, VsrStressStatus *status, double *eps_inf, double *objective, size_t *qp_iterations);
 
 /**
- * The regulariser ε actually used by the (last) stress step (larger than the setting after
+ * The regulariser ε actually used by the stress step that produced the result's forces
+ * (larger than the setting after
  * a numerical failure was retried). Written only on success.
  *
  * # Safety
@@ -798,7 +805,7 @@ VsrStatus vsr_result_stress_summary(const struct VsrResult *result, VsrStressSta
 VsrStatus vsr_result_regularisation(const struct VsrResult *result, double *out);
 
 /**
- * The solver that produced the (last) stress step's forces: `VSR_QP_SOLVER_CLARABEL` when
+ * The solver that produced the result's forces: `VSR_QP_SOLVER_CLARABEL` when
  * the native one was asked for but did not converge. Written only on success.
  *
  * # Safety

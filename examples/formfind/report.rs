@@ -106,7 +106,7 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "termination": name,
         "termination_detail": detail,
         "stress_status": variant_name(&format!("{:?}", s.status)),
-        // The QP solver that answered the last stress step (clarabel after a fallback).
+        // The QP solver that produced the final forces (clarabel after a fallback).
         "qp_solver_used": name_of(&QP_SOLVERS, s.solver),
         "iterations": outcome.iterations,
         "eps_inf": s.eps_inf,

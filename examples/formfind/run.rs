@@ -16,7 +16,7 @@ pub struct Outcome {
     /// None for `--stress-only`.
     pub termination: Option<Termination>,
     pub positions: Vec<[f64; 3]>,
-    /// The last stress step, at `positions`.
+    /// The forces the run ended with, at `positions` (see `FormFindResult::stress`).
     pub stress: StressResult,
     /// Stress analysis of the input shape.
     pub before: StressResult,

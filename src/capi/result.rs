@@ -319,8 +319,8 @@ pub unsafe extern "C" fn vsr_result_external_horizontal(
     })
 }
 
-/// Vertical load per vertex used by the (last) stress step, #V doubles (force, downward
-/// positive): face weights shared by the load rule plus extra loads, at the result's shape.
+/// Vertical load per vertex, #V doubles (force, downward positive): face weights shared by
+/// the load rule plus extra loads, at the result's shape (for form finding, the final one).
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -499,8 +499,10 @@ pub unsafe extern "C" fn vsr_result_force_diagram_segment_edges(
 
 /// ε∞ per form-finding iteration, one double per stress step (dimensionless), plus a last
 /// one when the loop converged on the last shape step's certificate: the previous forces
-/// recomputed at the new heights (the result's forces and residuals are then those). For an
-/// analysis result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
+/// recomputed at the new heights (the result's forces and residuals are then those). A step
+/// that stopped short of its optimum and balanced the shape worse than the previous forces
+/// at the same heights is not taken, and its entry is those forces' ε∞. For an analysis
+/// result: `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_stress_summary`).
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -521,10 +523,12 @@ pub unsafe extern "C" fn vsr_result_eps_history(
     })
 }
 
-/// Summary of the (last) stress step: `status` (a `VsrStressStatus`), `eps_inf` = max |r_i| /
-/// mean p_i over non-anchored vertices (dimensionless), `objective` = Σ r_i² (force²), and
-/// `qp_iterations` of the interior-point solver (0 when a form-finding step was solved from
-/// the previous step's active set alone). All four pointers required; written only on
+/// Summary of the result's forces: `status` (a `VsrStressStatus`) and `qp_iterations` of the
+/// interior-point solver of the stress step that produced them (0 when a form-finding step
+/// was solved from the previous step's active set alone), `eps_inf` = max |r_i| / mean p_i
+/// over non-anchored vertices (dimensionless) and `objective` = Σ r_i² (force²), both at the
+/// result's shape (for form finding, the final one: the forces may come from an earlier step
+/// than the shape). All four pointers required; written only on
 /// success.
 ///
 /// # Safety
@@ -558,7 +562,8 @@ pub unsafe extern "C" fn vsr_result_stress_summary(
     })
 }
 
-/// The regulariser ε actually used by the (last) stress step (larger than the setting after
+/// The regulariser ε actually used by the stress step that produced the result's forces
+/// (larger than the setting after
 /// a numerical failure was retried). Written only on success.
 ///
 /// # Safety
@@ -574,7 +579,7 @@ pub unsafe extern "C" fn vsr_result_regularisation(
     })
 }
 
-/// The solver that produced the (last) stress step's forces: `VSR_QP_SOLVER_CLARABEL` when
+/// The solver that produced the result's forces: `VSR_QP_SOLVER_CLARABEL` when
 /// the native one was asked for but did not converge. Written only on success.
 ///
 /// # Safety

@@ -16,7 +16,9 @@ use crate::FormFindSettings;
 use std::ffi::{c_int, c_void};
 
 /// Progress callback of `vsr_form_find`, called once per iteration after its stress step with
-/// the 0-based iteration number and that step's ε∞ (max |r_i| / mean load, dimensionless).
+/// the 0-based iteration number and the ε∞ the loop goes on with (max |r_i| / mean load,
+/// dimensionless): that step's, or the previous forces' when the step is not taken (see
+/// `vsr_result_eps_history`).
 /// Return 0 to continue, non-zero to cancel (the result then reports
 /// `VSR_TERMINATION_CANCELLED` and holds the state reached). It runs on the thread that called
 /// `vsr_form_find`; it must not unwind (throw a C++ exception or longjmp) out of the call, and
