@@ -258,12 +258,10 @@ pub fn form_find(
         // forces and the new heights, as for a stress step.
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
-        let converged = certified.eps_inf < settings.tolerance;
-        if converged {
-            history.push(certified.eps_inf);
-        }
+        let certified_eps = certified.eps_inf;
         last = Some(certified);
-        if converged {
+        if certified_eps < settings.tolerance {
+            history.push(certified_eps);
             termination = Termination::Converged;
             break;
         }
