@@ -185,6 +185,10 @@ enum VsrStressStatus
    * The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
    */
   VSR_STRESS_STATUS_INFEASIBLE = 2,
+  /**
+   * Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
+   * native solver beyond 20k unknowns) 20 iterations went by without progress.
+   */
   VSR_STRESS_STATUS_MAX_ITERATIONS = 3,
   VSR_STRESS_STATUS_NUMERICAL_ERROR = 4,
 };
@@ -208,7 +212,8 @@ enum VsrQpSolver
    * Default: the structured interior-point method; falls back to clarabel when it does not
    * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
    * with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
-   * limit with status VSR_STRESS_STATUS_MAX_ITERATIONS).
+   * limit, or after 20 iterations without progress, with status
+   * VSR_STRESS_STATUS_MAX_ITERATIONS).
    */
   VSR_QP_SOLVER_NATIVE = 0,
   /**

@@ -30,6 +30,8 @@ pub enum StressStatus {
     AlmostSolved,
     /// The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
     Infeasible,
+    /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
+    /// native solver beyond 20k unknowns) 20 iterations went by without progress.
     MaxIterations,
     NumericalError,
 }
@@ -636,8 +638,8 @@ pub fn equilibrium(
 /// Whether an attempt's answer ends the list of attempts in `analyse_cached`.
 /// - Native: only a converged answer stands (at reduced accuracy it can sit at a point that
 ///   is not optimal: four_holes), except on large problems, where the fallback would take
-///   many minutes: there an answer at reduced accuracy or at the iteration limit is kept and
-///   reported as such (at 100k vertices a form-finding step whose native iterations stalled
+///   many minutes: there an answer at reduced accuracy, at the iteration limit or where the
+///   iterations stalled is kept and reported as such (at 100k vertices a form-finding step whose native iterations stalled
 ///   at the limit then ran in clarabel for over 20 minutes).
 /// - Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other form
 ///   of the same problem, then keep the better. Numerical failure: go down the list.
