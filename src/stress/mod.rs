@@ -639,8 +639,8 @@ pub fn equilibrium(
 /// - Native: only a converged answer stands (at reduced accuracy it can sit at a point that
 ///   is not optimal: four_holes), except on large problems, where the fallback would take
 ///   many minutes: there an answer at reduced accuracy, at the iteration limit or where the
-///   iterations stalled is kept and reported as such (at 100k vertices a form-finding step whose native iterations stalled
-///   at the limit then ran in clarabel for over 20 minutes).
+///   iterations stalled is kept and reported as such (at 100k vertices a form-finding step
+///   whose native iterations stalled at the limit then ran in clarabel for over 20 minutes).
 /// - Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other form
 ///   of the same problem, then keep the better. Numerical failure: go down the list.
 fn attempt_is_final(
