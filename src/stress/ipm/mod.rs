@@ -1,0 +1,891 @@
+//! A primal–dual interior-point method (Mehrotra predictor–corrector) for sparse convex QPs of
+//! the stress step's shape:
+//!
+//!   minimise    ½ xᵀ P x + cᵀ x,   P = Σ_k ρ_k a_kᵀ a_k   (rows a_k of `quad`)
+//!   subject to  E x = f,   G x ≥ h
+//!
+//! Each Newton step is solved through the normal matrix P + Cᵀ W C, C = [E; G], with
+//! W = 1 / (s/z + δ) on inequality rows and 1 / δ on equality rows: one sparse positive
+//! definite factorisation whose symbolic analysis (fill-reducing ordering, supernodes) is
+//! done once, since only W changes. δ caps the weights (their rounding would otherwise swamp
+//! the small curvatures) and iterative refinement against the exact augmented system removes
+//! its effect. In weight space every row a_k and c_i touches a vertex's one-ring, so the
+//! matrix has the two-ring pattern of the mesh: much smaller than a generic conic solver's
+//! KKT system (MATH §8).
+//!
+//! The unknowns are relabelled once in a fill-reducing (AMD) order, so that no factorisation
+//! permutes the matrix again. Gondzio's centrality correctors lengthen steps that a few
+//! products s_i z_i would otherwise cut short; they reuse the factor with coarse solves. Near
+//! the optimum the active set is solved for directly ("polishing"): with an objective that is
+//! nearly zero at the optimum, the gap alone would creep towards the tolerance in rounding.
+//!
+//! The method has no infeasibility certificates: it reports failure and the caller falls back
+//! to clarabel, which decides.
+
+use super::sparse::Csr;
+
+mod newton;
+mod pattern;
+mod polish;
+use newton::*;
+pub use pattern::PatternCache;
+use pattern::*;
+use polish::*;
+
+/// A QP in the form above.
+pub struct Qp<'a> {
+    pub quad: &'a Csr,
+    pub quad_weight: &'a [f64],
+    pub c: &'a [f64],
+    /// Constant added to ½ xᵀPx + cᵀx so that the objective is the true one (for the
+    /// relative gap).
+    pub constant: f64,
+    pub eq: &'a Csr,
+    pub f: &'a [f64],
+    pub ineq: &'a Csr,
+    pub h: &'a [f64],
+    /// Inequality rows known to be dependent when all of a group are active (see
+    /// `RowGroups`); empty when none are known.
+    pub groups: &'a RowGroups,
+}
+
+/// Groups of inequality rows with two independent vanishing combinations each:
+/// Σ_k c_k row_k = 0 with c_k ∈ R² (the lower bounds of the edges around an interior vertex in
+/// reduced coordinates, whose forces balance horizontally there for every Airy function, with
+/// c the edge vectors). When a whole group is active, its rows are dependent and the right-hand
+/// side's rounding along the combinations is amplified by 1/δ: polishing then releases two
+/// rows per such group, which the others imply.
+#[derive(Debug, Clone, Default)]
+pub struct RowGroups {
+    /// Group g is `row[start[g]..start[g + 1]]` with coefficients `coef[..]` alike; `start` is
+    /// empty or begins with 0.
+    pub start: Vec<usize>,
+    pub row: Vec<usize>,
+    pub coef: Vec<[f64; 2]>,
+}
+
+impl RowGroups {
+    fn len(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    fn group(&self, g: usize) -> (&[usize], &[[f64; 2]]) {
+        let range = self.start[g]..self.start[g + 1];
+        (&self.row[range.clone()], &self.coef[range])
+    }
+
+    fn any_wholly_active(&self, active: &[bool]) -> bool {
+        (0..self.len()).any(|g| self.group(g).0.iter().all(|&r| active[r]))
+    }
+
+    /// The same groups for rows scaled by `row_scale` (coefficients divided by it).
+    fn for_scaled_rows(&self, row_scale: &[f64]) -> RowGroups {
+        let coef = self
+            .row
+            .iter()
+            .zip(&self.coef)
+            .map(|(&r, c)| [c[0] / row_scale[r], c[1] / row_scale[r]])
+            .collect();
+        RowGroups {
+            start: self.start.clone(),
+            row: self.row.clone(),
+            coef,
+        }
+    }
+
+    /// The rows to release from the active set `active`: two of every group whose rows are
+    /// all active (and not yet released for another group). With multipliers z, the pair is
+    /// chosen so that shifting z along the group's combinations to zero them keeps the
+    /// group's other multipliers non-negative (a vertex of {a : z_k + a·c_k ≥ 0}), the best
+    /// conditioned such pair; with z = 0 every pair qualifies.
+    fn released(&self, active: &[bool], z: &[f64]) -> Vec<bool> {
+        let mut released = vec![false; active.len()];
+        for g in 0..self.len() {
+            let (rows, coef) = self.group(g);
+            if rows.len() < 3 || !rows.iter().all(|&r| active[r]) {
+                continue;
+            }
+            let mut best: Option<(f64, usize, usize)> = None;
+            for i in 0..rows.len() {
+                for j in i + 1..rows.len() {
+                    if released[rows[i]] || released[rows[j]] {
+                        continue;
+                    }
+                    let (a, b) = (coef[i], coef[j]);
+                    let det = a[0] * b[1] - a[1] * b[0];
+                    let norms = a[0].hypot(a[1]) * b[0].hypot(b[1]);
+                    if det.abs() <= 1e-6 * norms {
+                        continue;
+                    }
+                    // a·c_i = −z_i, a·c_j = −z_j.
+                    let (zi, zj) = (z[rows[i]], z[rows[j]]);
+                    let shift = [
+                        (-zi * b[1] + zj * a[1]) / det,
+                        (-zj * a[0] + zi * b[0]) / det,
+                    ];
+                    let feasible = rows.iter().zip(coef).all(|(&r, c)| {
+                        z[r] + shift[0] * c[0] + shift[1] * c[1] >= -1e-9 * z[r].abs().max(1e-300)
+                    });
+                    let conditioning = det.abs() / norms;
+                    if feasible && best.is_none_or(|(q, ..)| conditioning > q) {
+                        best = Some((conditioning, rows[i], rows[j]));
+                    }
+                }
+            }
+            if let Some((_, ri, rj)) = best {
+                (released[ri], released[rj]) = (true, true);
+            }
+        }
+        released
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IpmStatus {
+    Solved,
+    /// The method stopped (iteration limit, no progress or numerical trouble) at a point that
+    /// meets the tolerances relaxed by `Tolerances::almost`.
+    AlmostSolved,
+    /// The iteration limit was reached, or beyond it stopped making progress (see
+    /// `Progress`), short of even the relaxed tolerances.
+    MaxIterations,
+    /// Factorisation failed or the iterates diverged (typically an infeasible or degenerate
+    /// problem).
+    NumericalError,
+}
+
+pub struct IpmOutput {
+    pub x: Vec<f64>,
+    pub status: IpmStatus,
+    pub iterations: u32,
+    /// Per inequality row, whether it is active at `x` (empty unless solved).
+    pub active: Vec<bool>,
+}
+
+/// Tolerances: the gap sᵀz must fall below `gap_abs + gap_rel |objective|`, the primal
+/// residuals below `feas` and the dual one below `dual_feas`, each relative to its data.
+#[derive(Debug, Clone, Copy)]
+pub struct Tolerances {
+    pub gap_abs: f64,
+    pub gap_rel: f64,
+    pub feas: f64,
+    /// The same for the dual residual P x + c − Eᵀλ − Gᵀz, or its rounding floor when that
+    /// is larger (see `for_size` and `DUAL_ROUNDING`).
+    pub dual_feas: f64,
+    /// Factor by which all tolerances are relaxed for `AlmostSolved`.
+    pub almost: f64,
+    pub max_iter: u32,
+}
+
+impl Tolerances {
+    /// The defaults adapted to `n` unknowns.
+    /// - The dual tolerance grows as √(n / 10⁴) from 10⁴ unknowns on, besides its rounding
+    ///   floor (`DUAL_ROUNDING`): at 100k unknowns form-finding steps whose residual hovered
+    ///   1–3× above 1e-10 of its scale stayed above the floor as well, and without the growth
+    ///   they fell back to clarabel. A flat 1e-9 let four_holes stop 0.2% above its optimum.
+    /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
+    ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
+    ///   native, 120 s clarabel), so large problems get more (see `fallback_is_costly`).
+    pub fn for_size(n: usize) -> Tolerances {
+        let base = Tolerances::default();
+        Tolerances {
+            dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
+            max_iter: if fallback_is_costly(n) { 150 } else { 80 },
+            ..base
+        }
+    }
+}
+
+/// Whether clarabel, the fallback, costs thousands of native iterations on a QP with `n`
+/// unknowns (a 20k-vertex QP: 2 s native, 120 s clarabel; at 100k a form-finding step ran
+/// for more than 10 minutes in clarabel where the native method had taken 20–75 s).
+pub fn fallback_is_costly(n: usize) -> bool {
+    n > 20_000
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        // As tight as the clarabel settings in qp.rs: residuals must be reproducible to ~1e-6
+        // of the mean load, and the objective (Σ r²) is often ~0 at the optimum.
+        Tolerances {
+            gap_abs: 1e-12,
+            gap_rel: 1e-11,
+            feas: 1e-10,
+            dual_feas: 1e-10,
+            almost: 10.0,
+            // Well-posed problems converge in 11–40 iterations (form-finding steps at 100k
+            // unknowns took up to 130); beyond, the caller's fallback is cheaper than crawling
+            // on: see `for_size`.
+            max_iter: 80,
+        }
+    }
+}
+
+/// Gondzio's centrality correctors: at most this many per iteration, each aiming at a step
+/// `stretch α + add` (α the step already reached) and kept only if it gains a tenth of that.
+const CORRECTORS: usize = 3;
+const CORRECTOR_STRETCH: f64 = 1.5;
+const CORRECTOR_ADD: f64 = 0.1;
+
+/// Fraction of the way to the boundary of the positive orthant taken by each step (0.995
+/// lost the last digits the 50k-vertex dome needs and fell back to clarabel).
+const STEP_FRACTION: f64 = 0.99;
+
+fn inf_norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+}
+
+/// max_i Σ_j |a_ij x_j|.
+fn abs_row_norm(a: &Csr, x: &[f64]) -> f64 {
+    (0..a.nrows())
+        .map(|r| a.row(r).map(|(c, v)| (v * x[c]).abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+/// Aᵀ y for a Csr A with `n` columns.
+fn mul_t(a: &Csr, y: &[f64], n: usize) -> Vec<f64> {
+    sum_t_terms(a, y, n, |a, y| a * y)
+}
+
+/// |A|ᵀ |y| for a Csr A with `n` columns.
+fn abs_mul_t(a: &Csr, y: &[f64], n: usize) -> Vec<f64> {
+    sum_t_terms(a, y, n, |a, y| (a * y).abs())
+}
+
+/// out_c = Σ_r term(a_rc, y_r) for a Csr A with `n` columns.
+fn sum_t_terms(a: &Csr, y: &[f64], n: usize, term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
+    let mut out = vec![0.0; n];
+    for (bounds, &yr) in a.start.windows(2).zip(y) {
+        let range = bounds[0]..bounds[1];
+        for (&c, &v) in a.col[range.clone()].iter().zip(&a.val[range]) {
+            out[c] += term(v, yr);
+        }
+    }
+    out
+}
+
+/// Largest α ≤ 1 with v + α dv ≥ 0.
+fn max_step(v: &[f64], dv: &[f64]) -> f64 {
+    v.iter()
+        .zip(dv)
+        .filter(|(_, d)| **d < 0.0)
+        .map(|(v, d)| -v / d)
+        .fold(1.0, f64::min)
+}
+
+/// `m` with column j scaled by `col[j]` and row i by `row[i]`.
+fn scaled(m: &Csr, col: &[f64], row: &[f64]) -> Csr {
+    let mut out = m.clone();
+    for (r, &rs) in row.iter().enumerate() {
+        for k in m.start[r]..m.start[r + 1] {
+            out.val[k] *= rs * col[m.col[k]];
+        }
+    }
+    out
+}
+
+/// Row scale that gives every row of `m` (after the column scaling) unit ∞-norm.
+fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
+    (0..m.nrows())
+        .map(|r| {
+            let norm = m.row(r).fold(0.0f64, |a, (c, v)| a.max((v * col[c]).abs()));
+            if norm > 0.0 {
+                1.0 / norm
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
+
+/// Per inequality row, the factor that turns its scaled slack back into the caller's units,
+/// up to one common factor (the median row scale). The starting point is built in those units:
+/// the stress QPs' rows bound force densities (and τ), commensurate as the caller states them,
+/// while the unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
+/// times larger than an interior edge's (a combination of Airy values). Mehrotra's uniform
+/// shift in the scaled units then started the boundary edges' slacks hundreds of times below
+/// their optimum (Cas-size dome: 65 against 3600; 50k: against 55 000), and the iterations
+/// spent 15 steps of 0.2–0.7 letting them grow. The iterates are otherwise invariant to the
+/// row scaling, which stays for the linear algebra.
+fn caller_units(row_scale: &[f64]) -> Vec<f64> {
+    let mut sorted = row_scale.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let Some(&median) = sorted.get(sorted.len() / 2) else {
+        return Vec::new();
+    };
+    row_scale.iter().map(|r| median / r).collect()
+}
+
+/// Solves the QP after equilibration: variables scaled so that the normal matrix at W = I has
+/// a unit diagonal, constraint rows scaled to unit norm. Weights and Airy values, boundary-edge
+/// forces and hole coefficients differ by orders of magnitude; unscaled, the factorisation
+/// loses the accuracy the last iterations need. `cache` holds the normal matrix's structure
+/// from an earlier QP of the same structure, and is left holding this one's.
+pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
+    let n = qp.c.len();
+    let mut diag = vec![0.0; n];
+    for (r, &w) in qp.quad_weight.iter().enumerate() {
+        qp.quad.row(r).for_each(|(c, v)| diag[c] += w * v * v);
+    }
+    for m in [qp.eq, qp.ineq] {
+        for r in 0..m.nrows() {
+            let norm2: f64 = m.row(r).map(|(_, v)| v * v).sum();
+            m.row(r)
+                .for_each(|(c, v)| diag[c] += v * v / norm2.max(1e-300));
+        }
+    }
+    let d: Vec<f64> = diag
+        .iter()
+        .map(|&v| if v > 0.0 { 1.0 / v.sqrt() } else { 1.0 })
+        .collect();
+    let ones_q = vec![1.0; qp.quad.nrows()];
+    let re = unit_rows(qp.eq, &d);
+    let ri = unit_rows(qp.ineq, &d);
+    let start_units = caller_units(&ri);
+    let warm = cache.last.take().map(|(x, active)| {
+        let x: Vec<f64> = x.iter().zip(&d).map(|(x, d)| x / d).collect();
+        (x, active)
+    });
+    let quad = scaled(qp.quad, &d, &ones_q);
+    let eq = scaled(qp.eq, &d, &re);
+    let ineq = scaled(qp.ineq, &d, &ri);
+    let c: Vec<f64> = qp.c.iter().zip(&d).map(|(c, d)| c * d).collect();
+    let f: Vec<f64> = qp.f.iter().zip(&re).map(|(f, r)| f * r).collect();
+    let h: Vec<f64> = qp.h.iter().zip(&ri).map(|(h, r)| h * r).collect();
+    let groups = qp.groups.for_scaled_rows(&ri);
+    let mut out = solve_scaled(
+        &Qp {
+            quad: &quad,
+            quad_weight: qp.quad_weight,
+            c: &c,
+            constant: qp.constant,
+            eq: &eq,
+            f: &f,
+            ineq: &ineq,
+            h: &h,
+            groups: &groups,
+        },
+        &start_units,
+        tol,
+        cache,
+        warm,
+    );
+    out.x.iter_mut().zip(&d).for_each(|(x, d)| *x *= d);
+    if out.status == IpmStatus::Solved {
+        cache.last = Some((out.x.clone(), out.active.clone()));
+    }
+    out
+}
+
+/// The residuals of the KKT conditions at a point, each with the size of the terms that make
+/// it up (a backward error: at the optimum E x ≈ f is often 0 while its terms are not).
+struct Kkt {
+    r_d: Vec<f64>,
+    r_e: Vec<f64>,
+    r_i: Vec<f64>,
+    gap: f64,
+    objective: f64,
+    dual_scale: f64,
+    /// The rounding floor of the dual residual: `DUAL_ROUNDING` ulps of its largest sum of
+    /// term sizes.
+    dual_floor: f64,
+    eq_scale: f64,
+    ineq_scale: f64,
+}
+
+impl Kkt {
+    fn new(qp: &Qp, normal: &Normal, x: &[f64], lambda: &[f64], s: &[f64], z: &[f64]) -> Kkt {
+        let n = x.len();
+        let px = normal.mul_p(x);
+        let et_l = mul_t(qp.eq, lambda, n);
+        let gt_z = mul_t(qp.ineq, z, n);
+        let r_d = (0..n)
+            .map(|i| px[i] + qp.c[i] - et_l[i] - gt_z[i])
+            .collect();
+        let r_e = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| a - b).collect();
+        let gx = qp.ineq.mul(x);
+        let r_i = (0..s.len()).map(|i| gx[i] - qp.h[i] - s[i]).collect();
+        Kkt {
+            r_d,
+            r_e,
+            r_i,
+            gap: dot(s, z),
+            objective: 0.5 * dot(x, &px) + dot(qp.c, x) + qp.constant,
+            dual_scale: 1.0
+                + inf_norm(qp.c)
+                    .max(inf_norm(&px))
+                    .max(inf_norm(&gt_z))
+                    .max(inf_norm(&et_l)),
+            dual_floor: DUAL_ROUNDING
+                * f64::EPSILON
+                * inf_norm(
+                    &normal
+                        .mul_p_abs(x)
+                        .iter()
+                        .zip(abs_mul_t(qp.eq, lambda, n))
+                        .zip(abs_mul_t(qp.ineq, z, n))
+                        .zip(qp.c)
+                        .map(|(((p, e), g), c)| p + e + g + c.abs())
+                        .collect::<Vec<f64>>(),
+                ),
+            eq_scale: 1.0 + inf_norm(qp.f).max(abs_row_norm(qp.eq, x)),
+            ineq_scale: 1.0 + inf_norm(qp.h).max(abs_row_norm(qp.ineq, x)),
+        }
+    }
+
+    fn feasible(&self, tol: &Tolerances, k: f64) -> bool {
+        inf_norm(&self.r_d) <= k * (tol.dual_feas * self.dual_scale).max(self.dual_floor)
+            && inf_norm(&self.r_e) <= k * tol.feas * self.eq_scale
+            && inf_norm(&self.r_i) <= k * tol.feas * self.ineq_scale
+    }
+
+    /// How many times their tolerances the residuals (the largest of the three) and the gap
+    /// are.
+    fn excess(&self, tol: &Tolerances) -> [f64; 2] {
+        let residuals = (inf_norm(&self.r_d)
+            / (tol.dual_feas * self.dual_scale).max(self.dual_floor))
+        .max(inf_norm(&self.r_e) / (tol.feas * self.eq_scale))
+        .max(inf_norm(&self.r_i) / (tol.feas * self.ineq_scale));
+        [
+            residuals,
+            self.gap / (tol.gap_abs + tol.gap_rel * self.objective.abs()),
+        ]
+    }
+
+    /// Meets the tolerances relaxed k times.
+    fn within(&self, tol: &Tolerances, k: f64) -> bool {
+        self.feasible(tol, k) && self.gap <= k * (tol.gap_abs + tol.gap_rel * self.objective.abs())
+    }
+
+    /// Close enough to the optimum for the active set to be guessed.
+    fn near(&self, tol: &Tolerances) -> bool {
+        self.feasible(tol, POLISH_FEAS) && self.gap <= POLISH_GAP * (1.0 + self.objective.abs())
+    }
+}
+
+/// The dual residual is accepted within this many ulps of the largest sum of absolute terms
+/// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding. Weights and Airy values can be
+/// 10⁶–10⁷ in the scaled unknowns while P x is O(1) (100k-vertex form finding: Σ|P||x| 1.75e7
+/// against |P x| 2.7), and the residual then hovered at 0.5–1.5 ulps of those terms, 2–4×
+/// above the relative tolerance, for 50 iterations.
+const DUAL_ROUNDING: f64 = 10.0;
+
+/// Iterations without progress after which `Progress` declares a stall.
+const STALL_WINDOW: u32 = 20;
+
+/// Whether the iterations still make progress: the residuals halving or the gap falling
+/// tenfold (against where they stood at the last such progress) within `STALL_WINDOW`
+/// iterations. Only beyond 20k unknowns is a stall an exit (`fallback_is_costly`: the caller
+/// then keeps the answer at hand): there form-finding steps whose directions had gone inexact
+/// kept the dual residual near 1e-4, 2700× its tolerance, from their 12th iteration to the
+/// 150-iteration limit, with no tenfold fall of the gap in the 60 iterations after the 36th.
+/// Stopped by a stall at 55 iterations, the 100k dome's 13th step balanced the shape as well
+/// as at 150 (ε∞ 0.1614) in 28 s instead of 71 s.
+struct Progress {
+    reference: [f64; 2],
+    since: u32,
+}
+
+impl Progress {
+    fn new() -> Progress {
+        Progress {
+            reference: [f64::INFINITY; 2],
+            since: 0,
+        }
+    }
+
+    /// Records an iterate's `Kkt::excess`; true once it has made no progress for
+    /// `STALL_WINDOW` iterations.
+    fn stalled(&mut self, iteration: u32, [residuals, gap]: [f64; 2]) -> bool {
+        let [r, g] = self.reference;
+        if residuals < 0.5 * r || gap < 0.1 * g {
+            self.reference = [r.min(residuals), g.min(gap)];
+            self.since = iteration;
+        }
+        iteration - self.since >= STALL_WINDOW
+    }
+}
+
+fn solve_scaled(
+    qp: &Qp,
+    start_units: &[f64],
+    tol: &Tolerances,
+    cache: &mut PatternCache,
+    warm: Option<(Vec<f64>, Vec<bool>)>,
+) -> IpmOutput {
+    let n = qp.c.len();
+    let cons = stacked(qp.eq, qp.ineq);
+    let Some((pattern, reused)) = cache.pattern(qp.quad, &cons, qp.eq.nrows()) else {
+        return IpmOutput {
+            x: vec![0.0; n],
+            status: IpmStatus::NumericalError,
+            iterations: 0,
+            active: Vec::new(),
+        };
+    };
+    let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
+    // The iterations work in the factor's labels: no vector is permuted per solve.
+    let relabelled = Relabelled::new(qp, &normal.pattern.label);
+    let warm = warm
+        .filter(|_| reused)
+        .map(|(x, active)| (relabel_vector(&x, &normal.pattern.label), active));
+    let mut out = iterate(
+        &relabelled.qp(qp),
+        &normal,
+        &relabelled.cons,
+        start_units,
+        tol,
+        warm.as_ref().map(|(x, a)| (&x[..], &a[..])),
+    );
+    out.x = normal.pattern.label.iter().map(|&l| out.x[l]).collect();
+    out
+}
+
+/// The constraints and linear term of a QP with its unknowns relabelled (`quad` is left as
+/// it is: the iterations use P only through `Normal`), and C = [E; G] in the new labels.
+struct Relabelled {
+    eq: Csr,
+    ineq: Csr,
+    cons: Csr,
+    c: Vec<f64>,
+}
+
+impl Relabelled {
+    fn new(qp: &Qp, label: &[usize]) -> Relabelled {
+        let (eq, ineq) = (
+            relabel_columns(qp.eq, label),
+            relabel_columns(qp.ineq, label),
+        );
+        let cons = stacked(&eq, &ineq);
+        let c = relabel_vector(qp.c, label);
+        Relabelled { eq, ineq, cons, c }
+    }
+
+    fn qp<'a>(&'a self, qp: &Qp<'a>) -> Qp<'a> {
+        Qp {
+            c: &self.c,
+            eq: &self.eq,
+            ineq: &self.ineq,
+            ..*qp
+        }
+    }
+}
+
+/// Weight 1 / START_PENALTY of the constraint term of the starting point's problem. CVXOPT's
+/// weight 1 pulls every force density towards its bound, so that nearly every constraint
+/// starts out looking active; measured on generated domes with a hole (with the start still in
+/// the unit-norm row scaling, before `caller_units`), 100 took the iterations
+/// from 29 to 22 at 6k unknowns, 34 to 31 at 20k, 46 to 34 at 50k and 79 to 39 at 100k, and
+/// cost the shared models 0 to 6 more (11–25 in all). 10 and 1000 did less well at 100k; 30
+/// left free_vault's dual residual 5× above its tolerance (it fell back to clarabel).
+const START_PENALTY: f64 = 100.0;
+
+/// The interior-point iterations on a QP whose unknowns are in `normal`'s labels; the
+/// starting point is built with inequality row i's slack multiplied by `start_units[i]` (see
+/// `caller_units`).
+fn iterate(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    start_units: &[f64],
+    tol: &Tolerances,
+    warm: Option<(&[f64], &[bool])>,
+) -> IpmOutput {
+    let n = qp.c.len();
+    let m_eq = qp.eq.nrows();
+    let m = qp.ineq.nrows();
+    // The last iterate that met the relaxed tolerances, returned if the method stops early.
+    let mut almost: Option<Vec<f64>> = None;
+    let fail = |x: Vec<f64>, iterations, almost: Option<Vec<f64>>| match almost {
+        Some(x) => IpmOutput {
+            x,
+            status: IpmStatus::AlmostSolved,
+            iterations,
+            active: Vec::new(),
+        },
+        None => IpmOutput {
+            x,
+            status: IpmStatus::NumericalError,
+            iterations,
+            active: Vec::new(),
+        },
+    };
+    let with_eq_zeros = |d: &[f64]| -> Vec<f64> {
+        let mut out = vec![0.0; m_eq];
+        out.extend_from_slice(d);
+        out
+    };
+
+    // Starting point (as CVXOPT, with the constraint term weighted down by START_PENALTY):
+    // minimise ½xᵀPx + cᵀx + ½‖U(Gx − h)‖² / START_PENALTY subject to Ex = f, take the slacks
+    // s = Gx − h and the duals z = −s, then shift both into the positive orthant; all in the
+    // caller's units (U = diag(start_units)), converted back at the end.
+    let minus_c: Vec<f64> = qp.c.iter().map(|c| -c).collect();
+    let mut rhs = qp.f.to_vec();
+    rhs.extend_from_slice(qp.h);
+    // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
+    let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
+        return fail(vec![0.0; n], 0, None);
+    };
+    // A form-finding step first tries the previous step's active set: where it is nearly
+    // right, a few active-set corrections reach the optimum for a fraction of the
+    // iterations' cost. Only x and the active set are carried over: the step computes the
+    // multipliers afresh, from zero.
+    if let Some((x0, guess)) = warm {
+        let (lambda0, z0) = (vec![0.0; m_eq], vec![0.0; m]);
+        let point = Point {
+            x: x0,
+            lambda: &lambda0,
+            z: &z0,
+        };
+        let warm = polish(
+            qp,
+            normal,
+            cons,
+            &point,
+            (guess, Corrections::AllWhileFewer),
+            tol,
+            &mut space,
+        );
+        if let Ok((x, active)) = warm {
+            return IpmOutput {
+                x,
+                status: IpmStatus::Solved,
+                iterations: 0,
+                active,
+            };
+        }
+    }
+    let penalty: Vec<f64> = start_units
+        .iter()
+        .map(|u| START_PENALTY / (u * u))
+        .collect();
+    let start = REGULARISATION.iter().find_map(|&reg| {
+        Newton::new(normal, cons, with_eq_zeros(&penalty), reg, &mut space)?
+            .solve(&minus_c, &rhs, 1e-8, false)
+    });
+    let Some([mut x, mut w]) = start else {
+        return fail(vec![0.0; n], 0, None);
+    };
+    // The solve returns w = (Gx − h) / penalty on the inequality rows.
+    let s_hat: Vec<f64> = w
+        .split_off(m_eq)
+        .iter()
+        .zip(&penalty)
+        .zip(start_units)
+        .map(|((w, p), u)| w * p * u)
+        .collect();
+    let mut lambda: Vec<f64> = w.iter().map(|v| -v).collect();
+    // Mehrotra's shift: into the positive orthant, then balanced so that s ∘ z starts centred.
+    let mut z: Vec<f64> = s_hat.iter().map(|v| -v).collect();
+    let mut s = s_hat;
+    let lowest = |v: &[f64]| v.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    let ds = (-1.5 * lowest(&s)).max(0.0);
+    let dz = (-1.5 * lowest(&z)).max(0.0);
+    s.iter_mut().for_each(|v| *v += ds);
+    z.iter_mut().for_each(|v| *v += dz);
+    let sz = dot(&s, &z);
+    let (sum_s, sum_z) = (s.iter().sum::<f64>(), z.iter().sum::<f64>());
+    let ds = if sum_z > 0.0 { 0.5 * sz / sum_z } else { 1.0 };
+    let dz = if sum_s > 0.0 { 0.5 * sz / sum_s } else { 1.0 };
+    s.iter_mut()
+        .zip(start_units)
+        .for_each(|(v, u)| *v = (*v + ds.max(1e-8)) / u);
+    z.iter_mut()
+        .zip(start_units)
+        .for_each(|(v, u)| *v = (*v + dz.max(1e-8)) * u);
+
+    // Polishing is tried only while the gap is below this (see `PolishFailure`).
+    let mut polish_below = f64::INFINITY;
+    // The guess of the last attempt that failed with an early guess: the same guess from
+    // another iterate leads to the same step (a QP's Newton step lands on the optimum for its
+    // active set wherever it starts), so it fails again (dome with doors: iterations 14, 15).
+    let mut failed_guess: Option<Vec<bool>> = None;
+    let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
+    let mut iterations = tol.max_iter;
+    for iteration in 0..tol.max_iter {
+        let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
+        if !kkt.objective.is_finite() || inf_norm(&x) > 1e15 {
+            return fail(x, iteration, almost);
+        }
+        if kkt.within(tol, tol.almost) {
+            almost = Some(x.clone());
+        }
+        if kkt.within(tol, 1.0) {
+            return IpmOutput {
+                x,
+                status: IpmStatus::Solved,
+                iterations: iteration,
+                active: active_guess(&s, &z),
+            };
+        }
+        if progress.stalled(iteration, kkt.excess(tol)) && stall_exits {
+            iterations = iteration;
+            break;
+        }
+        // Close to the optimum the active set is plain to see: solving for it directly ends
+        // the iterations the gap would otherwise need to creep down to the tolerance, which
+        // near a zero objective is at the edge of double precision.
+        let guess = (kkt.near(tol) && kkt.gap <= polish_below).then(|| active_guess(&s, &z));
+        if let Some(guess) = guess.filter(|g| failed_guess.as_ref() != Some(g)) {
+            let point = Point {
+                x: &x,
+                lambda: &lambda,
+                z: &z,
+            };
+            match polish(
+                qp,
+                normal,
+                cons,
+                &point,
+                (&guess, Corrections::Few),
+                tol,
+                &mut space,
+            ) {
+                Ok((x, active)) => {
+                    return IpmOutput {
+                        x,
+                        status: IpmStatus::Solved,
+                        iterations: iteration + 1,
+                        active,
+                    }
+                }
+                Err(PolishFailure::EarlyGuess) => {
+                    polish_below = f64::INFINITY;
+                    failed_guess = Some(guess);
+                }
+                Err(PolishFailure::Inexact) => {
+                    polish_below = INEXACT_RETRY * kkt.gap;
+                    failed_guess = None;
+                }
+            }
+        }
+        let Kkt {
+            r_d,
+            r_e,
+            r_i,
+            gap,
+            dual_scale,
+            ..
+        } = kkt;
+        let mu = if m > 0 { gap / m as f64 } else { 0.0 };
+
+        let minus_rd: Vec<f64> = r_d.iter().map(|v| -v).collect();
+        // Direction for a complementarity target r_c (Z ds + S dz = r_c): in augmented form
+        // P dx + Eᵀ(−dλ) + Gᵀ(−dz) = −r_d,  E dx = −r_e,  G dx − (s/z)(−dz) = r_c/z − r_i.
+        let rhs = |r_c: &[f64]| {
+            let mut b2: Vec<f64> = r_e.iter().map(|v| -v).collect();
+            b2.extend((0..m).map(|i| r_c[i] / z[i] - r_i[i]));
+            b2
+        };
+        let split = |[dx, mut w]: [Vec<f64>; 2], r_c: &[f64]| {
+            let w_in = w.split_off(m_eq);
+            let dl: Vec<f64> = w.iter().map(|w| -w).collect();
+            // Of ds and dz, the one of the larger variable comes from the linear system, the
+            // other from complementarity: dividing by the tiny one would amplify errors.
+            let gdx = qp.ineq.mul(&dx);
+            let (mut ds, mut dz) = (vec![0.0; m], vec![0.0; m]);
+            for i in 0..m {
+                if s[i] >= z[i] {
+                    ds[i] = gdx[i] + r_i[i];
+                    dz[i] = (r_c[i] - z[i] * ds[i]) / s[i];
+                } else {
+                    dz[i] = -w_in[i];
+                    ds[i] = (r_c[i] - s[i] * dz[i]) / z[i];
+                }
+            }
+            (dx, dl, ds, dz)
+        };
+        let step_length = |ds: &[f64], dz: &[f64]| max_step(&s, ds).min(max_step(&z, dz));
+        // Predictor (affine scaling), then the centred, second-order corrected step, with the
+        // least regularisation whose factor is sound.
+        let r_aff: Vec<f64> = (0..m).map(|i| -s[i] * z[i]).collect();
+        let d: Vec<f64> = (0..m).map(|i| s[i] / z[i]).collect();
+        // The corrector needs an accuracy just ahead of the iterate's own.
+        let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
+        let mut step = |reg: f64| {
+            let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg, &mut space)?;
+            let sol = newton.approximate(&minus_rd, &rhs(&r_aff));
+            let (_, _, ds_a, dz_a) = split(sol, &r_aff);
+            let alpha_a = step_length(&ds_a, &dz_a);
+            let mu_aff = if m > 0 {
+                (0..m)
+                    .map(|i| (s[i] + alpha_a * ds_a[i]) * (z[i] + alpha_a * dz_a[i]))
+                    .sum::<f64>()
+                    / m as f64
+            } else {
+                0.0
+            };
+            let sigma = if mu > 0.0 {
+                (mu_aff / mu).clamp(0.0, 1.0).powi(3)
+            } else {
+                0.0
+            };
+            let mut r_c: Vec<f64> = (0..m)
+                .map(|i| -s[i] * z[i] + sigma * mu - ds_a[i] * dz_a[i])
+                .collect();
+            // Gondzio's centrality correctors, tried with coarse solves: a few blocking
+            // products s_i z_i otherwise hold the step to a fraction of the way.
+            let mut b2 = rhs(&r_c);
+            let mut sol = newton.approximate(&minus_rd, &b2);
+            let mut dir = split(sol.clone(), &r_c);
+            let mut alpha = step_length(&dir.2, &dir.3);
+            let target = sigma * mu;
+            for _ in 0..CORRECTORS {
+                if alpha >= 0.9 || target <= 0.0 {
+                    break;
+                }
+                let trial = (CORRECTOR_STRETCH * alpha + CORRECTOR_ADD).min(1.0);
+                let mut r_try = r_c.clone();
+                for i in 0..m {
+                    let v = (s[i] + trial * dir.2[i]) * (z[i] + trial * dir.3[i]);
+                    let want = v.clamp(0.1 * target, 10.0 * target);
+                    r_try[i] += (want - v).max(-10.0 * target);
+                }
+                let b_try = rhs(&r_try);
+                let sol_try = newton.approximate(&minus_rd, &b_try);
+                let dir_try = split(sol_try.clone(), &r_try);
+                let a = step_length(&dir_try.2, &dir_try.3);
+                if a < alpha + 0.1 * (trial - alpha) {
+                    break;
+                }
+                (alpha, r_c, b2, sol, dir) = (a, r_try, b_try, sol_try, dir_try);
+            }
+            drop(dir);
+            let sol = newton.refine(sol, &minus_rd, &b2, precision, false)?;
+            Some(split(sol, &r_c))
+        };
+        let Some((dx, dl, ds, dz)) = REGULARISATION.iter().find_map(|&reg| step(reg)) else {
+            return fail(x, iteration, almost);
+        };
+        let alpha = (STEP_FRACTION * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
+        x.iter_mut().zip(&dx).for_each(|(a, d)| *a += alpha * d);
+        lambda
+            .iter_mut()
+            .zip(&dl)
+            .for_each(|(a, d)| *a += alpha * d);
+        s.iter_mut().zip(&ds).for_each(|(a, d)| *a += alpha * d);
+        z.iter_mut().zip(&dz).for_each(|(a, d)| *a += alpha * d);
+    }
+    match almost {
+        Some(x) => IpmOutput {
+            x,
+            status: IpmStatus::AlmostSolved,
+            iterations,
+            active: Vec::new(),
+        },
+        None => IpmOutput {
+            x,
+            status: IpmStatus::MaxIterations,
+            iterations,
+            active: Vec::new(),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests;

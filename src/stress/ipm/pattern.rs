@@ -1,0 +1,421 @@
+//! The normal matrix P + Cᵀ W C: its structure (fill-reducing relabelling, symbolic
+//! factorisation, the value slot of every product), built once per mesh connectivity and kept
+//! in a `PatternCache`, and its values for one QP.
+
+use super::*;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
+};
+use faer::sparse::linalg::{amd, SupernodalThreshold};
+use faer::sparse::SymbolicSparseColMatRef;
+
+/// The structure of the normal matrix P + Cᵀ W C (lower triangle, compressed columns): its
+/// fill-reducing relabelling (`label[i]` is the new index of unknown i, so that no numeric
+/// factorisation has to permute it again), its symbolic factorisation and the value slot of
+/// every product q_ka q_kb and c_ia c_ib. It depends only on where P's rows and C have entries,
+/// which form finding keeps from step to step, so a `PatternCache` carries it across steps.
+pub(super) struct Pattern {
+    /// Row starts and columns of P's rows and of C: with `n` and `m_eq`, the structure this
+    /// pattern was built from.
+    pub(super) built_from: [Vec<usize>; 4],
+    pub(super) n: usize,
+    pub(super) m_eq: usize,
+    pub(super) label: Vec<usize>,
+    pub(super) col_ptr: Vec<usize>,
+    pub(super) row_idx: Vec<usize>,
+    /// Slot of each product of P's rows, in the order `products` visits them.
+    pub(super) quad_slot: Vec<usize>,
+    /// Per constraint row, from `row_start[r]`: the slot of each of its products.
+    pub(super) row_start: Vec<usize>,
+    pub(super) row_slot: Vec<usize>,
+    pub(super) diag: Vec<usize>,
+    pub(super) symbolic: SymbolicCholesky<usize>,
+}
+
+/// The normal matrix's structure, kept between QPs of the same structure (the steps of one
+/// form finding): its ordering and symbolic analysis are then done once per loop instead of
+/// once per step. Empty by default; a QP of another structure replaces what it holds.
+#[derive(Default)]
+pub struct PatternCache {
+    pub(super) pattern: Option<Pattern>,
+    /// The last answer on this pattern, in the caller's units, and its active set.
+    pub(super) last: Option<(Vec<f64>, Vec<bool>)>,
+}
+
+impl PatternCache {
+    /// The pattern of P + Cᵀ W C for these matrices: the one held if it was built from the
+    /// same structure (true), else a new one (false; None if the ordering or analysis failed).
+    pub(super) fn pattern(
+        &mut self,
+        quad: &Csr,
+        cons: &Csr,
+        m_eq: usize,
+    ) -> Option<(&Pattern, bool)> {
+        let reused = self
+            .pattern
+            .as_ref()
+            .is_some_and(|p| p.fits(quad, cons, m_eq));
+        if !reused {
+            self.pattern = None;
+            self.pattern = Some(Pattern::new(quad, cons, m_eq)?);
+        }
+        self.pattern.as_ref().map(|p| (p, reused))
+    }
+}
+
+/// The normal matrix: the values of P and of each constraint row's products, on a `Pattern`.
+pub(super) struct Normal<'p> {
+    pub(super) pattern: &'p Pattern,
+    /// Values of P alone, in the pattern's slots.
+    pub(super) p_values: Vec<f64>,
+    /// c_ia c_ib for the slots `pattern.row_slot`.
+    pub(super) row_prod: Vec<f64>,
+}
+
+/// Every pair of entries (a, v_a), (b, v_b) with b ≤ a of each row r of `m`, as
+/// (r, a, b, v_a, v_b), row by row: the order of `Pattern::quad_slot` and `row_slot`.
+pub(super) fn products(m: &Csr) -> impl Iterator<Item = (usize, usize, usize, f64, f64)> + '_ {
+    (0..m.nrows()).flat_map(move |r| {
+        m.row(r).flat_map(move |(a, va)| {
+            m.row(r)
+                .filter(move |&(b, _)| b <= a)
+                .map(move |(b, vb)| (r, a, b, va, vb))
+        })
+    })
+}
+
+/// Lower-triangle pattern (column pointers, row indices) of the products of every row's
+/// entries with each other, for `n` unknowns. Built column by column with a marker array:
+/// sorting all products at once dominated the setup.
+pub(super) fn product_pattern(rows: [&Csr; 2], n: usize) -> (Vec<usize>, Vec<usize>) {
+    // The rows holding each unknown, as compressed columns; the second matrix's rows are
+    // numbered after the first's.
+    let first_rows = rows[0].nrows();
+    let row_entries = |k: usize| {
+        let m = rows[k];
+        (0..m.nrows()).flat_map(move |r| {
+            m.col[m.start[r]..m.start[r + 1]]
+                .iter()
+                .map(move |&a| (a, r + k * first_rows))
+        })
+    };
+    let (holder_ptr, holders) = bucketed(n, rows[0].col.len() + rows[1].col.len(), || {
+        row_entries(0).chain(row_entries(1))
+    });
+    let mut col_ptr = vec![0];
+    let mut row_idx = Vec::new();
+    let mut seen = vec![usize::MAX; n];
+    for c in 0..n {
+        let first = row_idx.len();
+        seen[c] = c;
+        row_idx.push(c);
+        for &h in &holders[holder_ptr[c]..holder_ptr[c + 1]] {
+            let (m, r) = match h.checked_sub(first_rows) {
+                Some(r) => (rows[1], r),
+                None => (rows[0], h),
+            };
+            for &b in &m.col[m.start[r]..m.start[r + 1]] {
+                if b > c && seen[b] != c {
+                    seen[b] = c;
+                    row_idx.push(b);
+                }
+            }
+        }
+        row_idx[first..].sort_unstable();
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx)
+}
+
+/// The slot in a relabelled lower-triangle pattern of every product `products(m)` visits, in
+/// its order. Per row, the labels are sorted so that one forward scan of each column finds
+/// all the row's later labels: a binary search per product mispredicted most of its branches
+/// (20 of the 35 ms the 6k-vertex row's pattern took).
+pub(super) fn product_slots(
+    m: &Csr,
+    label: &[usize],
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> Vec<usize> {
+    let mut out = Vec::new();
+    // The row's entries in label order, and the k × k table of their products' slots.
+    let (mut by_label, mut table) = (Vec::new(), Vec::new());
+    for r in 0..m.nrows() {
+        let cols = &m.col[m.start[r]..m.start[r + 1]];
+        let k = cols.len();
+        by_label.clear();
+        by_label.extend(0..k);
+        by_label.sort_unstable_by_key(|&i| label[cols[i]]);
+        table.clear();
+        table.resize(k * k, 0);
+        for (i, &a) in by_label.iter().enumerate() {
+            let col = label[cols[a]];
+            let mut slot = col_ptr[col];
+            debug_assert_eq!(row_idx[slot], col);
+            table[a * k + a] = slot;
+            for &b in &by_label[i + 1..] {
+                let row = label[cols[b]];
+                while row_idx[slot] != row {
+                    slot += 1;
+                }
+                debug_assert!(slot < col_ptr[col + 1]);
+                (table[a * k + b], table[b * k + a]) = (slot, slot);
+            }
+        }
+        // `products` order: a row's columns are sorted, so b ≤ a is position ib ≤ ia.
+        for ia in 0..k {
+            out.extend_from_slice(&table[ia * k..ia * k + ia + 1]);
+        }
+    }
+    out
+}
+
+/// The new label of every unknown in the approximate-minimum-degree order of a symmetric
+/// pattern (its lower triangle, rows sorted in each column).
+pub(super) fn amd_labels(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
+    let (mut order, mut label) = (vec![0; n], vec![0; n]);
+    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(n, row_idx.len())).ok()?;
+    amd::order(
+        &mut order,
+        &mut label,
+        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
+        amd::Control::default(),
+        MemStack::new(&mut buffer),
+    )
+    .ok()?;
+    Some(label)
+}
+
+/// The lower triangle of a symmetric pattern (given by its lower triangle) with its unknowns
+/// relabelled, rows sorted in each column.
+pub(super) fn relabelled_lower(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    label: &[usize],
+) -> (Vec<usize>, Vec<usize>) {
+    let (ptr, mut idx) = bucketed(n, row_idx.len(), || {
+        entries(col_ptr, row_idx).map(|(r, c)| {
+            let (a, b) = (label[r], label[c]);
+            (a.min(b), a.max(b))
+        })
+    });
+    for c in 0..n {
+        idx[ptr[c]..ptr[c + 1]].sort_unstable();
+    }
+    (ptr, idx)
+}
+
+/// The pattern of the transpose of an n × n compressed-column pattern (rows stay sorted: the
+/// entries come column by column).
+pub(super) fn transpose(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> (Vec<usize>, Vec<usize>) {
+    bucketed(n, row_idx.len(), || entries(col_ptr, row_idx))
+}
+
+/// The (row, column) entries of a compressed-column pattern, column by column.
+pub(super) fn entries<'a>(
+    col_ptr: &'a [usize],
+    row_idx: &'a [usize],
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    (0..col_ptr.len() - 1).flat_map(move |c| {
+        row_idx[col_ptr[c]..col_ptr[c + 1]]
+            .iter()
+            .map(move |&r| (r, c))
+    })
+}
+
+/// A compressed-column pattern of n columns from `nnz` (column, row) entries, rows in the
+/// order the entries come (`entries` is called twice: to count, then to fill).
+pub(super) fn bucketed<I: Iterator<Item = (usize, usize)>>(
+    n: usize,
+    nnz: usize,
+    entries: impl Fn() -> I,
+) -> (Vec<usize>, Vec<usize>) {
+    let mut ptr = vec![0; n + 1];
+    for (col, _) in entries() {
+        ptr[col + 1] += 1;
+    }
+    for c in 0..n {
+        ptr[c + 1] += ptr[c];
+    }
+    let mut next = ptr.clone();
+    let mut idx = vec![0; nnz];
+    for (col, row) in entries() {
+        idx[next[col]] = row;
+        next[col] += 1;
+    }
+    (ptr, idx)
+}
+
+/// The symbolic factorisation of a pattern already in its elimination order (given as an
+/// upper triangle: without an ordering faer reads it so, whatever the side).
+pub(super) fn symbolic_cholesky(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+) -> Option<SymbolicCholesky<usize>> {
+    factorize_symbolic_cholesky(
+        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
+        faer::Side::Lower,
+        SymmetricOrdering::Identity,
+        CholeskySymbolicParams {
+            // The simplicial variant is several times slower on these two-ring matrices
+            // even at a thousand unknowns.
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        },
+    )
+    .ok()
+}
+
+impl Pattern {
+    /// Whether the pattern was built from matrices with entries where `quad` and `cons` have
+    /// them (compared in place: no copy per step).
+    pub(super) fn fits(&self, quad: &Csr, cons: &Csr, m_eq: usize) -> bool {
+        let [quad_start, quad_col, cons_start, cons_col] = &self.built_from;
+        (self.n, self.m_eq) == (cons.ncols, m_eq)
+            && (quad_start, quad_col) == (&quad.start, &quad.col)
+            && (cons_start, cons_col) == (&cons.start, &cons.col)
+    }
+
+    /// `cons` = [E; G] with `m_eq` equality rows first.
+    pub(super) fn new(quad: &Csr, cons: &Csr, m_eq: usize) -> Option<Pattern> {
+        let n = cons.ncols;
+        let (col_ptr, row_idx) = product_pattern([quad, cons], n);
+        // One symbolic analysis in the new labels: the ordering alone comes from AMD, so
+        // that the pattern is not analysed twice.
+        let label = amd_labels(n, &col_ptr, &row_idx)?;
+        let (col_ptr, row_idx) = relabelled_lower(n, &col_ptr, &row_idx, &label);
+        let (up_ptr, up_idx) = transpose(n, &col_ptr, &row_idx);
+        let symbolic = symbolic_cholesky(n, &up_ptr, &up_idx)?;
+        let quad_slot = product_slots(quad, &label, &col_ptr, &row_idx);
+        let row_slot = product_slots(cons, &label, &col_ptr, &row_idx);
+        // A row's columns are distinct (`Csr::push_row` merges repeats): k entries, k(k+1)/2
+        // products.
+        let mut row_start = vec![0];
+        for r in 0..cons.nrows() {
+            let k = cons.start[r + 1] - cons.start[r];
+            row_start.push(row_start[r] + k * (k + 1) / 2);
+        }
+        debug_assert_eq!(row_start[cons.nrows()], row_slot.len());
+        // Rows are sorted in each column of the lower triangle: the diagonal comes first.
+        let diag = label.iter().map(|&l| col_ptr[l]).collect();
+        Some(Pattern {
+            built_from: [
+                quad.start.clone(),
+                quad.col.clone(),
+                cons.start.clone(),
+                cons.col.clone(),
+            ],
+            n,
+            m_eq,
+            label,
+            col_ptr,
+            row_idx,
+            quad_slot,
+            row_start,
+            row_slot,
+            diag,
+            symbolic,
+        })
+    }
+}
+
+impl<'p> Normal<'p> {
+    /// The values of P (rows of `quad` weighted by `quad_weight`) and of C's products on
+    /// `pattern`, which was built from the same structure.
+    pub(super) fn new(
+        pattern: &'p Pattern,
+        quad: &Csr,
+        quad_weight: &[f64],
+        cons: &Csr,
+    ) -> Normal<'p> {
+        let mut p_values = vec![0.0; pattern.row_idx.len()];
+        for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(products(quad)) {
+            p_values[slot] += quad_weight[r] * va * vb;
+        }
+        let mut row_prod = Vec::with_capacity(pattern.row_slot.len());
+        row_prod.extend(products(cons).map(|(.., va, vb)| va * vb));
+        Normal {
+            pattern,
+            p_values,
+            row_prod,
+        }
+    }
+
+    /// y = |P| |x| (entrywise absolute values): the size of the terms summed in P x.
+    pub(super) fn mul_p_abs(&self, x: &[f64]) -> Vec<f64> {
+        self.sum_p_terms(x, |p, x| (p * x).abs())
+    }
+
+    /// y = P x from the stored lower triangle (x and y in the new labels).
+    pub(super) fn mul_p(&self, x: &[f64]) -> Vec<f64> {
+        self.sum_p_terms(x, |p, x| p * x)
+    }
+
+    /// y_r = Σ_c term(P_rc, x_c) over the full symmetric P, from its lower triangle.
+    pub(super) fn sum_p_terms(&self, x: &[f64], term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
+        let mut y = vec![0.0; self.pattern.n];
+        let Pattern {
+            col_ptr, row_idx, ..
+        } = self.pattern;
+        for c in 0..self.pattern.n {
+            let mut acc = 0.0;
+            let range = col_ptr[c]..col_ptr[c + 1];
+            for (&r, &v) in row_idx[range.clone()].iter().zip(&self.p_values[range]) {
+                y[r] += term(v, x[c]);
+                if r != c {
+                    acc += term(v, x[r]);
+                }
+            }
+            y[c] += acc;
+        }
+        y
+    }
+}
+
+/// `m` with column j renamed `label[j]` (each row re-sorted by the new labels).
+pub(super) fn relabel_columns(m: &Csr, label: &[usize]) -> Csr {
+    let mut out = Csr {
+        ncols: m.ncols,
+        start: m.start.clone(),
+        col: Vec::with_capacity(m.col.len()),
+        val: Vec::with_capacity(m.val.len()),
+    };
+    let mut row = Vec::new();
+    for r in 0..m.nrows() {
+        row.clear();
+        row.extend(m.row(r).map(|(c, v)| (label[c], v)));
+        // Distinct columns stay distinct: sorting is all `Csr::push_row` would do.
+        row.sort_unstable_by_key(|e| e.0);
+        out.col.extend(row.iter().map(|e| e.0));
+        out.val.extend(row.iter().map(|e| e.1));
+    }
+    out
+}
+
+/// C = [E; G]: equality rows are constraints whose slack is pinned to zero. The rows are
+/// copied as they are (`Csr::push_row` made them sorted, without repeats or zeros).
+pub(super) fn stacked(eq: &Csr, ineq: &Csr) -> Csr {
+    let mut cons = eq.clone();
+    let offset = eq.col.len();
+    cons.start
+        .extend(ineq.start[1..].iter().map(|s| s + offset));
+    cons.col.extend_from_slice(&ineq.col);
+    cons.val.extend_from_slice(&ineq.val);
+    cons
+}
+
+/// `x` with entry i moved to `label[i]`.
+pub(super) fn relabel_vector(x: &[f64], label: &[usize]) -> Vec<f64> {
+    let mut out = vec![0.0; x.len()];
+    for (i, &l) in label.iter().enumerate() {
+        out[l] = x[i];
+    }
+    out
+}

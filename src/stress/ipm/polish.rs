@@ -1,0 +1,243 @@
+//! Polishing: the optimum for a guessed active set, solved for directly from an iterate or
+//! from the previous form-finding step's answer, with the guess corrected where it was wrong.
+
+use super::*;
+
+/// When `Kkt::near` holds: residuals within this many times the tolerance, relative gap
+/// below `POLISH_GAP`.
+pub(super) const POLISH_FEAS: f64 = 1e3;
+pub(super) const POLISH_GAP: f64 = 1e-5;
+
+/// The iterate polishing starts from (its slacks only enter through the active-set guess).
+#[derive(Clone, Copy)]
+pub(super) struct Point<'a> {
+    pub(super) x: &'a [f64],
+    pub(super) lambda: &'a [f64],
+    pub(super) z: &'a [f64],
+}
+
+/// How many wrong rows `polish` corrects, and for how many rounds (rows the step violates
+/// join the active set, rows whose multiplier comes out negative leave it).
+#[derive(Clone, Copy)]
+pub(super) enum Corrections {
+    /// From an iterate's guess: a few rows, up to `POLISH_ROUNDS` times; more wrong rows
+    /// than a share 1 / `POLISH_CORRECTABLE` of the active ones mean dependent active rows
+    /// or an early guess, and further rounds only chased them (cheese: each round made more
+    /// rows wrong).
+    Few,
+    /// From the previous form-finding step's active set (a primal–dual active-set method):
+    /// every wrong row, up to `WARM_ROUNDS` times, while their number at least halves each
+    /// round. Between late steps tens to hundreds of rows change, mostly bounds to release:
+    /// on the Cas-size dome and lilium the last 6–7 steps converged this way in 1–4 rounds
+    /// (Cas: 234 → 25 → 10 → 1 wrong rows), while on early steps the count fell by less
+    /// than half or grew from the second round on, and an attempt then costs two
+    /// factorisations.
+    AllWhileFewer,
+}
+pub(super) const POLISH_ROUNDS: usize = 3;
+pub(super) const POLISH_CORRECTABLE: usize = 200;
+pub(super) const WARM_ROUNDS: usize = 8;
+
+/// Why `polish` did not reach the optimum, which decides when it is worth another attempt
+/// (each costs a factorisation and several solves).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum PolishFailure {
+    /// The guess had more wrong rows than a round may correct, or kept finding new ones. One
+    /// more iteration usually settles it (lilium, groin), and where the gap stalls at its
+    /// rounding floor (the last form-finding steps on cheese, objective ~0) a later guess
+    /// is the way out: retried at the next iteration.
+    EarlyGuess,
+    /// No row was wrong, yet the step missed the tolerances (or its solve failed), also when
+    /// retried without the rows that wholly active groups imply: the active set is right but
+    /// the factor cannot resolve it that finely. At 100k unknowns, before that retry, this
+    /// repeated at every iteration from the 21st to the 27th: retried only once the gap has
+    /// fallen by `INEXACT_RETRY`.
+    Inexact,
+}
+
+/// After an `Inexact` failure, the factor by which the gap must fall before the next attempt
+/// (at 100k, from the gaps measured there: attempts at iterations 20, 21, 23, 25 and 27
+/// instead of every one from 20 to 27; 41 → 37 factorisations, as counted).
+pub(super) const INEXACT_RETRY: f64 = 1e-2;
+
+/// The optimum for the active set `guess` (see `active_guess`: inequalities with z > s held
+/// as equalities, the others dropped), accepted only if it meets every KKT condition: the
+/// inactive inequalities hold and the active ones have non-negative multipliers. It is a
+/// Newton step from the iterate, so it corrects the iterate's multipliers rather than
+/// computing new ones: when the active rows are dependent any combination would balance,
+/// and a fresh one need not be non-negative.
+///
+/// A guess with wrong rows is corrected as `corrections` says. An iterate's plain guess goes
+/// wrong on degenerate rows (s and z both tending to 0): on the generated
+/// groin vault one row with s = 7e-4, z = 2e-8 was violated by 1e-2 at every attempt, and
+/// the gap needed five more iterations to close.
+pub(super) fn polish(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    point: &Point,
+    (guess, corrections): (&[bool], Corrections),
+    tol: &Tolerances,
+    space: &mut FactorSpace,
+) -> Result<(Vec<f64>, Vec<bool>), PolishFailure> {
+    let m = guess.len();
+    let mut active = guess.to_vec();
+    let from = PolishFrom::new(qp, normal, point);
+    let rounds = match corrections {
+        Corrections::Few => POLISH_ROUNDS,
+        Corrections::AllWhileFewer => WARM_ROUNDS,
+    };
+    let mut last_wrong = usize::MAX;
+    // The answer is the point with the active rows on their bounds: their computed slack
+    // (rounding of differences of large Airy values) is an inequality residual, held to its
+    // tolerance, not complementarity. Counted in the gap it kept right active sets from
+    // being accepted (50k-vertex dome: the gap 3-11x its tolerance, the dual residual within).
+    let kkt_of = |step: &PolishStep, active: &[bool]| {
+        let s_new: Vec<f64> = (step.slack.iter().zip(active))
+            .map(|(&s, &a)| if a { 0.0 } else { s.max(0.0) })
+            .collect();
+        let z_new: Vec<f64> = step.multiplier.iter().map(|v| v.max(0.0)).collect();
+        Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new)
+    };
+    for _ in 0..rounds {
+        let step = polish_step(qp, normal, cons, &from, (&active, false), tol, space)
+            .ok_or(PolishFailure::Inexact)?;
+        let kkt = kkt_of(&step, &active);
+        if kkt.within(tol, 1.0) {
+            return Ok((step.x, active));
+        }
+        let (violation, negative) = (tol.feas * kkt.ineq_scale, tol.dual_feas * kkt.dual_scale);
+        let wrong: Vec<usize> = (0..m)
+            .filter(|&i| {
+                if active[i] {
+                    step.multiplier[i] < -negative
+                } else {
+                    step.slack[i] < -violation
+                }
+            })
+            .collect();
+        if wrong.is_empty() {
+            // The right active set, missed by the factor's accuracy: where whole groups of
+            // dependent rows are active, held without two rows each (at 100k the polished
+            // dual residual then came out 8-90x smaller, and the step ended at 26 iterations
+            // instead of 28).
+            if qp.groups.any_wholly_active(&active) {
+                let step = polish_step(qp, normal, cons, &from, (&active, true), tol, space)
+                    .ok_or(PolishFailure::Inexact)?;
+                if kkt_of(&step, &active).within(tol, 1.0) {
+                    return Ok((step.x, active));
+                }
+            }
+            return Err(PolishFailure::Inexact);
+        }
+        let correctable = match corrections {
+            Corrections::Few => {
+                let n_active = active.iter().filter(|&&a| a).count();
+                3.max(n_active / POLISH_CORRECTABLE)
+            }
+            Corrections::AllWhileFewer => last_wrong / 2,
+        };
+        if wrong.len() > correctable {
+            return Err(PolishFailure::EarlyGuess);
+        }
+        last_wrong = wrong.len();
+        for i in wrong {
+            active[i] = !active[i];
+        }
+    }
+    Err(PolishFailure::EarlyGuess)
+}
+
+/// The active set an iterate suggests: the inequality rows whose multiplier exceeds their
+/// slack.
+pub(super) fn active_guess(s: &[f64], z: &[f64]) -> Vec<bool> {
+    s.iter().zip(z).map(|(s, z)| z > s).collect()
+}
+
+/// The Newton step of `polish` for one guess of the active set. Slacks and multipliers are
+/// left unclipped: their signs show where the guess was wrong.
+pub(super) struct PolishStep {
+    pub(super) x: Vec<f64>,
+    pub(super) lambda: Vec<f64>,
+    /// G x − h per inequality row.
+    pub(super) slack: Vec<f64>,
+    /// The multiplier of each active row before clipping (0 on inactive rows).
+    pub(super) multiplier: Vec<f64>,
+}
+
+/// The iterate `polish` starts from, with the parts of its Newton right-hand side that do not
+/// depend on the active-set guess, computed once for all its rounds.
+pub(super) struct PolishFrom<'a> {
+    pub(super) point: Point<'a>,
+    /// P x + c − Eᵀλ: the dual residual before the active rows' Gᵀz.
+    pub(super) dual_before_g: Vec<f64>,
+    /// The constraint rows: f − E x, then h − G x.
+    pub(super) b2: Vec<f64>,
+}
+
+impl<'a> PolishFrom<'a> {
+    pub(super) fn new(qp: &Qp, normal: &Normal, point: &Point<'a>) -> PolishFrom<'a> {
+        let Point { x, lambda, .. } = *point;
+        let n = x.len();
+        let px = normal.mul_p(x);
+        let et_l = mul_t(qp.eq, lambda, n);
+        let dual_before_g = (0..n).map(|i| px[i] + qp.c[i] - et_l[i]).collect();
+        let mut b2: Vec<f64> = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| b - a).collect();
+        b2.extend(qp.ineq.mul(x).iter().zip(qp.h).map(|(a, b)| b - a));
+        PolishFrom {
+            point: *point,
+            dual_before_g,
+            b2,
+        }
+    }
+}
+
+pub(super) fn polish_step(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    from: &PolishFrom,
+    (active, release): (&[bool], bool),
+    tol: &Tolerances,
+    space: &mut FactorSpace,
+) -> Option<PolishStep> {
+    let Point { x, lambda, z, .. } = from.point;
+    let (n, m_eq, m) = (x.len(), qp.eq.nrows(), z.len());
+    // With `release`, rows of wholly active groups that the others imply are held only
+    // through them.
+    let active: Vec<bool> = if release {
+        let released = qp.groups.released(active, z);
+        (0..m).map(|i| active[i] && !released[i]).collect()
+    } else {
+        active.to_vec()
+    };
+    let z_active: Vec<f64> = (0..m).map(|i| if active[i] { z[i] } else { 0.0 }).collect();
+    let gt_z = mul_t(qp.ineq, &z_active, n);
+    let b1: Vec<f64> = (0..n).map(|i| -(from.dual_before_g[i] - gt_z[i])).collect();
+    let b2 = &from.b2;
+    // D = 0 holds a row as an equality; a huge D drops it (its multiplier is D⁻¹ × residual).
+    let mut d = vec![0.0; m_eq];
+    d.extend(active.iter().map(|&a| if a { 0.0 } else { 1e30 }));
+    let [dx, w] = REGULARISATION.iter().find_map(|&reg| {
+        Newton::new(normal, cons, d.clone(), reg, space)?.solve(&b1, b2, 1e-2 * tol.feas, true)
+    })?;
+    let x_new: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
+    let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
+    let gx = qp.ineq.mul(&x_new);
+    let slack: Vec<f64> = (0..m).map(|i| gx[i] - qp.h[i]).collect();
+    let multiplier: Vec<f64> = (0..m)
+        .map(|i| {
+            if active[i] {
+                z_active[i] - w[m_eq + i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    Some(PolishStep {
+        x: x_new,
+        lambda: lambda_new,
+        slack,
+        multiplier,
+    })
+}

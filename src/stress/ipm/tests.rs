@@ -1,0 +1,427 @@
+use super::*;
+
+fn csr(ncols: usize, rows: &[&[(usize, f64)]]) -> Csr {
+    let mut m = Csr::new(ncols);
+    for r in rows {
+        m.push_row(r.to_vec());
+    }
+    m
+}
+
+/// Two rows of a wholly active group are released, not collinear, and such that moving the
+/// multipliers along the group's combinations to zero them leaves its others non-negative
+/// (a vertex of {a : z_k + a·c_k ≥ 0}); a group with an inactive row releases none.
+#[test]
+fn released_rows_are_a_vertex_of_the_multiplier_shifts() {
+    let star: Vec<[f64; 2]> = [0.1f64, 1.2, 2.0, 3.3, 4.1, 5.4]
+        .iter()
+        .map(|a| [a.cos() * (1.0 + 0.3 * a), a.sin() * (1.0 + 0.3 * a)])
+        .collect();
+    let mut coef = star.clone();
+    coef.extend_from_slice(&star[..3]);
+    let groups = RowGroups {
+        start: vec![0, 6, 9],
+        row: (0..9).collect(),
+        coef,
+    };
+    let mut active = vec![true; 9];
+    active[8] = false;
+    for seed in 0..50u32 {
+        let z: Vec<f64> = (0..9)
+            .map(|k| 0.05 + ((seed * 7 + k * 13) % 17) as f64 / 4.0)
+            .collect();
+        let released = groups.released(&active, &z);
+        let rows: Vec<usize> = (0..9).filter(|&r| released[r]).collect();
+        assert_eq!(rows.len(), 2, "seed {seed}: {rows:?}");
+        let ([i, j], [a, b]) = ([rows[0], rows[1]], [star[rows[0]], star[rows[1]]]);
+        assert!(j < 6);
+        let det = a[0] * b[1] - a[1] * b[0];
+        assert!(det.abs() > 1e-3);
+        let shift = [
+            (-z[i] * b[1] + z[j] * a[1]) / det,
+            (-z[j] * a[0] + z[i] * b[0]) / det,
+        ];
+        for (k, c) in star.iter().enumerate() {
+            let shifted = z[k] + shift[0] * c[0] + shift[1] * c[1];
+            assert!(
+                shifted >= -1e-9,
+                "seed {seed}: row {k} shifted to {shifted}"
+            );
+        }
+    }
+}
+
+/// Every product of a row's entries lands in the slot of its (row, column) pair in the
+/// relabelled lower triangle, for rows of several lengths over a shuffled set of columns.
+#[test]
+fn product_slots_point_at_their_entries() {
+    let n = 40;
+    // A deterministic scramble of columns: rows of 1–12 distinct entries.
+    let mut seed = 12345u64;
+    let mut next = |k: usize| {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 33) as usize % k
+    };
+    let mut rows = |count: usize| {
+        let mut m = Csr::new(n);
+        for _ in 0..count {
+            let len = 1 + next(12);
+            m.push_row((0..len).map(|_| (next(n), 1.0 + next(5) as f64)).collect());
+        }
+        m
+    };
+    let (quad, cons) = (rows(30), rows(25));
+    let pattern = Pattern::new(&quad, &cons, 3).expect("pattern");
+    for (m, slots) in [(&quad, &pattern.quad_slot), (&cons, &pattern.row_slot)] {
+        let pairs: Vec<(usize, usize)> = products(m).map(|(_, a, b, ..)| (a, b)).collect();
+        assert_eq!(pairs.len(), slots.len());
+        for (&(a, b), &slot) in pairs.iter().zip(slots.iter()) {
+            let (col, row) = (pattern.label[a], pattern.label[b]);
+            let (col, row) = (col.min(row), col.max(row));
+            assert!((pattern.col_ptr[col]..pattern.col_ptr[col + 1]).contains(&slot));
+            assert_eq!(pattern.row_idx[slot], row, "product ({a}, {b})");
+        }
+    }
+    for (i, &slot) in pattern.diag.iter().enumerate() {
+        assert_eq!(pattern.row_idx[slot], pattern.label[i]);
+    }
+}
+
+/// min (x0 − 1)² + (x1 − 2)² + (x0 + x1 − 4)²  s.t. x0 − x1 = −0.5, x0 ≥ 1.8: on the
+/// line x1 = x0 + 0.5 the objective is least at x0 = 19/12 < 1.8, so the bound binds.
+#[test]
+fn small_qp_with_active_bound_and_equality() {
+    let quad = csr(2, &[&[(0, 1.0)], &[(1, 1.0)], &[(0, 1.0), (1, 1.0)]]);
+    let weight = [2.0, 2.0, 2.0];
+    // c = −2 Σ_k b_k a_k with targets b = (1, 2, 4).
+    let c = [-10.0, -12.0];
+    let eq = csr(2, &[&[(0, 1.0), (1, -1.0)]]);
+    let ineq = csr(2, &[&[(0, 1.0)]]);
+    let out = solve(
+        &Qp {
+            quad: &quad,
+            quad_weight: &weight,
+            c: &c,
+            constant: 1.0 + 4.0 + 16.0,
+            eq: &eq,
+            f: &[-0.5],
+            ineq: &ineq,
+            h: &[1.8],
+            groups: &RowGroups::default(),
+        },
+        &Tolerances::default(),
+        &mut PatternCache::default(),
+    );
+    assert_eq!(out.status, IpmStatus::Solved);
+    assert!((out.x[0] - 1.8).abs() < 1e-8, "{:?}", out.x);
+    assert!((out.x[1] - 2.3).abs() < 1e-8, "{:?}", out.x);
+}
+
+/// `polish` from the iterate (x, s, z) (no equality rows), in the caller's labels.
+fn polish_at(
+    qp: &Qp,
+    x: &[f64],
+    s: &[f64],
+    z: &[f64],
+    tol: &Tolerances,
+) -> Result<Vec<f64>, PolishFailure> {
+    let cons = stacked(qp.eq, qp.ineq);
+    let mut cache = PatternCache::default();
+    let (pattern, _) = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+    let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
+    let label = &normal.pattern.label;
+    let relabelled = Relabelled::new(qp, label);
+    let (qp, cons) = (relabelled.qp(qp), &relabelled.cons);
+    let mut space =
+        FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()).expect("factor space");
+    let x = relabel_vector(x, label);
+    let point = Point {
+        x: &x,
+        lambda: &[],
+        z,
+    };
+    let guess = active_guess(s, z);
+    let (polished, _) = polish(
+        &qp,
+        &normal,
+        cons,
+        &point,
+        (&guess, Corrections::Few),
+        tol,
+        &mut space,
+    )?;
+    Ok(label.iter().map(|&l| polished[l]).collect())
+}
+
+/// min (x0 − 2)² + (x1 + 10⁻⁶)² subject to x1 ≥ 0: the bound is active at the optimum
+/// (2, 0) with the tiny multiplier 2·10⁻⁶. At an iterate that has not told it apart yet
+/// (s = 10⁻³ > z = 10⁻⁷) the plain guess drops it and its step lands at x1 = −10⁻⁶,
+/// violating it; the corrected guess must find the optimum.
+#[test]
+fn polishing_corrects_a_wrongly_dropped_row() {
+    let quad = csr(2, &[&[(0, 1.0)], &[(1, 1.0)]]);
+    let qp = Qp {
+        quad: &quad,
+        quad_weight: &[2.0, 2.0],
+        c: &[-4.0, 2e-6],
+        constant: 4.0 + 1e-12,
+        eq: &csr(2, &[]),
+        f: &[],
+        ineq: &csr(2, &[&[(1, 1.0)]]),
+        h: &[0.0],
+        groups: &RowGroups::default(),
+    };
+    let x = polish_at(&qp, &[2.0, 1e-3], &[1e-3], &[1e-7], &Tolerances::default())
+        .expect("the corrected guess is optimal");
+    assert!((x[0] - 2.0).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
+}
+
+/// min Σ (x_i + 1)² subject to x ≥ 0 (four rows): every bound is active at the optimum
+/// x = 0, with multiplier 2.
+fn four_active_bounds<R>(run: impl FnOnce(&Qp) -> R) -> R {
+    let identity: Vec<Vec<(usize, f64)>> = (0..4).map(|i| vec![(i, 1.0)]).collect();
+    let rows: Vec<&[(usize, f64)]> = identity.iter().map(|r| r.as_slice()).collect();
+    let quad = csr(4, &rows);
+    run(&Qp {
+        quad: &quad,
+        quad_weight: &[2.0; 4],
+        c: &[2.0; 4],
+        constant: 4.0,
+        eq: &csr(4, &[]),
+        f: &[],
+        ineq: &quad,
+        h: &[0.0; 4],
+        groups: &RowGroups::default(),
+    })
+}
+
+/// A guess that drops all four active bounds has more wrong rows than a round may correct
+/// (at most three here): the iterate was early, and the caller may retry next iteration.
+#[test]
+fn polishing_a_guess_with_too_many_wrong_rows_reports_an_early_guess() {
+    let failure = four_active_bounds(|qp| {
+        polish_at(qp, &[0.1; 4], &[0.1; 4], &[1e-3; 4], &Tolerances::default())
+    });
+    assert_eq!(failure, Err(PolishFailure::EarlyGuess));
+}
+
+/// The right guess with a tolerance no step can meet (a negative gap) has no wrong row,
+/// so it is the precision that failed: the caller waits for the gap to fall before
+/// retrying. The same guess meets the default tolerances.
+#[test]
+fn polishing_the_right_guess_beyond_reach_reports_inexact() {
+    let at = |tol: Tolerances| {
+        four_active_bounds(|qp| polish_at(qp, &[0.1; 4], &[1e-3; 4], &[1.0; 4], &tol))
+    };
+    let unreachable = Tolerances {
+        gap_abs: -1.0,
+        ..Tolerances::default()
+    };
+    assert_eq!(at(unreachable), Err(PolishFailure::Inexact));
+    let x = at(Tolerances::default()).expect("the right guess is optimal");
+    assert!(x.iter().all(|v| v.abs() < 1e-12), "{x:?}");
+}
+
+/// min (x_0 − 10⁷)² + Σ (x_{i+1} − x_i − t_i)² subject to x_{i+1} − x_i ≥ 0.1, with
+/// t_i = −1 on every other difference (bound active, multiplier 2.2) and +1 on the rest.
+/// Polishing from a perturbed iterate lands on the optimum, but the slack of an active row,
+/// x_{i+1} − x_i − 0.1 with x near 10⁷, comes out as rounding (~1e-9) rather than 0. Those
+/// rows are held on their bounds, so that is an inequality residual (within its tolerance)
+/// and not complementarity: counted in the gap, the positive ones times z = 2.2 exceed the
+/// gap's tolerance (1e-12 + 1e-11 × 60.5) and would fail the step as inexact.
+#[test]
+fn polished_active_rows_count_on_their_bounds_in_the_gap() {
+    let n = 101;
+    let bound = 0.1;
+    let target: Vec<f64> = (0..n - 1)
+        .map(|i| if i % 2 == 0 { -1.0 } else { 1.0 })
+        .collect();
+    let mut rows: Vec<Vec<(usize, f64)>> = vec![vec![(0, 1.0)]];
+    rows.extend((0..n - 1).map(|i| vec![(i, -1.0), (i + 1, 1.0)]));
+    let quad = csr(n, &rows.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+    let ineq = csr(
+        n,
+        &rows[1..].iter().map(|r| r.as_slice()).collect::<Vec<_>>(),
+    );
+    let weight = vec![2.0; n];
+    // c = −2 Aᵀ b with b = (10⁷, t).
+    let mut c = vec![0.0; n];
+    c[0] = -2e7;
+    for (i, t) in target.iter().enumerate() {
+        c[i] += 2.0 * t;
+        c[i + 1] -= 2.0 * t;
+    }
+    let constant = 1e14 + target.iter().map(|t| t * t).sum::<f64>();
+    let qp = Qp {
+        quad: &quad,
+        quad_weight: &weight,
+        c: &c,
+        constant,
+        eq: &csr(n, &[]),
+        f: &[],
+        ineq: &ineq,
+        h: &vec![bound; n - 1],
+        groups: &RowGroups::default(),
+    };
+    let active = |i: usize| target[i] < bound;
+    let mut optimum = vec![1e7];
+    for t in &target {
+        optimum.push(optimum.last().expect("x_0") + t.max(bound));
+    }
+    let x: Vec<f64> = (0..n)
+        .map(|i| optimum[i] + 1e-3 * (((i * 7) % 5) as f64 - 2.0))
+        .collect();
+    let s: Vec<f64> = (0..n - 1)
+        .map(|i| if active(i) { 1e-6 } else { 1.0 })
+        .collect();
+    let z: Vec<f64> = (0..n - 1)
+        .map(|i| if active(i) { 2.2 } else { 1e-6 })
+        .collect();
+    let polished = polish_at(&qp, &x, &s, &z, &Tolerances::default())
+        .expect("the right active set polishes to the optimum");
+    for (i, t) in target.iter().enumerate() {
+        let d = polished[i + 1] - polished[i];
+        assert!(
+            (d - t.max(bound)).abs() < 1e-6,
+            "difference {i} = {d} for target {t}"
+        );
+    }
+    let above = (0..n - 1)
+        .filter(|&i| active(i) && polished[i + 1] - polished[i] - bound > 0.0)
+        .count();
+    assert!(
+        above > 0,
+        "no active slack rounds above 0: the test shows nothing"
+    );
+}
+
+/// min Σ (x_{i+1} − x_i − t_i)² subject to x_{i+1} ≥ x_i and x_0 = 10⁷: the differences
+/// come out at max(t_i, 0) while every unknown is near 10⁷, so P x sums terms of 10⁷ to
+/// O(1) results and its rounding (~1e-9) exceeds 1e-10 of the dual residual's scale. The
+/// method must still report the optimum as solved (the rounding floor), not stall.
+#[test]
+fn large_unknowns_with_small_differences_converge_at_the_rounding_floor() {
+    let n = 200;
+    let target: Vec<f64> = (0..n - 1)
+        .map(|i| ((i * 37) % 11) as f64 / 5.0 - 1.0)
+        .collect();
+    let diffs: Vec<Vec<(usize, f64)>> = (0..n - 1).map(|i| vec![(i, -1.0), (i + 1, 1.0)]).collect();
+    let rows: Vec<&[(usize, f64)]> = diffs.iter().map(|r| r.as_slice()).collect();
+    let quad = csr(n, &rows);
+    let weight = vec![2.0; n - 1];
+    // c = −2 Aᵀ t.
+    let mut c = vec![0.0; n];
+    for (i, t) in target.iter().enumerate() {
+        c[i] += 2.0 * t;
+        c[i + 1] -= 2.0 * t;
+    }
+    let constant = target.iter().map(|t| t * t).sum();
+    let out = solve(
+        &Qp {
+            quad: &quad,
+            quad_weight: &weight,
+            c: &c,
+            constant,
+            eq: &csr(n, &[&[(0, 1.0)]]),
+            f: &[1e7],
+            ineq: &quad,
+            h: &vec![0.0; n - 1],
+            groups: &RowGroups::default(),
+        },
+        &Tolerances::default(),
+        &mut PatternCache::default(),
+    );
+    assert_eq!(out.status, IpmStatus::Solved);
+    for (i, t) in target.iter().enumerate() {
+        let d = out.x[i + 1] - out.x[i];
+        assert!(
+            (d - t.max(0.0)).abs() < 1e-6,
+            "difference {i} = {d} for target {t}"
+        );
+    }
+}
+
+/// min Σ (x_i − t_i)² subject to x ≥ 0 and x constant over blocks of four: with targets of
+/// both signs many bounds are active, and each block must come out at the positive part
+/// of its mean (never 0: no degenerate bound), to the accuracy the tolerances imply
+/// (values are O(1); a wrong active set would be off by O(0.1)).
+#[test]
+fn bound_constrained_least_squares_finds_the_active_set() {
+    let n = 400;
+    let target: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 5.9).collect();
+    // The identity: the objective's rows and the bounds x ≥ 0.
+    let identity = csr(
+        n,
+        &(0..n)
+            .map(|i| vec![(i, 1.0)])
+            .collect::<Vec<_>>()
+            .iter()
+            .map(|r| r.as_slice())
+            .collect::<Vec<_>>(),
+    );
+    let weight = vec![2.0; n];
+    let c: Vec<f64> = target.iter().map(|t| -2.0 * t).collect();
+    let constant = target.iter().map(|t| t * t).sum();
+    let chain: Vec<Vec<(usize, f64)>> = (0..n - 1)
+        .filter(|i| i % 4 != 3)
+        .map(|i| vec![(i, 1.0), (i + 1, -1.0)])
+        .collect();
+    let eq = csr(n, &chain.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+    let out = solve(
+        &Qp {
+            quad: &identity,
+            quad_weight: &weight,
+            c: &c,
+            constant,
+            eq: &eq,
+            f: &vec![0.0; chain.len()],
+            ineq: &identity,
+            h: &vec![0.0; n],
+            groups: &RowGroups::default(),
+        },
+        &Tolerances::default(),
+        &mut PatternCache::default(),
+    );
+    assert_eq!(out.status, IpmStatus::Solved);
+    for block in 0..n / 4 {
+        let mean = target[4 * block..4 * block + 4].iter().sum::<f64>() / 4.0;
+        for i in 4 * block..4 * block + 4 {
+            assert!(
+                (out.x[i] - mean.max(0.0)).abs() < 1e-7,
+                "x{i} = {} for block mean {mean}",
+                out.x[i]
+            );
+        }
+    }
+}
+
+/// A stall is a window of `STALL_WINDOW` iterations in which neither the residuals halved
+/// nor the gap fell tenfold; progress on either, however slow, keeps the iterations going.
+#[test]
+fn a_stall_is_a_window_without_halved_residuals_or_a_tenfold_gap() {
+    let first_stall = |excess: &dyn Fn(u32) -> [f64; 2]| {
+        let mut progress = Progress::new();
+        (0..300).find(|&k| progress.stalled(k, excess(k)))
+    };
+    // Nothing moves: a stall as the window ends.
+    assert_eq!(first_stall(&|_| [10.0, 1e3]), Some(STALL_WINDOW));
+    // Slow but steady: the gap tenfold every 15 iterations, or the residuals halved
+    // every 19, the other flat.
+    let falling = |k: u32, per: f64, factor: f64| factor.powf(-(k as f64) / per);
+    assert_eq!(first_stall(&|k| [10.0, 1e3 * falling(k, 15.0, 10.0)]), None);
+    assert_eq!(first_stall(&|k| [10.0 * falling(k, 19.0, 2.0), 1e3]), None);
+    // Too slow: the residuals falling by 40% a window, the gap bouncing within a factor
+    // of 5: a stall as the first window ends.
+    assert_eq!(
+        first_stall(&|k| [
+            10.0 * 0.6f64.powf(k as f64 / 20.0),
+            if k % 2 == 0 { 1e3 } else { 2e2 }
+        ]),
+        Some(STALL_WINDOW)
+    );
+    // Progress restarts the window: the residuals halved at iteration 15, then flat.
+    let halved_at_15 = |k: u32| [if k < 15 { 10.0 } else { 4.9 }, 1e3];
+    assert_eq!(first_stall(&halved_at_15), Some(15 + STALL_WINDOW));
+}
