@@ -187,7 +187,7 @@ enum VsrStressStatus
   VSR_STRESS_STATUS_INFEASIBLE = 2,
   /**
    * Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
-   * native solver beyond 20k unknowns) 20 iterations went by without progress.
+   * native solver beyond 20k unknowns) 10 iterations went by without progress.
    */
   VSR_STRESS_STATUS_MAX_ITERATIONS = 3,
   VSR_STRESS_STATUS_NUMERICAL_ERROR = 4,
@@ -212,7 +212,7 @@ enum VsrQpSolver
    * Default: the structured interior-point method; falls back to clarabel when it does not
    * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
    * with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
-   * limit, or after 20 iterations without progress, with status
+   * limit, or after 10 iterations without progress, with status
    * VSR_STRESS_STATUS_MAX_ITERATIONS).
    */
   VSR_QP_SOLVER_NATIVE = 0,

@@ -137,7 +137,7 @@ pub enum VsrStressStatus {
     /// The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
     Infeasible = 2,
     /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
-    /// native solver beyond 20k unknowns) 20 iterations went by without progress.
+    /// native solver beyond 20k unknowns) 10 iterations went by without progress.
     MaxIterations = 3,
     NumericalError = 4,
 }
@@ -216,7 +216,7 @@ pub enum VsrQpSolver {
     /// Default: the structured interior-point method; falls back to clarabel when it does not
     /// converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
     /// with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
-    /// limit, or after 20 iterations without progress, with status
+    /// limit, or after 10 iterations without progress, with status
     /// VSR_STRESS_STATUS_MAX_ITERATIONS).
     Native = 0,
     /// clarabel's generic conic solver only: the reference.

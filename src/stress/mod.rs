@@ -31,7 +31,7 @@ pub enum StressStatus {
     /// The constraints (q_min, q_max, prescribed forces, straight free edges) admit no stress.
     Infeasible,
     /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
-    /// native solver beyond 20k unknowns) 20 iterations went by without progress.
+    /// native solver beyond 20k unknowns) 10 iterations went by without progress.
     MaxIterations,
     NumericalError,
 }

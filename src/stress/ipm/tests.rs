@@ -407,21 +407,21 @@ fn a_stall_is_a_window_without_halved_residuals_or_a_tenfold_gap() {
     };
     // Nothing moves: a stall as the window ends.
     assert_eq!(first_stall(&|_| [10.0, 1e3]), Some(STALL_WINDOW));
-    // Slow but steady: the gap tenfold every 15 iterations, or the residuals halved
-    // every 19, the other flat.
+    // Slow but steady: the gap tenfold every 8 iterations, or the residuals halved every
+    // 9, the other flat.
     let falling = |k: u32, per: f64, factor: f64| factor.powf(-(k as f64) / per);
-    assert_eq!(first_stall(&|k| [10.0, 1e3 * falling(k, 15.0, 10.0)]), None);
-    assert_eq!(first_stall(&|k| [10.0 * falling(k, 19.0, 2.0), 1e3]), None);
+    assert_eq!(first_stall(&|k| [10.0, 1e3 * falling(k, 8.0, 10.0)]), None);
+    assert_eq!(first_stall(&|k| [10.0 * falling(k, 9.0, 2.0), 1e3]), None);
     // Too slow: the residuals falling by 40% a window, the gap bouncing within a factor
     // of 5: a stall as the first window ends.
     assert_eq!(
         first_stall(&|k| [
-            10.0 * 0.6f64.powf(k as f64 / 20.0),
+            10.0 * 0.6f64.powf(k as f64 / STALL_WINDOW as f64),
             if k % 2 == 0 { 1e3 } else { 2e2 }
         ]),
         Some(STALL_WINDOW)
     );
-    // Progress restarts the window: the residuals halved at iteration 15, then flat.
-    let halved_at_15 = |k: u32| [if k < 15 { 10.0 } else { 4.9 }, 1e3];
-    assert_eq!(first_stall(&halved_at_15), Some(15 + STALL_WINDOW));
+    // Progress restarts the window: the residuals halved at iteration 7, then flat.
+    let halved_at_7 = |k: u32| [if k < 7 { 10.0 } else { 4.9 }, 1e3];
+    assert_eq!(first_stall(&halved_at_7), Some(7 + STALL_WINDOW));
 }
