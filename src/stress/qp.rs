@@ -294,8 +294,9 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
 
 /// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
 /// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
-/// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`.
-pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
+/// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
+/// `coarse`: solve to `ipm::Tolerances::coarse` if the QP has more than 20k unknowns.
+pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) -> QpOutput {
     let n_y = inp.s.ncols;
     let n_vertices = inp.u.len();
     let mut tau_col = vec![None; n_vertices];
@@ -415,7 +416,11 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache) -> QpOutput {
             h: &h,
             groups: &groups,
         },
-        &ipm::Tolerances::for_size(n),
+        &if coarse && ipm::fallback_is_costly(n) {
+            ipm::Tolerances::for_size(n).coarse()
+        } else {
+            ipm::Tolerances::for_size(n)
+        },
         cache,
     );
     let tau = tau_col
