@@ -176,6 +176,10 @@ enum VsrStressStatus
   : uint32_t
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
+  /**
+   * Solved to the solver's tolerances; in form finding beyond 20k unknowns to coarse
+   * optimality (relative gap 1e-3, bounds and equality rows as tight as ever).
+   */
   VSR_STRESS_STATUS_SOLVED = 0,
   /**
    * Solved to reduced accuracy.

@@ -131,6 +131,8 @@ impl VsrTermination {
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VsrStressStatus {
+    /// Solved to the solver's tolerances; in form finding beyond 20k unknowns to coarse
+    /// optimality (relative gap 1e-3, bounds and equality rows as tight as ever).
     Solved = 0,
     /// Solved to reduced accuracy.
     AlmostSolved = 1,
