@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Mat, Side};
 
 /// Parameters of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
@@ -45,8 +45,13 @@ pub struct ShapeStep {
     /// Row of each non-anchored vertex in the system (None for anchored / unreferenced).
     row: Vec<Option<usize>>,
     vertices: Vec<u32>,
-    /// Lower-triangle (row ≥ col) pattern of KᵀK, sorted and unique.
-    pattern: Vec<(usize, usize)>,
+    /// KᵀK's lower triangle (row ≥ col), column by column: `col_ptr`, `row_idx`.
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// Slot in `row_idx` of every product K_ia K_ic (a ≥ c) in the order `step` forms them,
+    /// and of every diagonal entry: the values are summed in place, in the same order each step.
+    product_slot: Vec<usize>,
+    diag_slot: Vec<usize>,
     symbolic: SymbolicLlt<usize>,
 }
 
@@ -61,42 +66,56 @@ impl ShapeStep {
                 vertices.push(v as u32);
             }
         }
-        // K's pattern: diagonal + edges between non-anchored vertices; KᵀK = Σ_i (row i)ᵀ(row i).
-        let k_rows = k_pattern(mesh, &row, &vertices);
-        let mut pattern = Vec::new();
+        let m = vertices.len();
+        let k_rows = k_columns(mesh, &row, m);
+        // The lower triangle's (col, row) pairs, sorted: column-major order.
+        let mut pairs: Vec<(usize, usize)> = Vec::new();
         for cols in &k_rows {
             for &a in cols {
-                for &b in cols {
-                    if a >= b {
-                        pattern.push((a, b));
+                for &c in cols {
+                    if a >= c {
+                        pairs.push((c, a));
                     }
                 }
             }
         }
-        pattern.sort_unstable();
-        pattern.dedup();
-        let m = vertices.len();
-        let entries: Vec<Triplet<usize, usize, f64>> = pattern
-            .iter()
-            .map(|&(r, c)| Triplet {
-                row: r,
-                col: c,
-                val: 1.0,
-            })
-            .collect();
-        let a = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &entries).map_err(|e| {
-            Error::Numerical {
-                what: format!("shape system pattern: {e:?}"),
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut col_ptr = vec![0usize; m + 1];
+        for &(c, _) in &pairs {
+            col_ptr[c + 1] += 1;
+        }
+        for c in 0..m {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let row_idx: Vec<usize> = pairs.iter().map(|&(_, r)| r).collect();
+        let slot_of = |a: usize, c: usize| {
+            let range = col_ptr[c]..col_ptr[c + 1];
+            range.start + row_idx[range].binary_search(&a).expect("in the pattern")
+        };
+        let mut product_slot = Vec::new();
+        for cols in &k_rows {
+            for &a in cols {
+                for &c in cols {
+                    if a >= c {
+                        product_slot.push(slot_of(a, c));
+                    }
+                }
             }
-        })?;
+        }
+        let diag_slot = (0..m).map(|i| slot_of(i, i)).collect();
+        let structure = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
         let symbolic =
-            SymbolicLlt::try_new(a.symbolic(), Side::Lower).map_err(|e| Error::Numerical {
+            SymbolicLlt::try_new(structure, Side::Lower).map_err(|e| Error::Numerical {
                 what: format!("shape system analysis: {e:?}"),
             })?;
         Ok(ShapeStep {
             row,
             vertices,
-            pattern,
+            col_ptr,
+            row_idx,
+            product_slot,
+            diag_slot,
             symbolic,
         })
     }
@@ -141,22 +160,20 @@ impl ShapeStep {
             .collect();
         let r_inf = r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         // KᵀK values on the fixed pattern, Kᵀb.
-        let mut ktk = std::collections::HashMap::with_capacity(self.pattern.len());
+        let mut ktk = vec![0.0; self.row_idx.len()];
         let mut ktb = vec![0.0; m];
+        let mut slots = self.product_slot.iter();
         for (i, cols) in k_rows.iter().enumerate() {
             for &(a, va) in cols {
                 ktb[a] += va * b[i];
                 for &(c, vc) in cols {
                     if a >= c {
-                        *ktk.entry((a, c)).or_insert(0.0) += va * vc;
+                        ktk[*slots.next().expect("one slot per product")] += va * vc;
                     }
                 }
             }
         }
-        let mean_diag = (0..m)
-            .map(|i| ktk.get(&(i, i)).copied().unwrap_or(0.0))
-            .sum::<f64>()
-            / m.max(1) as f64;
+        let mean_diag = self.diag_slot.iter().map(|&k| ktk[k]).sum::<f64>() / m.max(1) as f64;
         let scale = if mean_diag > 0.0 { mean_diag } else { 1.0 };
         let mu = (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * scale;
         let nu = schedule.pull * scale;
@@ -170,30 +187,18 @@ impl ShapeStep {
                 }
             })
             .collect();
-        let entries: Vec<Triplet<usize, usize, f64>> = self
-            .pattern
-            .iter()
-            .map(|&(a, c)| {
-                let mut val = ktk.get(&(a, c)).copied().unwrap_or(0.0);
-                if a == c {
-                    val += mu * lambda[a] + nu;
-                }
-                Triplet {
-                    row: a,
-                    col: c,
-                    val,
-                }
-            })
-            .collect();
-        let mat =
-            SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &entries).map_err(|e| {
+        for (i, &k) in self.diag_slot.iter().enumerate() {
+            ktk[k] += mu * lambda[i] + nu;
+        }
+        let mat = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx),
+            &ktk[..],
+        );
+        let llt =
+            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).map_err(|e| {
                 Error::Numerical {
-                    what: format!("shape system: {e:?}"),
+                    what: format!("shape system is not positive definite: {e:?}"),
                 }
-            })?;
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat.as_ref(), Side::Lower)
-            .map_err(|e| Error::Numerical {
-                what: format!("shape system is not positive definite: {e:?}"),
             })?;
         let mut rhs = Mat::from_fn(m, 1, |i, _| {
             let v = self.vertices[i] as usize;
@@ -213,13 +218,19 @@ impl ShapeStep {
     }
 }
 
-fn k_pattern(mesh: &Mesh, row: &[Option<usize>], vertices: &[u32]) -> Vec<Vec<usize>> {
-    let mut rows: Vec<Vec<usize>> = (0..vertices.len()).map(|i| vec![i]).collect();
+/// The columns of each row of K in the order `ShapeStep::step` pushes them (one diagonal
+/// entry per incident edge, then the neighbour's column if it is not anchored).
+fn k_columns(mesh: &Mesh, row: &[Option<usize>], m: usize) -> Vec<Vec<usize>> {
+    let mut rows: Vec<Vec<usize>> = vec![Vec::new(); m];
     for edge in &mesh.edges {
         let [i, j] = edge.v.map(|v| v as usize);
-        if let (Some(a), Some(b)) = (row[i], row[j]) {
-            rows[a].push(b);
-            rows[b].push(a);
+        for (a, c) in [(i, j), (j, i)] {
+            if let Some(ra) = row[a] {
+                rows[ra].push(ra);
+                if let Some(rc) = row[c] {
+                    rows[ra].push(rc);
+                }
+            }
         }
     }
     rows
