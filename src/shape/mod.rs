@@ -49,8 +49,9 @@ pub struct ShapeStep {
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     /// Slot in `row_idx` of every product K_ia K_ic (a ≥ c) in the order `step` forms them,
-    /// and of every diagonal entry: the values are summed in place, in the same order each step.
-    product_slot: Vec<usize>,
+    /// and of every diagonal entry: the values are summed in place, in the same order each step
+    /// (u32: tens of products per vertex, 31 MB at 100k vertices).
+    product_slot: Vec<u32>,
     diag_slot: Vec<usize>,
     symbolic: SymbolicLlt<usize>,
 }
@@ -93,12 +94,16 @@ impl ShapeStep {
             let range = col_ptr[c]..col_ptr[c + 1];
             range.start + row_idx[range].binary_search(&a).expect("in the pattern")
         };
+        let too_large = || Error::Numerical {
+            what: format!("shape system: {} non-zeros exceed u32", row_idx.len()),
+        };
+        u32::try_from(row_idx.len()).map_err(|_| too_large())?;
         let mut product_slot = Vec::new();
         for cols in &k_rows {
             for &a in cols {
                 for &c in cols {
                     if a >= c {
-                        product_slot.push(slot_of(a, c));
+                        product_slot.push(slot_of(a, c) as u32);
                     }
                 }
             }
@@ -168,7 +173,7 @@ impl ShapeStep {
                 ktb[a] += va * b[i];
                 for &(c, vc) in cols {
                     if a >= c {
-                        ktk[*slots.next().expect("one slot per product")] += va * vc;
+                        ktk[*slots.next().expect("one slot per product") as usize] += va * vc;
                     }
                 }
             }
