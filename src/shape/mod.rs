@@ -69,8 +69,9 @@ impl ShapeStep {
         }
         let m = vertices.len();
         let k_rows = k_columns(mesh, &row, m);
-        // The lower triangle's (col, row) pairs, sorted: column-major order.
-        let mut pairs: Vec<(usize, usize)> = Vec::new();
+        // The lower triangle's (col, row) pairs, sorted: column-major order. The diagonal is
+        // always in it (the proximal term), whatever the products.
+        let mut pairs: Vec<(usize, usize)> = (0..m).map(|i| (i, i)).collect();
         for cols in &k_rows {
             for &a in cols {
                 for &c in cols {
