@@ -42,9 +42,9 @@ impl Default for Schedule {
 /// The height step with its sparsity pattern analysed once: KᵀK has the two-ring pattern of
 /// the mesh restricted to non-anchored vertices, whatever the force densities.
 pub struct ShapeStep {
-    /// Row of each non-anchored vertex in the system (None for anchored / unreferenced).
-    row: Vec<Option<usize>>,
+    /// The non-anchored vertices, in the order of the system's rows.
     vertices: Vec<u32>,
+    k: KStructure,
     /// KᵀK's lower triangle (row ≥ col), column by column: `col_ptr`, `row_idx`.
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -68,13 +68,14 @@ impl ShapeStep {
             }
         }
         let m = vertices.len();
-        let k_rows = k_columns(mesh, &row, m);
+        let k = KStructure::new(mesh, &row, m);
+        let k_rows: Vec<&[usize]> = (0..m).map(|i| k.columns(i)).collect();
         // The lower triangle's (col, row) pairs, sorted: column-major order. The diagonal is
         // always in it (the proximal term), whatever the products.
         let mut pairs: Vec<(usize, usize)> = (0..m).map(|i| (i, i)).collect();
         for cols in &k_rows {
-            for &a in cols {
-                for &c in cols {
+            for &a in *cols {
+                for &c in *cols {
                     if a >= c {
                         pairs.push((c, a));
                     }
@@ -101,8 +102,8 @@ impl ShapeStep {
         u32::try_from(row_idx.len()).map_err(|_| too_large())?;
         let mut product_slot = Vec::new();
         for cols in &k_rows {
-            for &a in cols {
-                for &c in cols {
+            for &a in *cols {
+                for &c in *cols {
                     if a >= c {
                         product_slot.push(slot_of(a, c) as u32);
                     }
@@ -116,8 +117,8 @@ impl ShapeStep {
                 what: format!("shape system analysis: {e:?}"),
             })?;
         Ok(ShapeStep {
-            row,
             vertices,
+            k,
             col_ptr,
             row_idx,
             product_slot,
@@ -126,12 +127,10 @@ impl ShapeStep {
         })
     }
 
-    /// New heights for the non-anchored vertices (anchored ones are copied), given force
-    /// densities `q` per edge, loads `p`, current heights `z`, input heights `z0`, iteration k.
-    #[allow(clippy::too_many_arguments)]
+    /// New heights for the non-anchored vertices of the mesh given to `new` (anchored ones
+    /// are copied), given force densities `q` per edge, loads `p`, current heights `z`, input heights `z0`, iteration k.
     pub fn step(
         &self,
-        mesh: &Mesh,
         q: &[f64],
         p: &[f64],
         z: &[f64],
@@ -140,28 +139,33 @@ impl ShapeStep {
         schedule: &Schedule,
     ) -> Result<Vec<f64>> {
         let m = self.vertices.len();
-        // K rows as (col, value) lists, b, and r = K z − b.
-        let mut k_rows: Vec<Vec<(usize, f64)>> = self.vertices.iter().map(|_| Vec::new()).collect();
-        let mut b: Vec<f64> = self.vertices.iter().map(|&v| p[v as usize]).collect();
-        for (e, edge) in mesh.edges.iter().enumerate() {
-            let [i, j] = edge.v.map(|v| v as usize);
-            for (a, c) in [(i, j), (j, i)] {
-                if let Some(ra) = self.row[a] {
-                    k_rows[ra].push((ra, q[e]));
-                    match self.row[c] {
-                        Some(rc) => k_rows[ra].push((rc, -q[e])),
-                        None => b[ra] += q[e] * z[c],
-                    }
+        // K's values (one per entry of its structure), b, and r = K z − b.
+        let k_val: Vec<f64> = (self.k.edge.iter().zip(&self.k.negative))
+            .map(|(&e, &negative)| {
+                if negative {
+                    -q[e as usize]
+                } else {
+                    q[e as usize]
                 }
-            }
-        }
-        let r: Vec<f64> = (0..m)
+            })
+            .collect();
+        let k_rows: Vec<(&[usize], &[f64])> = (0..m)
             .map(|i| {
-                k_rows[i]
-                    .iter()
-                    .map(|&(c, v)| v * z[self.vertices[c] as usize])
+                let range = self.k.start[i]..self.k.start[i + 1];
+                (&self.k.col[range.clone()], &k_val[range])
+            })
+            .collect();
+        let mut b: Vec<f64> = self.vertices.iter().map(|&v| p[v as usize]).collect();
+        for &(ra, e, c) in &self.k.anchored {
+            b[ra] += q[e as usize] * z[c as usize];
+        }
+        let r: Vec<f64> = (k_rows.iter().zip(&b))
+            .map(|((cols, vals), bi)| {
+                cols.iter()
+                    .zip(*vals)
+                    .map(|(&c, v)| v * z[self.vertices[c] as usize])
                     .sum::<f64>()
-                    - b[i]
+                    - bi
             })
             .collect();
         let r_inf = r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -169,10 +173,10 @@ impl ShapeStep {
         let mut ktk = vec![0.0; self.row_idx.len()];
         let mut ktb = vec![0.0; m];
         let mut slots = self.product_slot.iter();
-        for (i, cols) in k_rows.iter().enumerate() {
-            for &(a, va) in cols {
+        for (i, (cols, vals)) in k_rows.iter().enumerate() {
+            for (&a, &va) in cols.iter().zip(*vals) {
                 ktb[a] += va * b[i];
-                for &(c, vc) in cols {
+                for (&c, &vc) in cols.iter().zip(*vals) {
                     if a >= c {
                         ktk[*slots.next().expect("one slot per product") as usize] += va * vc;
                     }
@@ -224,20 +228,56 @@ impl ShapeStep {
     }
 }
 
-/// The columns of each row of K in the order `ShapeStep::step` pushes them (one diagonal
-/// entry per incident edge, then the neighbour's column if it is not anchored).
-fn k_columns(mesh: &Mesh, row: &[Option<usize>], m: usize) -> Vec<Vec<usize>> {
-    let mut rows: Vec<Vec<usize>> = vec![Vec::new(); m];
-    for edge in &mesh.edges {
-        let [i, j] = edge.v.map(|v| v as usize);
-        for (a, c) in [(i, j), (j, i)] {
-            if let Some(ra) = row[a] {
-                rows[ra].push(ra);
-                if let Some(rc) = row[c] {
-                    rows[ra].push(rc);
+/// K = L_q[V_N, V_N] as a structure fixed by the mesh: per row, one diagonal entry +q_e per
+/// incident edge and, for a non-anchored neighbour, an entry −q_e in its column, in edge order;
+/// an anchored neighbour's q_e z_c goes to b instead. `ShapeStep::new` derives KᵀK's pattern
+/// and product slots from it, and `step` fills it with values, so both see one order.
+struct KStructure {
+    /// Row i is `start[i]..start[i + 1]` of `col`, `edge`, `negative`.
+    start: Vec<usize>,
+    col: Vec<usize>,
+    edge: Vec<u32>,
+    negative: Vec<bool>,
+    /// (row, edge, anchored vertex), in edge order.
+    anchored: Vec<(usize, u32, u32)>,
+}
+
+impl KStructure {
+    fn new(mesh: &Mesh, row: &[Option<usize>], m: usize) -> KStructure {
+        let mut rows: Vec<Vec<(usize, u32, bool)>> = vec![Vec::new(); m];
+        let mut anchored = Vec::new();
+        for (e, edge) in mesh.edges.iter().enumerate() {
+            let [i, j] = edge.v;
+            for (a, c) in [(i, j), (j, i)] {
+                if let Some(ra) = row[a as usize] {
+                    rows[ra].push((ra, e as u32, false));
+                    match row[c as usize] {
+                        Some(rc) => rows[ra].push((rc, e as u32, true)),
+                        None => anchored.push((ra, e as u32, c)),
+                    }
                 }
             }
         }
+        let mut start = vec![0];
+        let (mut col, mut edge, mut negative) = (Vec::new(), Vec::new(), Vec::new());
+        for entries in rows {
+            for (c, e, n) in entries {
+                col.push(c);
+                edge.push(e);
+                negative.push(n);
+            }
+            start.push(col.len());
+        }
+        KStructure {
+            start,
+            col,
+            edge,
+            negative,
+            anchored,
+        }
     }
-    rows
+
+    fn columns(&self, i: usize) -> &[usize] {
+        &self.col[self.start[i]..self.start[i + 1]]
+    }
 }

@@ -239,15 +239,7 @@ pub fn form_find(
         let t = Instant::now();
         let s = last.as_ref().unwrap();
         let z: Vec<f64> = positions.iter().map(|p| p[2]).collect();
-        match shape.step(
-            mesh,
-            &s.force_densities,
-            &s.loads,
-            &z,
-            &z0,
-            k,
-            &settings.schedule,
-        ) {
+        match shape.step(&s.force_densities, &s.loads, &z, &z0, k, &settings.schedule) {
             Ok(z_new) => positions.iter_mut().zip(z_new).for_each(|(p, z)| p[2] = z),
             Err(e) => {
                 termination = Termination::NumericalError {

@@ -193,7 +193,7 @@ pub fn analyse_near(
 #[derive(Default)]
 pub struct StressCache {
     normal: ipm::PatternCache,
-    /// Solve large native QPs to `ipm::Tolerances::coarse`.
+    /// Solve native QPs to `ipm::Tolerances::for_form_finding` (coarse when large).
     coarse: bool,
 }
 

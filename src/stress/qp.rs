@@ -295,7 +295,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
 /// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
 /// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
 /// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
-/// `coarse`: solve to `ipm::Tolerances::coarse` if the QP has more than 20k unknowns.
+/// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns).
 pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) -> QpOutput {
     let n_y = inp.s.ncols;
     let n_vertices = inp.u.len();
@@ -416,8 +416,8 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             h: &h,
             groups: &groups,
         },
-        &if coarse && ipm::fallback_is_costly(n) {
-            ipm::Tolerances::for_size(n).coarse()
+        &if coarse {
+            ipm::Tolerances::for_form_finding(n)
         } else {
             ipm::Tolerances::for_size(n)
         },

@@ -195,17 +195,22 @@ impl Tolerances {
         }
     }
 
-    /// Coarse optimality, the same feasibility: the relative gap 1e-3 and the dual residual
-    /// 10⁶ times its tolerance, while the bounds and equality rows are held as tightly, so the
-    /// answer is as compressive and as balanced horizontally as an exact one. A relative gap
-    /// g leaves the residual vector within √(2g) (4.5%) of the optimum's in norm. For form
-    /// finding beyond 20k unknowns (see `StressCache`), where exact QPs are most of the loop's
-    /// cost and their dual residual is what stalls.
-    pub fn coarse(self) -> Tolerances {
+    /// The tolerances of a form-finding step with `n` unknowns: `for_size`, with coarse
+    /// optimality where `fallback_is_costly` (beyond 20k unknowns; see `StressCache`): the
+    /// relative gap 1e-3 and the dual residual 10⁶ times its tolerance, while the bounds and
+    /// equality rows are held as tightly, so the answer is as compressive and as balanced
+    /// horizontally as an exact one. A relative gap g leaves the residual vector within √(2g)
+    /// (4.5%) of the optimum's in norm. There exact QPs are most of the loop's cost and their
+    /// dual residual is what stalls.
+    pub fn for_form_finding(n: usize) -> Tolerances {
+        let exact = Tolerances::for_size(n);
+        if !fallback_is_costly(n) {
+            return exact;
+        }
         Tolerances {
             gap_rel: 1e-3,
-            dual_feas: self.dual_feas * 1e6,
-            ..self
+            dual_feas: exact.dual_feas * 1e6,
+            ..exact
         }
     }
 }
