@@ -594,6 +594,12 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
     let fresh = stress::analyse(&small, &settings).unwrap();
     assert_eq!(cached.iterations, fresh.iterations);
     assert_eq!(cached.objective, fresh.objective);
+    // Small QPs try the last active set even far from balance: the same QP again is solved
+    // from it, without interior-point iterations.
+    cache.far_from_balance(true);
+    let again =
+        stress::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache).unwrap();
+    assert_eq!((again.status, again.iterations), (StressStatus::Solved, 0));
 
     let large = Problem::new(generate::cap_dome(0.8, 13_500).unwrap());
     assert!(large.mesh.positions.len() > 20_000);

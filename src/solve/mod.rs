@@ -185,6 +185,8 @@ pub fn form_find(
         } else {
             &settings.stress
         };
+        // Far from balance, a large step skips the last active set (a poor start there).
+        cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > 0.1));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         // A step that stopped short of its optimum may balance the shape worse than the forces
         // at hand (the previous ones, certified at these heights): those are kept instead,

@@ -365,7 +365,8 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
     let re = unit_rows(qp.eq, &d);
     let ri = unit_rows(qp.ineq, &d);
     let start_units = caller_units(&ri);
-    let warm = cache.last.take().map(|(x, active)| {
+    let skip_last = cache.far_from_balance && fallback_is_costly(n);
+    let warm = cache.last.take().filter(|_| !skip_last).map(|(x, active)| {
         let x: Vec<f64> = x.iter().zip(&d).map(|(x, d)| x / d).collect();
         (x, active)
     });

@@ -397,6 +397,54 @@ fn bound_constrained_least_squares_finds_the_active_set() {
     }
 }
 
+/// The same QP solved again starts from the last answer's active set (no interior-point
+/// iterations), unless the shape is said to be far from balance and the QP is large.
+#[test]
+fn far_from_balance_skips_the_last_active_set_only_beyond_20k_unknowns() {
+    for n in [400, 20_001] {
+        let target: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64 - 5.9).collect();
+        let rows: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+        let identity = csr(n, &rows.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+        let weight = vec![2.0; n];
+        let c: Vec<f64> = target.iter().map(|t| -2.0 * t).collect();
+        let constant = target.iter().map(|t| t * t).sum();
+        let qp = Qp {
+            quad: &identity,
+            quad_weight: &weight,
+            c: &c,
+            constant,
+            eq: &Csr::new(n),
+            f: &[],
+            ineq: &identity,
+            h: &vec![0.0; n],
+            groups: &RowGroups::default(),
+        };
+        let tol = Tolerances::for_size(n);
+        let mut cache = PatternCache::default();
+        let cold = solve(&qp, &tol, &mut cache);
+        assert_eq!(cold.status, IpmStatus::Solved);
+        assert!(cold.iterations > 0);
+        let near = solve(&qp, &tol, &mut cache);
+        assert_eq!(
+            (near.status, near.iterations),
+            (IpmStatus::Solved, 0),
+            "n = {n}"
+        );
+        cache.far_from_balance(true);
+        let far = solve(&qp, &tol, &mut cache);
+        let expected = if fallback_is_costly(n) {
+            cold.iterations
+        } else {
+            0
+        };
+        assert_eq!(
+            (far.status, far.iterations),
+            (IpmStatus::Solved, expected),
+            "n = {n}"
+        );
+    }
+}
+
 /// A stall is a window of `STALL_WINDOW` iterations in which neither the residuals halved
 /// nor the gap fell tenfold; progress on either, however slow, keeps the iterations going.
 #[test]
