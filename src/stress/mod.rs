@@ -227,7 +227,8 @@ impl StressCache {
 /// [`analyse_near`] reusing, and updating, `cache`: form finding's steps keep one cache, so
 /// that only the first step (and the first with a proximal centre) orders and analyses the
 /// normal matrix, and each later step first tries the previous step's active set (bounds
-/// held as equalities), corrected a few times; only if that does not meet the solver's
+/// held as equalities; not beyond 20k unknowns after [`StressCache::far_from_balance`]
+/// with `true`), corrected a few times; only if that does not meet the solver's
 /// tolerances do the interior-point iterations run. Either way the answer meets the same
 /// optimality tolerances as without the cache (the optimum itself, not necessarily the same
 /// point where the optimum is not unique), unless the cache is
