@@ -47,13 +47,9 @@ pub struct PatternCache {
 }
 
 impl PatternCache {
-    /// Whether the next QP's shape is far from balance (ε∞ > 0.1 with the last forces). A
-    /// height step there moves much of the shape, and the last active set is wrong in hundreds
-    /// of rows: counted over form findings of the nine shared models and the generated 20k
-    /// and 50k domes, attempts from shapes with ε∞ > 0.1 succeeded 3 times in 60 (50k: 0 in
-    /// 10, 0.3–0.6 s each, 2–3 factorisations), those below 0.1 in 42 of 61. Beyond 20k
-    /// unknowns such attempts are skipped; below, a failed one costs milliseconds and a
-    /// successful one can spare a fallback to clarabel (free_vault).
+    /// Whether the next QP's shape is far from balance (see `StressCache::far_from_balance`).
+    /// Only beyond 20k unknowns is the last active set then skipped: below, a failed attempt
+    /// costs milliseconds and a successful one can spare a fallback to clarabel (free_vault).
     pub fn far_from_balance(&mut self, far: bool) {
         self.far_from_balance = far;
     }
