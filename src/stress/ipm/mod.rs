@@ -188,11 +188,18 @@ impl Tolerances {
     /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
     ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
     ///   native, 120 s clarabel), so large problems get more (see `fallback_is_costly`).
+    /// - Beyond 20k unknowns one centrality corrector per iteration instead of three: each
+    ///   costs a solve with a large factor. The benchmark's 100k dome: 23 iterations and
+    ///   13.0 s instead of 26 and 17.1 s; 50k: 21 and 5.44 s instead of 20 and 5.58 s. At
+    ///   the paper's sizes one corrector was neither faster nor slower (±3%: barrel, lilium,
+    ///   cheese, dome with doors, free_vault, the Cas-size dome), so they keep three.
     pub fn for_size(n: usize) -> Tolerances {
         let base = Tolerances::default();
+        let large = fallback_is_costly(n);
         Tolerances {
             dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
-            max_iter: if fallback_is_costly(n) { 150 } else { 80 },
+            max_iter: if large { 150 } else { 80 },
+            correctors: if large { 1 } else { base.correctors },
             ..base
         }
     }
@@ -205,11 +212,10 @@ impl Tolerances {
     /// (4.5%) of the optimum's in norm. There exact QPs are most of the loop's cost and their
     /// dual residual is what stalls.
     ///
-    /// Coarse steps also try one centrality corrector per iteration instead of three: each
-    /// costs a solve with the factor, and the centrality the others buy is not what a coarse
-    /// stop needs. Measured on the generated domes' whole form findings (one run each): 50k
-    /// with 0, 1, 2 and 3 correctors 58.0, 51.7–53.4, 58.5 and 61.5–62.9 s (17 steps each);
-    /// 100k with 1 and 3, 164.9 s (24 steps) and 187.7 s (23 steps).
+    /// With `for_size`'s one centrality corrector: measured on the generated domes' whole
+    /// form findings (one run each), 50k with 0, 1, 2 and 3 correctors 58.0, 51.7–53.4, 58.5
+    /// and 61.5–62.9 s (17 steps each); 100k with 1 and 3, 164.9 s (24 steps) and 187.7 s
+    /// (23 steps).
     pub fn for_form_finding(n: usize) -> Tolerances {
         let exact = Tolerances::for_size(n);
         if !fallback_is_costly(n) {
@@ -218,7 +224,6 @@ impl Tolerances {
         Tolerances {
             gap_rel: 1e-3,
             dual_feas: exact.dual_feas * 1e6,
-            correctors: 1,
             ..exact
         }
     }
