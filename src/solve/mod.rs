@@ -119,6 +119,10 @@ pub struct FormFindResult {
     pub total_seconds: f64,
 }
 
+/// ε∞ with the previous forces above which a large stress step does not start from the
+/// previous active set (see `StressCache::far_from_balance`).
+const FAR_FROM_BALANCE: f64 = 0.1;
+
 /// Finds the nearest self-supporting shape to `problem`'s mesh.
 pub fn form_find(
     problem: &Problem,
@@ -185,8 +189,7 @@ pub fn form_find(
         } else {
             &settings.stress
         };
-        // Far from balance, a large step skips the last active set (a poor start there).
-        cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > 0.1));
+        cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         // A step that stopped short of its optimum may balance the shape worse than the forces
         // at hand (the previous ones, certified at these heights): those are kept instead,
