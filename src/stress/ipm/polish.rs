@@ -60,6 +60,10 @@ pub(super) enum PolishFailure {
 /// instead of every one from 20 to 27; 41 → 37 factorisations, as counted).
 pub(super) const INEXACT_RETRY: f64 = 1e-2;
 
+/// A polishing round is given up before its refinement when the unrefined step is wrong in
+/// more than this many times the rows the round may correct.
+pub(super) const HOPELESS: usize = 4;
+
 /// The optimum for the active set `guess` (see `active_guess`: inequalities with z > s held
 /// as equalities, the others dropped), accepted only if it meets every KKT condition: the
 /// inactive inequalities hold and the active ones have non-negative multipliers. It is a
@@ -99,15 +103,11 @@ pub(super) fn polish(
         let z_new: Vec<f64> = step.multiplier.iter().map(|v| v.max(0.0)).collect();
         Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new)
     };
-    for _ in 0..rounds {
-        let step = polish_step(qp, normal, cons, &from, (&active, false), tol, space)
-            .ok_or(PolishFailure::Inexact)?;
-        let kkt = kkt_of(&step, &active);
-        if kkt.within(tol, 1.0) {
-            return Ok((step.x, active));
-        }
+    // Rows where the step contradicts the guess: inactive rows it violates, active rows
+    // whose multiplier comes out negative.
+    let wrong_rows = |step: &PolishStep, kkt: &Kkt, active: &[bool]| -> Vec<usize> {
         let (violation, negative) = (tol.feas * kkt.ineq_scale, tol.dual_feas * kkt.dual_scale);
-        let wrong: Vec<usize> = (0..m)
+        (0..m)
             .filter(|&i| {
                 if active[i] {
                     step.multiplier[i] < -negative
@@ -115,21 +115,9 @@ pub(super) fn polish(
                     step.slack[i] < -violation
                 }
             })
-            .collect();
-        if wrong.is_empty() {
-            // The right active set, missed by the factor's accuracy: where whole groups of
-            // dependent rows are active, held without two rows each (at 100k the polished
-            // dual residual then came out 8-90x smaller, and the step ended at 26 iterations
-            // instead of 28).
-            if qp.groups.any_wholly_active(&active) {
-                let step = polish_step(qp, normal, cons, &from, (&active, true), tol, space)
-                    .ok_or(PolishFailure::Inexact)?;
-                if kkt_of(&step, &active).within(tol, 1.0) {
-                    return Ok((step.x, active));
-                }
-            }
-            return Err(PolishFailure::Inexact);
-        }
+            .collect()
+    };
+    for _ in 0..rounds {
         let correctable = match corrections {
             Corrections::Few => {
                 let n_active = active.iter().filter(|&&a| a).count();
@@ -137,6 +125,40 @@ pub(super) fn polish(
             }
             Corrections::AllWhileFewer => last_wrong / 2,
         };
+        let hopeless = |rough: &PolishStep| {
+            wrong_rows(rough, &kkt_of(rough, &active), &active).len()
+                > HOPELESS.saturating_mul(correctable.max(3))
+        };
+        let step = polish_step(
+            qp,
+            normal,
+            cons,
+            &from,
+            (&active, false, &hopeless),
+            tol,
+            space,
+        )?;
+        let kkt = kkt_of(&step, &active);
+        if kkt.within(tol, 1.0) {
+            return Ok((step.x, active));
+        }
+        let wrong = wrong_rows(&step, &kkt, &active);
+        if wrong.is_empty() {
+            // The right active set, missed by the factor's accuracy: where whole groups of
+            // dependent rows are active, held without two rows each (at 100k the polished
+            // dual residual then came out 8-90x smaller, and the step ended at 26 iterations
+            // instead of 28).
+            if qp.groups.any_wholly_active(&active) {
+                let never = |_: &PolishStep| false;
+                let step =
+                    polish_step(qp, normal, cons, &from, (&active, true, &never), tol, space)
+                        .map_err(|_| PolishFailure::Inexact)?;
+                if kkt_of(&step, &active).within(tol, 1.0) {
+                    return Ok((step.x, active));
+                }
+            }
+            return Err(PolishFailure::Inexact);
+        }
         if wrong.len() > correctable {
             return Err(PolishFailure::EarlyGuess);
         }
@@ -192,15 +214,22 @@ impl<'a> PolishFrom<'a> {
     }
 }
 
+/// Whether the unrefined step of a polishing round is wrong in too many rows to refine it.
+pub(super) type Hopeless<'a> = &'a dyn Fn(&PolishStep) -> bool;
+
+/// The Newton step of `polish` from `from` for the active set `active` (with `release`, less
+/// the rows that wholly active groups imply), refined to the tolerances unless `hopeless`
+/// gives up on the unrefined step (`EarlyGuess`); `Inexact` when no regularisation gives a
+/// factor fit for refinement.
 pub(super) fn polish_step(
     qp: &Qp,
     normal: &Normal,
     cons: &Csr,
     from: &PolishFrom,
-    (active, release): (&[bool], bool),
+    (active, release, hopeless): (&[bool], bool, Hopeless),
     tol: &Tolerances,
     space: &mut FactorSpace,
-) -> Option<PolishStep> {
+) -> Result<PolishStep, PolishFailure> {
     let Point { x, lambda, z, .. } = from.point;
     let (n, m_eq, m) = (x.len(), qp.eq.nrows(), z.len());
     // With `release`, rows of wholly active groups that the others imply are held only
@@ -215,29 +244,42 @@ pub(super) fn polish_step(
     let gt_z = mul_t(qp.ineq, &z_active, n);
     let b1: Vec<f64> = (0..n).map(|i| -(from.dual_before_g[i] - gt_z[i])).collect();
     let b2 = &from.b2;
+    let step_of = |[dx, w]: &[Vec<f64>; 2]| {
+        let x_new: Vec<f64> = x.iter().zip(dx).map(|(x, d)| x + d).collect();
+        let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
+        let gx = qp.ineq.mul(&x_new);
+        let slack: Vec<f64> = (0..m).map(|i| gx[i] - qp.h[i]).collect();
+        let multiplier: Vec<f64> = (0..m)
+            .map(|i| {
+                if active[i] {
+                    z_active[i] - w[m_eq + i]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        PolishStep {
+            x: x_new,
+            lambda: lambda_new,
+            slack,
+            multiplier,
+        }
+    };
     // D = 0 holds a row as an equality; a huge D drops it (its multiplier is D⁻¹ × residual).
     let mut d = vec![0.0; m_eq];
     d.extend(active.iter().map(|&a| if a { 0.0 } else { 1e30 }));
-    let [dx, w] = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(normal, cons, d.clone(), reg, space)?.solve(&b1, b2, 1e-2 * tol.feas, true)
-    })?;
-    let x_new: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| x + d).collect();
-    let lambda_new: Vec<f64> = (0..m_eq).map(|i| lambda[i] - w[i]).collect();
-    let gx = qp.ineq.mul(&x_new);
-    let slack: Vec<f64> = (0..m).map(|i| gx[i] - qp.h[i]).collect();
-    let multiplier: Vec<f64> = (0..m)
-        .map(|i| {
-            if active[i] {
-                z_active[i] - w[m_eq + i]
-            } else {
-                0.0
+    REGULARISATION
+        .iter()
+        .find_map(|&reg| {
+            let mut newton = Newton::new(normal, cons, d.clone(), reg, space)?;
+            let rough = newton.approximate(&b1, b2);
+            // The refinement to the tolerances costs several solves; a guess wrong in many
+            // times more rows than a round may correct is given up on the unrefined step.
+            if hopeless(&step_of(&rough)) {
+                return Some(Err(PolishFailure::EarlyGuess));
             }
+            let sol = newton.refine(rough, &b1, b2, 1e-2 * tol.feas, true)?;
+            Some(Ok(step_of(&sol)))
         })
-        .collect();
-    Some(PolishStep {
-        x: x_new,
-        lambda: lambda_new,
-        slack,
-        multiplier,
-    })
+        .unwrap_or(Err(PolishFailure::Inexact))
 }

@@ -178,23 +178,92 @@ fn polishing_corrects_a_wrongly_dropped_row() {
     assert!((x[0] - 2.0).abs() < 1e-12 && x[1].abs() < 1e-12, "{x:?}");
 }
 
-/// min Σ (x_i + 1)² subject to x ≥ 0 (four rows): every bound is active at the optimum
+/// min Σ (x_i + 1)² subject to x ≥ 0 (`k` rows): every bound is active at the optimum
 /// x = 0, with multiplier 2.
-fn four_active_bounds<R>(run: impl FnOnce(&Qp) -> R) -> R {
-    let identity: Vec<Vec<(usize, f64)>> = (0..4).map(|i| vec![(i, 1.0)]).collect();
+fn active_bounds<R>(k: usize, run: impl FnOnce(&Qp) -> R) -> R {
+    let identity: Vec<Vec<(usize, f64)>> = (0..k).map(|i| vec![(i, 1.0)]).collect();
     let rows: Vec<&[(usize, f64)]> = identity.iter().map(|r| r.as_slice()).collect();
-    let quad = csr(4, &rows);
+    let quad = csr(k, &rows);
     run(&Qp {
         quad: &quad,
-        quad_weight: &[2.0; 4],
-        c: &[2.0; 4],
-        constant: 4.0,
-        eq: &csr(4, &[]),
+        quad_weight: &vec![2.0; k],
+        c: &vec![2.0; k],
+        constant: k as f64,
+        eq: &csr(k, &[]),
         f: &[],
         ineq: &quad,
-        h: &[0.0; 4],
+        h: &vec![0.0; k],
         groups: &RowGroups::default(),
     })
+}
+
+fn four_active_bounds<R>(run: impl FnOnce(&Qp) -> R) -> R {
+    active_bounds(4, run)
+}
+
+/// Dropping all 40 active bounds of `active_bounds`: the unrefined step already violates
+/// each of them (x_i = −1), as the refined one does, so `polish` may give the guess up before
+/// refining it (40 wrong rows against at most 3 correctable); and a step given up is an
+/// early guess, not an inexact one.
+#[test]
+fn a_hopeless_guess_shows_its_wrong_rows_before_refinement() {
+    active_bounds(40, |qp| {
+        let cons = stacked(qp.eq, qp.ineq);
+        let mut cache = PatternCache::default();
+        let (pattern, _) = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+        let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
+        let mut space = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len())
+            .expect("factor space");
+        let (x, z) = (vec![0.1; 40], vec![1e-3; 40]);
+        let point = Point {
+            x: &x,
+            lambda: &[],
+            z: &z,
+        };
+        let from = PolishFrom::new(qp, &normal, &point);
+        let dropped = vec![false; 40];
+        let violated = |step: &PolishStep| step.slack.iter().filter(|&&s| s < -0.5).count();
+        let rough = std::cell::Cell::new(0);
+        let record = |step: &PolishStep| {
+            rough.set(violated(step));
+            false
+        };
+        let tol = Tolerances::default();
+        let refined = polish_step(
+            qp,
+            &normal,
+            &cons,
+            &from,
+            (&dropped, false, &record),
+            &tol,
+            &mut space,
+        )
+        .expect("a sound factor");
+        assert_eq!((rough.get(), violated(&refined)), (40, 40));
+        let give_up = |_: &PolishStep| true;
+        let given_up = polish_step(
+            qp,
+            &normal,
+            &cons,
+            &from,
+            (&dropped, false, &give_up),
+            &tol,
+            &mut space,
+        );
+        assert_eq!(given_up.err(), Some(PolishFailure::EarlyGuess));
+        let guess = active_guess(&[0.1; 40], &z);
+        assert_eq!(guess, dropped);
+        let polished = polish(
+            qp,
+            &normal,
+            &cons,
+            &point,
+            (&guess, Corrections::Few),
+            &tol,
+            &mut space,
+        );
+        assert_eq!(polished.err(), Some(PolishFailure::EarlyGuess));
+    });
 }
 
 /// A guess that drops all four active bounds has more wrong rows than a round may correct
