@@ -542,3 +542,92 @@ fn a_stall_is_a_window_without_halved_residuals_or_a_tenfold_gap() {
     let halved_at_7 = |k: u32| [if k < 7 { 10.0 } else { 4.9 }, 1e3];
     assert_eq!(first_stall(&halved_at_7), Some(7 + STALL_WINDOW));
 }
+
+/// `supernodal::solve_in_place` on the normal matrix of a QP whose quadratic rows are a
+/// 15 × 15 grid's five-point stencils (a two-ring normal matrix, factored in many
+/// supernodes): its solution solves the assembled matrix to rounding and equals faer's solve.
+#[test]
+fn supernodal_solve_matches_the_matrix_and_faer() {
+    let k: usize = 15;
+    let n = k * k;
+    let stencils: Vec<Vec<(usize, f64)>> = (0..n)
+        .map(|v| {
+            let (i, j) = (v / k, v % k);
+            let mut row = vec![(v, 4.0 + 0.1 * (v % 7) as f64)];
+            let neighbours = [
+                (i + 1, j),
+                (i, j + 1),
+                (i.wrapping_sub(1), j),
+                (i, j.wrapping_sub(1)),
+            ];
+            for (a, b) in neighbours.into_iter().filter(|&(a, b)| a < k && b < k) {
+                let u = a * k + b;
+                row.push((u, -1.0 - 0.01 * (u % 5) as f64));
+            }
+            row.sort_by_key(|e| e.0);
+            row
+        })
+        .collect();
+    let rows: Vec<&[(usize, f64)]> = stencils.iter().map(|r| r.as_slice()).collect();
+    let quad = csr(n, &rows);
+    let bounds: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+    let bound_rows: Vec<&[(usize, f64)]> = bounds.iter().map(|r| r.as_slice()).collect();
+    let ineq = csr(n, &bound_rows);
+    let cons = stacked(&csr(n, &[]), &ineq);
+    let mut cache = PatternCache::default();
+    let (pattern, _) = cache.pattern(&quad, &cons, 0).expect("normal matrix");
+    let normal = Normal::new(pattern, &quad, &vec![1.0; n], &cons);
+    let mut space =
+        FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()).expect("factor space");
+    let d: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+    drop(Newton::new(&normal, &cons, d, 1e-12, &mut space).expect("a sound factor"));
+    let symbolic = &normal.pattern.symbolic;
+    let faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw()
+    else {
+        panic!("the normal matrix is factored supernodally");
+    };
+    assert!(sym.n_supernodes() > 20, "{} supernodes", sym.n_supernodes());
+    let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
+    let mut own = b.clone();
+    assert!(supernodal::solve_in_place(
+        symbolic,
+        &space.l_values,
+        &mut own,
+        &mut Vec::new()
+    ));
+    let mut theirs = b.clone();
+    faer::sparse::linalg::cholesky::LdltRef::new(symbolic, &space.l_values)
+        .solve_in_place_with_conj(
+            faer::Conj::No,
+            faer::MatMut::from_column_major_slice_mut(&mut theirs, n, 1),
+            faer::Par::Seq,
+            faer::dyn_stack::MemStack::new(&mut space.buffer),
+        );
+    // A x from the factored lower triangle.
+    let (col_ptr, row_idx) = (&normal.pattern.col_ptr, &normal.pattern.row_idx);
+    let mut ax = vec![0.0; n];
+    for c in 0..n {
+        let range = col_ptr[c]..col_ptr[c + 1];
+        for (&r, &v) in row_idx[range.clone()].iter().zip(&space.values[range]) {
+            ax[r] += v * own[c];
+            if r != c {
+                ax[c] += v * own[r];
+            }
+        }
+    }
+    let residual = ax
+        .iter()
+        .zip(&b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(residual <= 1e-12 * inf_norm(&b), "residual {residual:e}");
+    let gap = own
+        .iter()
+        .zip(&theirs)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        gap <= 1e-12 * inf_norm(&theirs),
+        "own against faer's: {gap:e}"
+    );
+}
