@@ -229,27 +229,20 @@ fn a_hopeless_guess_shows_its_wrong_rows_before_refinement() {
             false
         };
         let tol = Tolerances::default();
-        let refined = polish_step(
-            qp,
-            &normal,
-            &cons,
-            &from,
-            (&dropped, false, &record),
-            &tol,
-            &mut space,
-        )
-        .expect("a sound factor");
+        let mut step_with = |hopeless: Hopeless| {
+            polish_step(
+                qp,
+                &normal,
+                &cons,
+                &from,
+                (&dropped, false, hopeless),
+                &tol,
+                &mut space,
+            )
+        };
+        let refined = step_with(&record).expect("a sound factor");
         assert_eq!((rough.get(), violated(&refined)), (40, 40));
-        let give_up = |_: &PolishStep| true;
-        let given_up = polish_step(
-            qp,
-            &normal,
-            &cons,
-            &from,
-            (&dropped, false, &give_up),
-            &tol,
-            &mut space,
-        );
+        let given_up = step_with(&|_: &PolishStep| true);
         assert_eq!(given_up.err(), Some(PolishFailure::EarlyGuess));
         let guess = active_guess(&[0.1; 40], &z);
         assert_eq!(guess, dropped);
