@@ -36,6 +36,9 @@ pub(super) enum Corrections {
 }
 pub(super) const POLISH_ROUNDS: usize = 3;
 pub(super) const POLISH_CORRECTABLE: usize = 200;
+/// An iterate's guess may always have this many rows corrected, and `HOPELESS` counts at
+/// least this many as correctable.
+pub(super) const MIN_CORRECTABLE: usize = 3;
 pub(super) const WARM_ROUNDS: usize = 8;
 
 /// Why `polish` did not reach the optimum, which decides when it is worth another attempt
@@ -61,12 +64,13 @@ pub(super) enum PolishFailure {
 pub(super) const INEXACT_RETRY: f64 = 1e-2;
 
 /// A polishing round is given up before its refinement when the unrefined step is wrong in
-/// more than this many times the rows the round may correct (counted as at least three: a
-/// warm round allowed no wrong row saw one unrefined that refinement removed, on lilium).
-/// Failed attempts had refined their step in full first; traced on lilium's form finding the
-/// unrefined steps of those given up showed 18–33 wrong rows against 24–50 refined (3
-/// correctable), and the nine shared models' reports stayed bit-identical. A step from a
-/// factor that refinement would have found unsound is judged the same way, as an early guess.
+/// more than this many times the rows the round may correct, counted as at least
+/// `MIN_CORRECTABLE` (a warm round allowed no wrong row saw one unrefined that refinement
+/// removed, on lilium). Failed attempts had refined their step in full first; traced on
+/// lilium's form finding the unrefined steps of those given up showed 18–33 wrong rows
+/// against 24–50 refined (3 correctable), and the nine shared models' reports stayed
+/// bit-identical. A step from a factor that refinement would have found unsound is judged
+/// the same way, as an early guess.
 pub(super) const HOPELESS: usize = 4;
 
 /// The optimum for the active set `guess` (see `active_guess`: inequalities with z > s held
@@ -126,13 +130,13 @@ pub(super) fn polish(
         let correctable = match corrections {
             Corrections::Few => {
                 let n_active = active.iter().filter(|&&a| a).count();
-                3.max(n_active / POLISH_CORRECTABLE)
+                MIN_CORRECTABLE.max(n_active / POLISH_CORRECTABLE)
             }
             Corrections::AllWhileFewer => last_wrong / 2,
         };
         let hopeless = |rough: &PolishStep| {
             wrong_rows(rough, &kkt_of(rough, &active), &active).len()
-                > HOPELESS.saturating_mul(correctable.max(3))
+                > HOPELESS.saturating_mul(correctable.max(MIN_CORRECTABLE))
         };
         let step = polish_step(
             qp,
