@@ -24,14 +24,18 @@
 
 use super::sparse::Csr;
 
+mod kkt;
 mod newton;
 mod pattern;
 mod polish;
+mod row_groups;
 mod supernodal;
+use kkt::*;
 use newton::*;
 pub use pattern::PatternCache;
 use pattern::*;
 use polish::*;
+pub use row_groups::RowGroups;
 
 /// A QP in the form above.
 pub struct Qp<'a> {
@@ -48,97 +52,6 @@ pub struct Qp<'a> {
     /// Inequality rows known to be dependent when all of a group are active (see
     /// `RowGroups`); empty when none are known.
     pub groups: &'a RowGroups,
-}
-
-/// Groups of inequality rows with two independent vanishing combinations each:
-/// Σ_k c_k row_k = 0 with c_k ∈ R² (the lower bounds of the edges around an interior vertex in
-/// reduced coordinates, whose forces balance horizontally there for every Airy function, with
-/// c the edge vectors). When a whole group is active, its rows are dependent and the right-hand
-/// side's rounding along the combinations is amplified by 1/δ: polishing then releases two
-/// rows per such group, which the others imply.
-#[derive(Debug, Clone, Default)]
-pub struct RowGroups {
-    /// Group g is `row[start[g]..start[g + 1]]` with coefficients `coef[..]` alike; `start` is
-    /// empty or begins with 0.
-    pub start: Vec<usize>,
-    pub row: Vec<usize>,
-    pub coef: Vec<[f64; 2]>,
-}
-
-impl RowGroups {
-    fn len(&self) -> usize {
-        self.start.len().saturating_sub(1)
-    }
-
-    fn group(&self, g: usize) -> (&[usize], &[[f64; 2]]) {
-        let range = self.start[g]..self.start[g + 1];
-        (&self.row[range.clone()], &self.coef[range])
-    }
-
-    fn any_wholly_active(&self, active: &[bool]) -> bool {
-        (0..self.len()).any(|g| self.group(g).0.iter().all(|&r| active[r]))
-    }
-
-    /// The same groups for rows scaled by `row_scale` (coefficients divided by it).
-    fn for_scaled_rows(&self, row_scale: &[f64]) -> RowGroups {
-        let coef = self
-            .row
-            .iter()
-            .zip(&self.coef)
-            .map(|(&r, c)| [c[0] / row_scale[r], c[1] / row_scale[r]])
-            .collect();
-        RowGroups {
-            start: self.start.clone(),
-            row: self.row.clone(),
-            coef,
-        }
-    }
-
-    /// The rows to release from the active set `active`: two of every group whose rows are
-    /// all active (and not yet released for another group). With multipliers z, the pair is
-    /// chosen so that shifting z along the group's combinations to zero them keeps the
-    /// group's other multipliers non-negative (a vertex of {a : z_k + a·c_k ≥ 0}), the best
-    /// conditioned such pair; with z = 0 every pair qualifies.
-    fn released(&self, active: &[bool], z: &[f64]) -> Vec<bool> {
-        let mut released = vec![false; active.len()];
-        for g in 0..self.len() {
-            let (rows, coef) = self.group(g);
-            if rows.len() < 3 || !rows.iter().all(|&r| active[r]) {
-                continue;
-            }
-            let mut best: Option<(f64, usize, usize)> = None;
-            for i in 0..rows.len() {
-                for j in i + 1..rows.len() {
-                    if released[rows[i]] || released[rows[j]] {
-                        continue;
-                    }
-                    let (a, b) = (coef[i], coef[j]);
-                    let det = a[0] * b[1] - a[1] * b[0];
-                    let norms = a[0].hypot(a[1]) * b[0].hypot(b[1]);
-                    if det.abs() <= 1e-6 * norms {
-                        continue;
-                    }
-                    // a·c_i = −z_i, a·c_j = −z_j.
-                    let (zi, zj) = (z[rows[i]], z[rows[j]]);
-                    let shift = [
-                        (-zi * b[1] + zj * a[1]) / det,
-                        (-zj * a[0] + zi * b[0]) / det,
-                    ];
-                    let feasible = rows.iter().zip(coef).all(|(&r, c)| {
-                        z[r] + shift[0] * c[0] + shift[1] * c[1] >= -1e-9 * z[r].abs().max(1e-300)
-                    });
-                    let conditioning = det.abs() / norms;
-                    if feasible && best.is_none_or(|(q, ..)| conditioning > q) {
-                        best = Some((conditioning, rows[i], rows[j]));
-                    }
-                }
-            }
-            if let Some((_, ri, rj)) = best {
-                (released[ri], released[rj]) = (true, true);
-            }
-        }
-        released
-    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -415,141 +328,6 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
         cache.last = Some((out.x.clone(), out.active.clone()));
     }
     out
-}
-
-/// The residuals of the KKT conditions at a point, each with the size of the terms that make
-/// it up (a backward error: at the optimum E x ≈ f is often 0 while its terms are not).
-struct Kkt {
-    r_d: Vec<f64>,
-    r_e: Vec<f64>,
-    r_i: Vec<f64>,
-    gap: f64,
-    objective: f64,
-    dual_scale: f64,
-    /// The rounding floor of the dual residual: `DUAL_ROUNDING` ulps of its largest sum of
-    /// term sizes.
-    dual_floor: f64,
-    eq_scale: f64,
-    ineq_scale: f64,
-}
-
-impl Kkt {
-    fn new(qp: &Qp, normal: &Normal, x: &[f64], lambda: &[f64], s: &[f64], z: &[f64]) -> Kkt {
-        let n = x.len();
-        let px = normal.mul_p(x);
-        let et_l = mul_t(qp.eq, lambda, n);
-        let gt_z = mul_t(qp.ineq, z, n);
-        let r_d = (0..n)
-            .map(|i| px[i] + qp.c[i] - et_l[i] - gt_z[i])
-            .collect();
-        let r_e = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| a - b).collect();
-        let gx = qp.ineq.mul(x);
-        let r_i = (0..s.len()).map(|i| gx[i] - qp.h[i] - s[i]).collect();
-        Kkt {
-            r_d,
-            r_e,
-            r_i,
-            gap: dot(s, z),
-            objective: 0.5 * dot(x, &px) + dot(qp.c, x) + qp.constant,
-            dual_scale: 1.0
-                + inf_norm(qp.c)
-                    .max(inf_norm(&px))
-                    .max(inf_norm(&gt_z))
-                    .max(inf_norm(&et_l)),
-            dual_floor: DUAL_ROUNDING
-                * f64::EPSILON
-                * inf_norm(
-                    &normal
-                        .mul_p_abs(x)
-                        .iter()
-                        .zip(abs_mul_t(qp.eq, lambda, n))
-                        .zip(abs_mul_t(qp.ineq, z, n))
-                        .zip(qp.c)
-                        .map(|(((p, e), g), c)| p + e + g + c.abs())
-                        .collect::<Vec<f64>>(),
-                ),
-            eq_scale: 1.0 + inf_norm(qp.f).max(abs_row_norm(qp.eq, x)),
-            ineq_scale: 1.0 + inf_norm(qp.h).max(abs_row_norm(qp.ineq, x)),
-        }
-    }
-
-    fn feasible(&self, tol: &Tolerances, k: f64) -> bool {
-        inf_norm(&self.r_d) <= k * (tol.dual_feas * self.dual_scale).max(self.dual_floor)
-            && inf_norm(&self.r_e) <= k * tol.feas * self.eq_scale
-            && inf_norm(&self.r_i) <= k * tol.feas * self.ineq_scale
-    }
-
-    /// How many times their tolerances the residuals (the largest of the three) and the gap
-    /// are.
-    fn excess(&self, tol: &Tolerances) -> [f64; 2] {
-        let residuals = (inf_norm(&self.r_d)
-            / (tol.dual_feas * self.dual_scale).max(self.dual_floor))
-        .max(inf_norm(&self.r_e) / (tol.feas * self.eq_scale))
-        .max(inf_norm(&self.r_i) / (tol.feas * self.ineq_scale));
-        [
-            residuals,
-            self.gap / (tol.gap_abs + tol.gap_rel * self.objective.abs()),
-        ]
-    }
-
-    /// Meets the tolerances relaxed k times.
-    fn within(&self, tol: &Tolerances, k: f64) -> bool {
-        self.feasible(tol, k) && self.gap <= k * (tol.gap_abs + tol.gap_rel * self.objective.abs())
-    }
-
-    /// Close enough to the optimum for the active set to be guessed.
-    fn near(&self, tol: &Tolerances) -> bool {
-        self.feasible(tol, POLISH_FEAS) && self.gap <= POLISH_GAP * (1.0 + self.objective.abs())
-    }
-}
-
-/// The dual residual is accepted within this many ulps of the largest sum of absolute terms
-/// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding. Weights and Airy values can be
-/// 10⁶–10⁷ in the scaled unknowns while P x is O(1) (100k-vertex form finding: Σ|P||x| 1.75e7
-/// against |P x| 2.7), and the residual then hovered at 0.5–1.5 ulps of those terms, 2–4×
-/// above the relative tolerance, for 50 iterations. Where the optimum is flat along some
-/// unknowns the iterates drift along them with the solves' rounding: free_vault's QP with
-/// q_min, solved with the supernodal solve's rounding instead of faer's (equal backward
-/// errors), drifted one Airy value from 8e3 to 7e4 and stalled at 35–40 ulps: with 10 it took
-/// 80 iterations and clarabel, with 100 it takes 11 (12 with faer's rounding and 10). 100
-/// ulps is still a backward error of 2e-14.
-const DUAL_ROUNDING: f64 = 100.0;
-
-/// Iterations without progress after which `Progress` declares a stall.
-const STALL_WINDOW: u32 = 10;
-
-/// Whether the iterations still make progress: the residuals halving or the gap falling
-/// tenfold (against where they stood at the last such progress) within `STALL_WINDOW`
-/// iterations. Only beyond 20k unknowns is a stall an exit (`fallback_is_costly`: the caller
-/// then keeps the answer at hand): there form-finding steps whose directions had gone inexact
-/// kept the dual residual near 1e-4, 2700× its tolerance, from their 12th iteration to the
-/// 150-iteration limit, with no tenfold fall of the gap in the 60 iterations after the 36th.
-/// Stopped by a stall at 19 iterations, the 100k dome's 13th step balanced the shape as well
-/// as at 150 (ε∞ 0.1612 against 0.1614) in 11 s instead of 71 s; a window of 20 stopped it at
-/// 55 (28 s), and the whole 100k form finding took 785 s with it against 508 s with 10.
-struct Progress {
-    reference: [f64; 2],
-    since: u32,
-}
-
-impl Progress {
-    fn new() -> Progress {
-        Progress {
-            reference: [f64::INFINITY; 2],
-            since: 0,
-        }
-    }
-
-    /// Records an iterate's `Kkt::excess`; true once it has made no progress for
-    /// `STALL_WINDOW` iterations.
-    fn stalled(&mut self, iteration: u32, [residuals, gap]: [f64; 2]) -> bool {
-        let [r, g] = self.reference;
-        if residuals < 0.5 * r || gap < 0.1 * g {
-            self.reference = [r.min(residuals), g.min(gap)];
-            self.since = iteration;
-        }
-        iteration - self.since >= STALL_WINDOW
-    }
 }
 
 fn solve_scaled(

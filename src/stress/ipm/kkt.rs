@@ -1,0 +1,146 @@
+//! The KKT residuals of an iterate, with the sizes of their terms, and the test of whether the
+//! iterations still make progress.
+
+use super::*;
+
+/// The residuals of the KKT conditions at a point, each with the size of the terms that make
+/// it up (a backward error: at the optimum E x ≈ f is often 0 while its terms are not).
+pub(super) struct Kkt {
+    pub(super) r_d: Vec<f64>,
+    pub(super) r_e: Vec<f64>,
+    pub(super) r_i: Vec<f64>,
+    pub(super) gap: f64,
+    pub(super) objective: f64,
+    pub(super) dual_scale: f64,
+    /// The rounding floor of the dual residual: `DUAL_ROUNDING` ulps of its largest sum of
+    /// term sizes.
+    pub(super) dual_floor: f64,
+    pub(super) eq_scale: f64,
+    pub(super) ineq_scale: f64,
+}
+
+impl Kkt {
+    pub(super) fn new(
+        qp: &Qp,
+        normal: &Normal,
+        x: &[f64],
+        lambda: &[f64],
+        s: &[f64],
+        z: &[f64],
+    ) -> Kkt {
+        let n = x.len();
+        let px = normal.mul_p(x);
+        let et_l = mul_t(qp.eq, lambda, n);
+        let gt_z = mul_t(qp.ineq, z, n);
+        let r_d = (0..n)
+            .map(|i| px[i] + qp.c[i] - et_l[i] - gt_z[i])
+            .collect();
+        let r_e = qp.eq.mul(x).iter().zip(qp.f).map(|(a, b)| a - b).collect();
+        let gx = qp.ineq.mul(x);
+        let r_i = (0..s.len()).map(|i| gx[i] - qp.h[i] - s[i]).collect();
+        Kkt {
+            r_d,
+            r_e,
+            r_i,
+            gap: dot(s, z),
+            objective: 0.5 * dot(x, &px) + dot(qp.c, x) + qp.constant,
+            dual_scale: 1.0
+                + inf_norm(qp.c)
+                    .max(inf_norm(&px))
+                    .max(inf_norm(&gt_z))
+                    .max(inf_norm(&et_l)),
+            dual_floor: DUAL_ROUNDING
+                * f64::EPSILON
+                * inf_norm(
+                    &normal
+                        .mul_p_abs(x)
+                        .iter()
+                        .zip(abs_mul_t(qp.eq, lambda, n))
+                        .zip(abs_mul_t(qp.ineq, z, n))
+                        .zip(qp.c)
+                        .map(|(((p, e), g), c)| p + e + g + c.abs())
+                        .collect::<Vec<f64>>(),
+                ),
+            eq_scale: 1.0 + inf_norm(qp.f).max(abs_row_norm(qp.eq, x)),
+            ineq_scale: 1.0 + inf_norm(qp.h).max(abs_row_norm(qp.ineq, x)),
+        }
+    }
+
+    pub(super) fn feasible(&self, tol: &Tolerances, k: f64) -> bool {
+        inf_norm(&self.r_d) <= k * (tol.dual_feas * self.dual_scale).max(self.dual_floor)
+            && inf_norm(&self.r_e) <= k * tol.feas * self.eq_scale
+            && inf_norm(&self.r_i) <= k * tol.feas * self.ineq_scale
+    }
+
+    /// How many times their tolerances the residuals (the largest of the three) and the gap
+    /// are.
+    pub(super) fn excess(&self, tol: &Tolerances) -> [f64; 2] {
+        let residuals = (inf_norm(&self.r_d)
+            / (tol.dual_feas * self.dual_scale).max(self.dual_floor))
+        .max(inf_norm(&self.r_e) / (tol.feas * self.eq_scale))
+        .max(inf_norm(&self.r_i) / (tol.feas * self.ineq_scale));
+        [
+            residuals,
+            self.gap / (tol.gap_abs + tol.gap_rel * self.objective.abs()),
+        ]
+    }
+
+    /// Meets the tolerances relaxed k times.
+    pub(super) fn within(&self, tol: &Tolerances, k: f64) -> bool {
+        self.feasible(tol, k) && self.gap <= k * (tol.gap_abs + tol.gap_rel * self.objective.abs())
+    }
+
+    /// Close enough to the optimum for the active set to be guessed.
+    pub(super) fn near(&self, tol: &Tolerances) -> bool {
+        self.feasible(tol, POLISH_FEAS) && self.gap <= POLISH_GAP * (1.0 + self.objective.abs())
+    }
+}
+
+/// The dual residual is accepted within this many ulps of the largest sum of absolute terms
+/// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding. Weights and Airy values can be
+/// 10⁶–10⁷ in the scaled unknowns while P x is O(1) (100k-vertex form finding: Σ|P||x| 1.75e7
+/// against |P x| 2.7), and the residual then hovered at 0.5–1.5 ulps of those terms, 2–4×
+/// above the relative tolerance, for 50 iterations. Where the optimum is flat along some
+/// unknowns the iterates drift along them with the solves' rounding: free_vault's QP with
+/// q_min, solved with the supernodal solve's rounding instead of faer's (equal backward
+/// errors), drifted one Airy value from 8e3 to 7e4 and stalled at 35–40 ulps: with 10 it took
+/// 80 iterations and clarabel, with 100 it takes 11 (12 with faer's rounding and 10). 100
+/// ulps is still a backward error of 2e-14.
+pub(super) const DUAL_ROUNDING: f64 = 100.0;
+
+/// Iterations without progress after which `Progress` declares a stall.
+pub(super) const STALL_WINDOW: u32 = 10;
+
+/// Whether the iterations still make progress: the residuals halving or the gap falling
+/// tenfold (against where they stood at the last such progress) within `STALL_WINDOW`
+/// iterations. Only beyond 20k unknowns is a stall an exit (`fallback_is_costly`: the caller
+/// then keeps the answer at hand): there form-finding steps whose directions had gone inexact
+/// kept the dual residual near 1e-4, 2700× its tolerance, from their 12th iteration to the
+/// 150-iteration limit, with no tenfold fall of the gap in the 60 iterations after the 36th.
+/// Stopped by a stall at 19 iterations, the 100k dome's 13th step balanced the shape as well
+/// as at 150 (ε∞ 0.1612 against 0.1614) in 11 s instead of 71 s; a window of 20 stopped it at
+/// 55 (28 s), and the whole 100k form finding took 785 s with it against 508 s with 10.
+pub(super) struct Progress {
+    pub(super) reference: [f64; 2],
+    pub(super) since: u32,
+}
+
+impl Progress {
+    pub(super) fn new() -> Progress {
+        Progress {
+            reference: [f64::INFINITY; 2],
+            since: 0,
+        }
+    }
+
+    /// Records an iterate's `Kkt::excess`; true once it has made no progress for
+    /// `STALL_WINDOW` iterations.
+    pub(super) fn stalled(&mut self, iteration: u32, [residuals, gap]: [f64; 2]) -> bool {
+        let [r, g] = self.reference;
+        if residuals < 0.5 * r || gap < 0.1 * g {
+            self.reference = [r.min(residuals), g.min(gap)];
+            self.since = iteration;
+        }
+        iteration - self.since >= STALL_WINDOW
+    }
+}
