@@ -581,13 +581,6 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
     };
     assert!(sym.n_supernodes() > 20, "{} supernodes", sym.n_supernodes());
     let b: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 5.0).collect();
-    let mut own = b.clone();
-    assert!(supernodal::solve_in_place(
-        symbolic,
-        &space.l_values,
-        &mut own,
-        &mut Vec::new()
-    ));
     let mut theirs = b.clone();
     faer::sparse::linalg::cholesky::LdltRef::new(symbolic, &space.l_values)
         .solve_in_place_with_conj(
@@ -596,31 +589,45 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
             faer::Par::Seq,
             faer::dyn_stack::MemStack::new(&mut space.buffer),
         );
-    // A x from the factored lower triangle.
-    let (col_ptr, row_idx) = (&normal.pattern.col_ptr, &normal.pattern.row_idx);
-    let mut ax = vec![0.0; n];
-    for c in 0..n {
-        let range = col_ptr[c]..col_ptr[c + 1];
-        for (&r, &v) in row_idx[range.clone()].iter().zip(&space.values[range]) {
-            ax[r] += v * own[c];
-            if r != c {
-                ax[c] += v * own[r];
+    // Both directions of the backward solve's reading.
+    for downwards in [false, true] {
+        let mut own = b.clone();
+        assert!(supernodal::solve_in_place_reading(
+            symbolic,
+            &space.l_values,
+            &mut own,
+            &mut Vec::new(),
+            downwards
+        ));
+        // A x from the factored lower triangle.
+        let (col_ptr, row_idx) = (&normal.pattern.col_ptr, &normal.pattern.row_idx);
+        let mut ax = vec![0.0; n];
+        for c in 0..n {
+            let range = col_ptr[c]..col_ptr[c + 1];
+            for (&r, &v) in row_idx[range.clone()].iter().zip(&space.values[range]) {
+                ax[r] += v * own[c];
+                if r != c {
+                    ax[c] += v * own[r];
+                }
             }
         }
+        let residual = ax
+            .iter()
+            .zip(&b)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            residual <= 1e-12 * inf_norm(&b),
+            "downwards {downwards}: residual {residual:e}"
+        );
+        let gap = own
+            .iter()
+            .zip(&theirs)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            gap <= 1e-12 * inf_norm(&theirs),
+            "downwards {downwards}: own against faer's: {gap:e}"
+        );
     }
-    let residual = ax
-        .iter()
-        .zip(&b)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    assert!(residual <= 1e-12 * inf_norm(&b), "residual {residual:e}");
-    let gap = own
-        .iter()
-        .zip(&theirs)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    assert!(
-        gap <= 1e-12 * inf_norm(&theirs),
-        "own against faer's: {gap:e}"
-    );
 }
