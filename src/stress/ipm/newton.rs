@@ -18,10 +18,13 @@ pub(super) const DELTA: f64 = 1e-7;
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
 /// Up to this many unknowns solves with the factor use `supernodal::solve_in_place`, beyond
-/// it faer's, whose dense kernels per supernode pay off on large supernodes. Scratch medians
-/// (own against faer's, with `DUAL_ROUNDING` 100 both): barrel 6.97 against 7.70 ms, lilium
-/// 26.9 / 28.0 ms (edge-based 61.0 / 66.8), cheese 141 / 154 ms, hex 16.1 / 18.4 ms; the
-/// 6k and 20k domes 0.18–0.19 and 1.28–1.34 s either way; the 50k dome 6.1 against 5.7 s.
+/// it faer's. Scratch medians (own against faer's, with `DUAL_ROUNDING` 100 both): barrel
+/// 6.97 against 7.70 ms, lilium 26.9 / 28.0 ms (edge-based 61.0 / 66.8), cheese 141 /
+/// 154 ms, hex 16.1 / 18.4 ms; the 6k and 20k domes 0.18–0.19 and 1.28–1.34 s either way.
+/// Since its backward solve reads large factors downwards the own solve is faster beyond
+/// too (50k: 8.7 against 13.1 ms a solve, 100k: 20 against 30 ms), but its rounding took the
+/// 100k step onto a trajectory that meets a frozen pivot (31 iterations and the stall exit
+/// against 23; docs/performance.md, nineteenth session), so faer's stays there.
 pub(super) const OWN_SOLVE_UP_TO: usize = 20_000;
 
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
