@@ -99,14 +99,17 @@ pub(super) fn solve_in_place_reading(
 /// register (one running sum must add in order, one term at a time).
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
+    four_sums((a4.remainder(), b4.remainder()), a4.zip(b4))
+}
+
+/// The sums of `dot`: the terms of `tail`, then four partial sums over `chunks` of four.
+fn four_sums<'a>(
+    tail: (&[f64], &[f64]),
+    chunks: impl Iterator<Item = (&'a [f64], &'a [f64])>,
+) -> f64 {
+    let tail: f64 = tail.0.iter().zip(tail.1).map(|(x, y)| x * y).sum();
     let mut acc = [0.0; 4];
-    for (x, y) in a4.zip(b4) {
+    for (x, y) in chunks {
         for k in 0..4 {
             acc[k] += x[k] * y[k];
         }
@@ -129,17 +132,5 @@ const DOWNWARDS_FROM: usize = 1 << 20;
 /// `dot` from the last terms to the first (the same four partial sums, taken from the end).
 fn dot_downwards(a: &[f64], b: &[f64]) -> f64 {
     let (a4, b4) = (a.rchunks_exact(4), b.rchunks_exact(4));
-    let tail: f64 = a4
-        .remainder()
-        .iter()
-        .zip(b4.remainder())
-        .map(|(x, y)| x * y)
-        .sum();
-    let mut acc = [0.0; 4];
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+    four_sums((a4.remainder(), b4.remainder()), a4.zip(b4))
 }

@@ -611,20 +611,17 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
                 }
             }
         }
-        let residual = ax
-            .iter()
-            .zip(&b)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let max_gap = |u: &[f64], v: &[f64]| {
+            (u.iter().zip(v))
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        };
+        let residual = max_gap(&ax, &b);
         assert!(
             residual <= 1e-12 * inf_norm(&b),
             "downwards {downwards}: residual {residual:e}"
         );
-        let gap = own
-            .iter()
-            .zip(&theirs)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let gap = max_gap(&own, &theirs);
         assert!(
             gap <= 1e-12 * inf_norm(&theirs),
             "downwards {downwards}: own against faer's: {gap:e}"
