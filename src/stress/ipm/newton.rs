@@ -22,9 +22,9 @@ pub(super) const DELTA_EQ: f64 = 1e-6;
 /// 6.97 against 7.70 ms, lilium 26.9 / 28.0 ms (edge-based 61.0 / 66.8), cheese 141 /
 /// 154 ms, hex 16.1 / 18.4 ms; the 6k and 20k domes 0.18–0.19 and 1.28–1.34 s either way.
 /// Since its backward solve reads large factors downwards the own solve is faster beyond
-/// too (50k: 8.7 against 13.1 ms a solve, 100k: 20 against 30 ms), but its rounding took the
-/// 100k step onto a trajectory that meets a frozen pivot (31 iterations and the stall exit
-/// against 23; docs/performance.md, nineteenth session), so faer's stays there.
+/// too (50k: 8.7 against 13.1 ms a solve, 100k: about 21 against 30 ms), but its rounding
+/// took the 100k step onto a trajectory that meets a frozen pivot (31 iterations and the
+/// stall exit against 23; docs/performance.md, nineteenth session), so faer's stays there.
 pub(super) const OWN_SOLVE_UP_TO: usize = 20_000;
 
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
