@@ -1,7 +1,8 @@
 //! Solves with a supernodal LDLᵀ factor, one right-hand side, in place. faer's solve
 //! dispatches a dense triangular solve and a matrix–vector product for every supernode; on
 //! the small supernodes of QPs with up to a few thousand unknowns that dispatch costs more
-//! than the arithmetic, and plain loops over each supernode's columns are faster.
+//! than the arithmetic, and plain loops over each supernode's columns are faster. Factors
+//! too large for the cache are read downwards by the backward solve (`DOWNWARDS_FROM`).
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
