@@ -1,6 +1,7 @@
 //! The reduced operator of de Goes et al.: force densities as a linear map of the Airy values
 //! φ (vertex weights), the hole jumps and the boundary creases, q = S y (MATH §3–6).
 
+use super::gauge;
 use super::holes::{cut_holes, HoleCut};
 use super::sparse::Csr;
 use crate::error::Result;
@@ -27,7 +28,8 @@ impl HoleMode {
     }
 }
 
-/// q = S y for y = (φ without the gauge vertices, hole coefficients, boundary creases).
+/// q = S y for y = (φ without the gauge vertices (`gauge::pinned_vertices`), hole
+/// coefficients, boundary creases).
 #[derive(Debug, Clone)]
 pub struct AiryOperator {
     /// One row per mesh edge (inactive edges have empty rows).
@@ -69,16 +71,7 @@ fn hole_basis(u: [f64; 2]) -> [f64; 3] {
 impl AiryOperator {
     pub fn new(mesh: &Mesh, plan: &Plan, mode: HoleMode) -> Result<AiryOperator> {
         let n = mesh.positions.len();
-        // Gauge: φ = 0 at the three vertices of the first face of every component.
-        let mut gauge = vec![false; n];
-        let mut gauged = vec![false; mesh.n_components];
-        for (t, f) in mesh.faces.iter().enumerate() {
-            let c = mesh.face_component[t] as usize;
-            if !gauged[c] {
-                gauged[c] = true;
-                f.iter().for_each(|&v| gauge[v as usize] = true);
-            }
-        }
+        let gauge = gauge::pinned_vertices(mesh, plan);
         let mut phi_col = vec![None; n];
         let mut cols = 0;
         for v in 0..n {

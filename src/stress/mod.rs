@@ -5,6 +5,7 @@
 //! it reports (residuals, ε∞, imbalance) is a certificate, not the solver's own claim.
 
 pub mod airy;
+mod gauge;
 pub mod holes;
 mod ipm;
 mod qp;

@@ -1,0 +1,160 @@
+//! The gauge of the Airy function. Affine φ gives q = 0, so φ is pinned to 0 at three
+//! vertices of every component (MATH §3). Any three non-collinear vertices remove that null
+//! space exactly, but not equally well: pinned at one small face, an Airy function that is
+//! affine except at that face, of size L (the mesh's extent) away from it, changes the
+//! force densities only by about h/L of its size (h the edge length), so the normal matrix
+//! has a direction whose curvature is about (h/L)², 1/n, below the rest. Pinned at three
+//! vertices far apart, the same direction must bend by its full size. On the benchmark's
+//! 100k-vertex dome that direction was the last pivot of the factor, which rounded away and
+//! derailed the interior-point iterations (docs/performance.md, twentieth session).
+
+use crate::geometry::Plan;
+use crate::mesh::Mesh;
+
+/// Per vertex, whether φ is pinned to 0 there: three free vertices of every component that
+/// are far apart in hops along edges (a choice that depends on the connectivity only, so it
+/// stays the same through a form finding), or the vertices of the component's first face
+/// where that triangle is no larger in the plan (fewer than three free vertices, or a mesh
+/// so thin that they line up).
+pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
+    let n = mesh.positions.len();
+    let mut free: Vec<Vec<usize>> = vec![Vec::new(); mesh.n_components];
+    for v in (0..n).filter(|&v| mesh.is_non_anchored(v)) {
+        let component = mesh.vertex_component.get(v).map(|&c| c as usize);
+        if let Some(list) = component.and_then(|c| free.get_mut(c)) {
+            list.push(v);
+        }
+    }
+    let mut first_face = vec![None; mesh.n_components];
+    for (t, &c) in mesh.face_component.iter().enumerate() {
+        first_face[c as usize].get_or_insert(t);
+    }
+    let mut pinned = vec![false; n];
+    let mut hops = Hops::new(mesh);
+    for (candidates, face) in free.iter().zip(first_face) {
+        let Some(face) = face else { continue };
+        let face = mesh.faces[face].map(|v| v as usize);
+        let chosen = spread(&mut hops, candidates)
+            .filter(|far| plan_area(plan, far) > plan_area(plan, &face))
+            .unwrap_or(face);
+        chosen.iter().for_each(|&v| pinned[v] = true);
+    }
+    pinned
+}
+
+/// Three distinct candidates far apart: the farthest from the first, the farthest from that
+/// one, and the one farthest from both.
+fn spread(hops: &mut Hops, candidates: &[usize]) -> Option<[usize; 3]> {
+    let &start = candidates.first()?;
+    // Ties go to the lowest vertex id, so the choice is deterministic.
+    let farthest = |key: &dyn Fn(usize) -> u32| {
+        candidates
+            .iter()
+            .copied()
+            .max_by_key(|&v| (key(v), std::cmp::Reverse(v)))
+    };
+    let from_start = hops.from(start);
+    let a = farthest(&|v| from_start[v])?;
+    let from_a = hops.from(a);
+    let b = farthest(&|v| from_a[v])?;
+    let from_b = hops.from(b);
+    let c = farthest(&|v| from_a[v].min(from_b[v]))?;
+    (a != b && b != c && c != a).then_some([a, b, c])
+}
+
+fn plan_area(plan: &Plan, v: &[usize; 3]) -> f64 {
+    let [a, b, c] = v.map(|v| plan.u[v]);
+    ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs()
+}
+
+/// Breadth-first hop counts along the mesh's edges.
+struct Hops<'a> {
+    mesh: &'a Mesh,
+    queue: Vec<usize>,
+}
+
+impl<'a> Hops<'a> {
+    fn new(mesh: &'a Mesh) -> Hops<'a> {
+        Hops {
+            mesh,
+            queue: Vec::new(),
+        }
+    }
+
+    /// Hops from `source` to every vertex (u32::MAX where unreachable).
+    fn from(&mut self, source: usize) -> Vec<u32> {
+        let mesh = self.mesh;
+        let mut hops = vec![u32::MAX; mesh.positions.len()];
+        hops[source] = 0;
+        self.queue.clear();
+        self.queue.push(source);
+        let mut next = 0;
+        while let Some(&v) = self.queue.get(next) {
+            next += 1;
+            for &e in mesh.edges_at(v) {
+                let [p, q] = mesh.edges[e as usize].v;
+                let w = if p as usize == v { q } else { p } as usize;
+                if hops[w] == u32::MAX {
+                    hops[w] = hops[v] + 1;
+                    self.queue.push(w);
+                }
+            }
+        }
+        hops
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate;
+    use crate::geometry::Frame;
+
+    fn pinned(mesh: &Mesh) -> (Vec<usize>, Plan) {
+        let plan = Plan::new(mesh, &mesh.positions, &Frame::of(mesh, &mesh.positions));
+        let pinned = pinned_vertices(mesh, &plan);
+        ((0..pinned.len()).filter(|&v| pinned[v]).collect(), plan)
+    }
+
+    #[test]
+    fn a_dome_is_pinned_at_three_free_vertices_spanning_its_plan() {
+        let mesh = generate::cap_dome(0.8, 2_000).unwrap();
+        let (vertices, plan) = pinned(&mesh);
+        assert_eq!(vertices.len(), 3);
+        assert!(vertices.iter().all(|&v| mesh.is_non_anchored(v)));
+        let triangle = plan_area(&plan, &[vertices[0], vertices[1], vertices[2]]) / 2.0;
+        let plan_total: f64 = plan.area.iter().sum();
+        // Three vertices spread over a disk span about a quarter of it (the inscribed
+        // right isosceles triangle: 1/π); one face spans 1/|F|.
+        assert!(triangle > 0.2 * plan_total, "{triangle} of {plan_total}");
+    }
+
+    #[test]
+    fn the_choice_follows_the_connectivity_not_the_plan() {
+        let mesh = generate::cap_dome(0.8, 500).unwrap();
+        let (before, _) = pinned(&mesh);
+        // Squeezed to a third of its width and turned: the same vertices.
+        let moved: Vec<[f64; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| [0.3 * p[0] - p[1], 0.1 * p[0] + p[1], p[2]])
+            .collect();
+        let plan = Plan::new(&mesh, &moved, &Frame::of(&mesh, &moved));
+        let after = pinned_vertices(&mesh, &plan);
+        assert!(before.iter().all(|&v| after[v]));
+    }
+
+    #[test]
+    fn too_few_free_vertices_fall_back_to_the_first_face() {
+        // A fan of six triangles around one free centre vertex.
+        let mut positions = vec![[0.0, 0.0, 1.0]];
+        for k in 0..6 {
+            let a = k as f64 * std::f64::consts::PI / 3.0;
+            positions.push([a.cos(), a.sin(), 0.0]);
+        }
+        let faces: Vec<[u32; 3]> = (0..6).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
+        let mesh = Mesh::new(positions, faces, &[1, 2, 3, 4, 5, 6]).unwrap();
+        let (vertices, _) = pinned(&mesh);
+        assert_eq!(vertices, vec![0, 1, 2]);
+    }
+}
