@@ -17,16 +17,6 @@ use faer::{Conj, MatMut, Par};
 pub(super) const DELTA: f64 = 1e-7;
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
-/// Up to this many unknowns solves with the factor use `supernodal::solve_in_place`, beyond
-/// it faer's. Scratch medians (own against faer's, with `DUAL_ROUNDING` 100 both): barrel
-/// 6.97 against 7.70 ms, lilium 26.9 / 28.0 ms (edge-based 61.0 / 66.8), cheese 141 /
-/// 154 ms, hex 16.1 / 18.4 ms; the 6k and 20k domes 0.18–0.19 and 1.28–1.34 s either way.
-/// Since its backward solve reads large factors downwards the own solve is faster beyond
-/// too (50k: 8.7 against 13.1 ms a solve, 100k: about 21 against 30 ms), but its rounding
-/// took the 100k step onto a trajectory that meets a frozen pivot (31 iterations and the
-/// stall exit against 23; docs/performance.md, nineteenth session), so faer's stays there.
-pub(super) const OWN_SOLVE_UP_TO: usize = 20_000;
-
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
 pub(super) const REGULARISATION: [f64; 3] = [1e-12, 1e-9, 1e-6];
 
@@ -140,9 +130,9 @@ impl<'a> Newton<'a> {
         dx.iter_mut().zip(b1).for_each(|(x, b)| *x += b);
         let space = &mut *self.space;
         let symbolic = &self.normal.pattern.symbolic;
-        let own = n <= OWN_SOLVE_UP_TO
-            && supernodal::solve_in_place(symbolic, &space.l_values, &mut dx, &mut space.scratch);
-        if !own {
+        // Our own loops over the supernodes (`supernodal`); faer's solve only for a factor
+        // that is not supernodal.
+        if !supernodal::solve_in_place(symbolic, &space.l_values, &mut dx, &mut space.scratch) {
             LdltRef::new(symbolic, &space.l_values).solve_in_place_with_conj(
                 Conj::No,
                 MatMut::from_column_major_slice_mut(&mut dx, n, 1),
