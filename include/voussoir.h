@@ -667,7 +667,9 @@ VsrStatus vsr_result_force_densities(const struct VsrResult *result, double *out
 
 /**
  * Airy stress function value φ per vertex, #V doubles (force × length; 0 at vertices used by
- * no triangle).
+ * no triangle). φ is defined up to an affine function, which changes no force: the reduced
+ * formulation pins it to 0 at three free vertices far apart, the edge-based one integrates
+ * it from the first face; compare forces, not φ, between runs.
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
