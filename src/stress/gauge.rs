@@ -5,17 +5,20 @@
 //! force densities only by about h/L of its size (h the edge length), so the normal matrix
 //! has a direction whose curvature is about (h/L)², 1/n, below the rest. Pinned at three
 //! vertices far apart, the same direction must bend by its full size. On the benchmark's
-//! 100k-vertex dome that direction was the last pivot of the factor, which rounded away and
-//! derailed the interior-point iterations (docs/performance.md, twentieth session).
+//! 100k-vertex dome the factor's last pivot, an Airy value, rounded away and derailed the
+//! interior-point iterations, most likely along that direction: with the spread gauge the
+//! same steps converge (docs/performance.md, twentieth session).
 
 use crate::geometry::Plan;
 use crate::mesh::Mesh;
+use std::cmp::Reverse;
 
 /// Per vertex, whether φ is pinned to 0 there: three free vertices of every component that
 /// are far apart in hops along edges (a choice that depends on the connectivity only, so it
 /// stays the same through a form finding), or the vertices of the component's first face
 /// where that triangle is no larger in the plan (fewer than three free vertices, or a mesh
-/// so thin that they line up).
+/// so thin that they line up; then the plan decides, and smoothing may flip the choice
+/// between steps, which only costs the next step its cached structure).
 pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
     let n = mesh.positions.len();
     let mut free: Vec<Vec<usize>> = vec![Vec::new(); mesh.n_components];
@@ -30,7 +33,7 @@ pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
         first_face[c as usize].get_or_insert(t);
     }
     let mut pinned = vec![false; n];
-    let mut hops = Hops::new(mesh);
+    let mut hops = Hops::new(mesh, n);
     for (candidates, face) in free.iter().zip(first_face) {
         let Some(face) = face else { continue };
         let face = mesh.faces[face].map(|v| v as usize);
@@ -46,20 +49,17 @@ pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
 /// one, and the one farthest from both.
 fn spread(hops: &mut Hops, candidates: &[usize]) -> Option<[usize; 3]> {
     let &start = candidates.first()?;
-    // Ties go to the lowest vertex id, so the choice is deterministic.
-    let farthest = |key: &dyn Fn(usize) -> u32| {
-        candidates
-            .iter()
-            .copied()
-            .max_by_key(|&v| (key(v), std::cmp::Reverse(v)))
-    };
-    let from_start = hops.from(start);
-    let a = farthest(&|v| from_start[v])?;
-    let from_a = hops.from(a);
-    let b = farthest(&|v| from_a[v])?;
-    let from_b = hops.from(b);
-    let c = farthest(&|v| from_a[v].min(from_b[v]))?;
-    (a != b && b != c && c != a).then_some([a, b, c])
+    // The index of the candidate with the largest key; ties go to the lowest index (the
+    // lowest vertex id), so the choice is deterministic.
+    let farthest =
+        |key: &dyn Fn(usize) -> u32| (0..candidates.len()).max_by_key(|&i| (key(i), Reverse(i)));
+    let from_start = hops.from(start, candidates);
+    let a = farthest(&|i| from_start[i])?;
+    let from_a = hops.from(candidates[a], candidates);
+    let b = farthest(&|i| from_a[i])?;
+    let from_b = hops.from(candidates[b], candidates);
+    let c = farthest(&|i| from_a[i].min(from_b[i]))?;
+    (a != b && b != c && c != a).then(|| [a, b, c].map(|i| candidates[i]))
 }
 
 fn plan_area(plan: &Plan, v: &[usize; 3]) -> f64 {
@@ -70,22 +70,25 @@ fn plan_area(plan: &Plan, v: &[usize; 3]) -> f64 {
 /// Breadth-first hop counts along the mesh's edges.
 struct Hops<'a> {
     mesh: &'a Mesh,
+    /// Per vertex, u32::MAX between searches.
+    hops: Vec<u32>,
     queue: Vec<usize>,
 }
 
 impl<'a> Hops<'a> {
-    fn new(mesh: &'a Mesh) -> Hops<'a> {
+    fn new(mesh: &'a Mesh, n: usize) -> Hops<'a> {
         Hops {
             mesh,
+            hops: vec![u32::MAX; n],
             queue: Vec::new(),
         }
     }
 
-    /// Hops from `source` to every vertex (u32::MAX where unreachable).
-    fn from(&mut self, source: usize) -> Vec<u32> {
+    /// Hops from `source` to each of `targets` (u32::MAX where unreachable). The search
+    /// stays in `source`'s component, so a mesh of many components costs O(n) in all.
+    fn from(&mut self, source: usize, targets: &[usize]) -> Vec<u32> {
         let mesh = self.mesh;
-        let mut hops = vec![u32::MAX; mesh.positions.len()];
-        hops[source] = 0;
+        self.hops[source] = 0;
         self.queue.clear();
         self.queue.push(source);
         let mut next = 0;
@@ -94,13 +97,15 @@ impl<'a> Hops<'a> {
             for &e in mesh.edges_at(v) {
                 let [p, q] = mesh.edges[e as usize].v;
                 let w = if p as usize == v { q } else { p } as usize;
-                if hops[w] == u32::MAX {
-                    hops[w] = hops[v] + 1;
+                if self.hops[w] == u32::MAX {
+                    self.hops[w] = self.hops[v] + 1;
                     self.queue.push(w);
                 }
             }
         }
-        hops
+        let out = targets.iter().map(|&t| self.hops[t]).collect();
+        self.queue.iter().for_each(|&v| self.hops[v] = u32::MAX);
+        out
     }
 }
 
@@ -124,8 +129,8 @@ mod tests {
         assert!(vertices.iter().all(|&v| mesh.is_non_anchored(v)));
         let triangle = plan_area(&plan, &[vertices[0], vertices[1], vertices[2]]) / 2.0;
         let plan_total: f64 = plan.area.iter().sum();
-        // Three vertices spread over a disk span about a quarter of it (the inscribed
-        // right isosceles triangle: 1/π); one face spans 1/|F|.
+        // Three vertices spread over a disk span about a third of it (the inscribed right
+        // isosceles triangle: 1/π); one face spans 1/|F|.
         assert!(triangle > 0.2 * plan_total, "{triangle} of {plan_total}");
     }
 
@@ -133,15 +138,46 @@ mod tests {
     fn the_choice_follows_the_connectivity_not_the_plan() {
         let mesh = generate::cap_dome(0.8, 500).unwrap();
         let (before, _) = pinned(&mesh);
-        // Squeezed to a third of its width and turned: the same vertices.
+        let first_face: Vec<usize> = mesh.faces[0].iter().map(|&v| v as usize).collect();
+        assert_ne!(before, first_face);
+        // Warped (r → r², not affine) and turned: the same vertices, though the plan's
+        // farthest points and largest triangles are others now.
         let moved: Vec<[f64; 3]> = mesh
             .positions
             .iter()
-            .map(|p| [0.3 * p[0] - p[1], 0.1 * p[0] + p[1], p[2]])
+            .map(|p| {
+                let r = p[0].hypot(p[1]);
+                [
+                    r * (0.6 * p[0] - 0.8 * p[1]),
+                    r * (0.8 * p[0] + 0.6 * p[1]),
+                    p[2],
+                ]
+            })
             .collect();
         let plan = Plan::new(&mesh, &moved, &Frame::of(&mesh, &moved));
         let after = pinned_vertices(&mesh, &plan);
         assert!(before.iter().all(|&v| after[v]));
+    }
+
+    #[test]
+    fn every_component_is_pinned_apart() {
+        // Two domes side by side, the second's ids after the first's.
+        let one = generate::cap_dome(0.8, 300).unwrap();
+        let n = one.positions.len() as u32;
+        let mut positions = one.positions.clone();
+        positions.extend(one.positions.iter().map(|p| [p[0] + 3.0, p[1], p[2]]));
+        let mut faces = one.faces.clone();
+        faces.extend(one.faces.iter().map(|f| f.map(|v| v + n)));
+        let anchored: Vec<u32> = (0..n)
+            .filter(|&v| one.anchored[v as usize])
+            .flat_map(|v| [v, v + n])
+            .collect();
+        let two = Mesh::new(positions, faces, &anchored).unwrap();
+        assert_eq!(two.n_components, 2);
+        let (vertices, _) = pinned(&two);
+        let (single, _) = pinned(&one);
+        let shifted: Vec<usize> = single.iter().map(|&v| v + n as usize).collect();
+        assert_eq!(vertices, [single, shifted].concat());
     }
 
     #[test]
