@@ -140,18 +140,15 @@ mod tests {
         let (before, _) = pinned(&mesh);
         let first_face: Vec<usize> = mesh.faces[0].iter().map(|&v| v as usize).collect();
         assert_ne!(before, first_face);
-        // Warped (r → r², not affine) and turned: the same vertices, though the plan's
-        // farthest points and largest triangles are others now.
+        // Warped so that other vertices are farthest apart in the plan and span the largest
+        // triangles (the right half squeezed to a fifth, the plan sheared by x): the same
+        // vertices.
         let moved: Vec<[f64; 3]> = mesh
             .positions
             .iter()
             .map(|p| {
-                let r = p[0].hypot(p[1]);
-                [
-                    r * (0.6 * p[0] - 0.8 * p[1]),
-                    r * (0.8 * p[0] + 0.6 * p[1]),
-                    p[2],
-                ]
+                let x = if p[0] > 0.0 { 0.2 * p[0] } else { p[0] };
+                [x, p[1] * (1.0 + 0.8 * p[0]), p[2]]
             })
             .collect();
         let plan = Plan::new(&mesh, &moved, &Frame::of(&mesh, &moved));
