@@ -44,6 +44,8 @@ pub(super) struct FactorSpace {
     pub(super) buffer: MemBuffer,
     /// Working storage of `supernodal::solve_in_place`.
     pub(super) scratch: Vec<f64>,
+    /// Large factors' solves on two threads.
+    pub(super) split: Option<supernodal::Split>,
 }
 
 impl FactorSpace {
@@ -58,6 +60,7 @@ impl FactorSpace {
             l_values: vec![0.0; symbolic.len_val()],
             buffer: MemBuffer::try_new(scratch).ok()?,
             scratch: Vec::new(),
+            split: supernodal::Split::new(symbolic, supernodal::SPLIT_FROM),
         })
     }
 }
@@ -131,8 +134,15 @@ impl<'a> Newton<'a> {
         let space = &mut *self.space;
         let symbolic = &self.normal.pattern.symbolic;
         // Our own loops over the supernodes (`supernodal`); faer's solve only for a factor
-        // that is not supernodal.
-        if !supernodal::solve_in_place(symbolic, &space.l_values, &mut dx, &mut space.scratch) {
+        // that is not supernodal or is permuted.
+        let split = space.split.as_ref();
+        if !supernodal::solve_in_place(
+            symbolic,
+            &space.l_values,
+            &mut dx,
+            &mut space.scratch,
+            split,
+        ) {
             LdltRef::new(symbolic, &space.l_values).solve_in_place_with_conj(
                 Conj::No,
                 MatMut::from_column_major_slice_mut(&mut dx, n, 1),

@@ -7,21 +7,24 @@
 //! backward solve (`DOWNWARDS_FROM`), which makes these loops faster at every size (50k
 //! unknowns: 8.7 against 13.1 ms a solve, 100k: about 21 against 30 ms). Until the gauge was
 //! spread (`stress::gauge`), their other rounding took the 100k step onto a trajectory that
-//! froze a pivot, so faer's solve was kept beyond 20k unknowns.
+//! froze a pivot, so faer's solve was kept beyond 20k unknowns. Factors of more than
+//! `SPLIT_FROM` values are solved on two threads (`Split`).
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
 /// x ← (L D Lᵀ)⁻¹ x for the factor `values` of `symbolic`, which must be supernodal and
 /// without a permutation (the normal matrix is factored in its elimination order); false,
-/// with x untouched, otherwise. `scratch` is working storage.
+/// with x untouched, otherwise. `scratch` is working storage; with a `split` of this
+/// factor's tree the two branches are solved on two threads.
 pub(super) fn solve_in_place(
     symbolic: &SymbolicCholesky<usize>,
     values: &[f64],
     x: &mut [f64],
     scratch: &mut Vec<f64>,
+    split: Option<&Split>,
 ) -> bool {
     let downwards = values.len() > DOWNWARDS_FROM;
-    solve_in_place_reading(symbolic, values, x, scratch, downwards)
+    solve_in_place_reading(symbolic, values, x, scratch, downwards, split)
 }
 
 /// `solve_in_place`, its backward solve reading each column downwards (`dot_downwards`) or
@@ -32,32 +35,74 @@ pub(super) fn solve_in_place_reading(
     x: &mut [f64],
     scratch: &mut Vec<f64>,
     downwards: bool,
+    split: Option<&Split>,
 ) -> bool {
-    let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+    let Some(factor) = Factor::new(symbolic, values) else {
         return false;
     };
-    if symbolic.perm().is_some() {
-        return false;
+    let dot = if downwards { dot_downwards } else { dot };
+    match split {
+        Some(split) => factor.solve_split(split, x, dot),
+        None => {
+            let all = 0..factor.n_supernodes();
+            all.clone().for_each(|s| factor.forward(s, x, scratch));
+            factor.scale(x);
+            all.rev().for_each(|s| factor.backward(s, x, scratch, dot));
+        }
     }
-    let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
-    let (row_ptr, val_ptr, row_idx) = (
-        sym.col_ptr_for_row_idx(),
-        sym.col_ptr_for_val(),
-        sym.row_idx(),
-    );
-    // Supernode s: columns start..start + ncols, stored column-major as a block of
-    // ncols + |pattern| rows (the unit lower triangle with D on its diagonal, then the rows
-    // `pattern` below it).
-    let block = |s: usize| {
-        let (start, ncols) = (begin[s], end[s] - begin[s]);
-        let pattern = &row_idx[row_ptr[s]..row_ptr[s + 1]];
-        let l = &values[val_ptr[s]..val_ptr[s + 1]];
+    true
+}
+
+/// A supernodal factor without a permutation, as `solve_in_place` takes it.
+struct Factor<'a> {
+    n_supernodes: usize,
+    begin: &'a [usize],
+    end: &'a [usize],
+    row_ptr: &'a [usize],
+    val_ptr: &'a [usize],
+    row_idx: &'a [usize],
+    values: &'a [f64],
+}
+
+type Dot = fn(&[f64], &[f64]) -> f64;
+
+impl<'a> Factor<'a> {
+    fn new(symbolic: &'a SymbolicCholesky<usize>, values: &'a [f64]) -> Option<Factor<'a>> {
+        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+            return None;
+        };
+        if symbolic.perm().is_some() {
+            return None;
+        }
+        Some(Factor {
+            n_supernodes: sym.n_supernodes(),
+            begin: sym.supernode_begin(),
+            end: sym.supernode_end(),
+            row_ptr: sym.col_ptr_for_row_idx(),
+            val_ptr: sym.col_ptr_for_val(),
+            row_idx: sym.row_idx(),
+            values,
+        })
+    }
+
+    fn n_supernodes(&self) -> usize {
+        self.n_supernodes
+    }
+
+    /// Supernode s: columns start..start + ncols, stored column-major as a block of
+    /// ncols + |pattern| rows (the unit lower triangle with D on its diagonal, then the rows
+    /// `pattern` below it).
+    fn block(&self, s: usize) -> (usize, usize, &'a [usize], &'a [f64], usize) {
+        let (start, ncols) = (self.begin[s], self.end[s] - self.begin[s]);
+        let pattern = &self.row_idx[self.row_ptr[s]..self.row_ptr[s + 1]];
+        let l = &self.values[self.val_ptr[s]..self.val_ptr[s + 1]];
         (start, ncols, pattern, l, ncols + pattern.len())
-    };
-    // L y = b, supernode by supernode: the triangle, then the rows below, gathered in
-    // `scratch` and subtracted once.
-    for s in 0..sym.n_supernodes() {
-        let (start, ncols, pattern, l, nrows) = block(s);
+    }
+
+    /// Supernode s's part of L y = b: the triangle, then the rows below, gathered in
+    /// `scratch` and subtracted once.
+    fn forward(&self, s: usize, x: &mut [f64], scratch: &mut Vec<f64>) {
+        let (start, ncols, pattern, l, nrows) = self.block(s);
         scratch.clear();
         scratch.resize(pattern.len(), 0.0);
         for j in 0..ncols {
@@ -77,17 +122,21 @@ pub(super) fn solve_in_place_reading(
             x[r] -= t;
         }
     }
-    // D z = y.
-    for s in 0..sym.n_supernodes() {
-        let (start, ncols, _, l, nrows) = block(s);
-        for j in 0..ncols {
-            x[start + j] /= l[j * nrows + j];
+
+    /// D z = y.
+    fn scale(&self, x: &mut [f64]) {
+        for s in 0..self.n_supernodes() {
+            let (start, ncols, _, l, nrows) = self.block(s);
+            for j in 0..ncols {
+                x[start + j] /= l[j * nrows + j];
+            }
         }
     }
-    // Lᵀ x = z, supernodes in reverse: the rows below are final, then the triangle upwards.
-    let dot = if downwards { dot_downwards } else { dot };
-    for s in (0..sym.n_supernodes()).rev() {
-        let (start, ncols, pattern, l, nrows) = block(s);
+
+    /// Supernode s's part of Lᵀ x = z (supernodes in reverse): the rows below are final,
+    /// then the triangle upwards.
+    fn backward(&self, s: usize, x: &mut [f64], scratch: &mut Vec<f64>, dot: Dot) {
+        let (start, ncols, pattern, l, nrows) = self.block(s);
         scratch.clear();
         scratch.extend(pattern.iter().map(|&r| x[r]));
         for j in (0..ncols).rev() {
@@ -98,7 +147,183 @@ pub(super) fn solve_in_place_reading(
             x[start + j] = xj;
         }
     }
-    true
+
+    /// The solve with the two branches of `split` on two threads. Each branch works on its
+    /// own copy of x: forwards, its updates of the stem's rows collect in the copy (those
+    /// rows start at 0) and are added to x after both; backwards, it reads the stem's final
+    /// values. Only the order of those additions differs from the sequential solve.
+    fn solve_split(&self, split: &Split, x: &mut [f64], dot: Dot) {
+        let forward_branch = |members: &[usize], x: &[f64]| {
+            let mut own = x.to_vec();
+            split.stem_columns(self).for_each(|c| own[c] = 0.0);
+            let mut scratch = Vec::new();
+            members
+                .iter()
+                .for_each(|&s| self.forward(s, &mut own, &mut scratch));
+            own
+        };
+        let [first, second] = on_two_threads(|branch| forward_branch(&split.branches[branch], x));
+        for (branch, own) in [&first, &second].into_iter().enumerate() {
+            for c in split.columns(self, &split.branches[branch]) {
+                x[c] = own[c];
+            }
+        }
+        for c in split.stem_columns(self) {
+            x[c] += first[c] + second[c];
+        }
+        let mut scratch = Vec::new();
+        split
+            .stem
+            .iter()
+            .for_each(|&s| self.forward(s, x, &mut scratch));
+        self.scale(x);
+        for &s in split.stem.iter().rev() {
+            self.backward(s, x, &mut scratch, dot);
+        }
+        let backward_branch = |members: &[usize], x: &[f64]| {
+            let mut own = x.to_vec();
+            let mut scratch = Vec::new();
+            for &s in members.iter().rev() {
+                self.backward(s, &mut own, &mut scratch, dot);
+            }
+            own
+        };
+        let solved = on_two_threads(|branch| backward_branch(&split.branches[branch], x));
+        for (branch, own) in solved.iter().enumerate() {
+            for c in split.columns(self, &split.branches[branch]) {
+                x[c] = own[c];
+            }
+        }
+    }
+}
+
+/// `work(0)` on a second thread and `work(1)` on this one.
+fn on_two_threads<T: Send>(work: impl Fn(usize) -> T + Sync) -> [T; 2] {
+    std::thread::scope(|scope| {
+        let first = scope.spawn(|| work(0));
+        let second = work(1);
+        let first = first
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        [first, second]
+    })
+}
+
+/// Factors with more values than this are solved on two threads where the machine has them
+/// (`Split`): from about 40k vertices. Timed within one run on the same factors (the 100k
+/// dome's 17M values: 25.2 against 20.3 ms a solve; 50k, 7.7M: 11.5 against 8.9 ms), short
+/// of the 1.5× the split allows (reading the factor from memory is shared). Below, the
+/// threads' start and the copies of x would cost more than they save, and the shared
+/// models' rounding stays as it was.
+pub(super) const SPLIT_FROM: usize = 1 << 22;
+
+/// A division of a factor's supernodes into two branches, independent subtrees of its
+/// elimination tree, and the stem, the rest: the branches can be solved at the same time.
+/// The solves with large factors are limited by reading them from memory, which two cores
+/// do faster than one. On the 100k dome's factor the longer branch and the stem hold 67% of
+/// its values.
+pub(super) struct Split {
+    branches: [Vec<usize>; 2],
+    stem: Vec<usize>,
+}
+
+impl Split {
+    /// The split of `symbolic`'s tree whose longest branch plus stem holds the fewest factor
+    /// values, if the factor has more than `min_values` of them, the machine at least two
+    /// threads, and the split saves at least a tenth of the values read in sequence.
+    pub(super) fn new(symbolic: &SymbolicCholesky<usize>, min_values: usize) -> Option<Split> {
+        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+            return None;
+        };
+        let two_threads = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
+        if symbolic.len_val() <= min_values || !two_threads {
+            return None;
+        }
+        let (begin, end, row_ptr, row_idx, val_ptr) = (
+            sym.supernode_begin(),
+            sym.supernode_end(),
+            sym.col_ptr_for_row_idx(),
+            sym.row_idx(),
+            sym.col_ptr_for_val(),
+        );
+        let ns = sym.n_supernodes();
+        let mut owner = vec![0; symbolic.nrows()];
+        for s in 0..ns {
+            owner[begin[s]..end[s]].fill(s);
+        }
+        // A supernode's parent owns the first row below its columns; ns stands for a root
+        // above the roots of a forest.
+        let parent: Vec<usize> = (0..ns)
+            .map(|s| {
+                row_idx
+                    .get(row_ptr[s])
+                    .filter(|_| row_ptr[s] < row_ptr[s + 1])
+            })
+            .map(|first| first.map_or(ns, |&r| owner[r]))
+            .collect();
+        let mut children = vec![Vec::new(); ns + 1];
+        let mut weight: Vec<usize> = (0..ns).map(|s| val_ptr[s + 1] - val_ptr[s]).collect();
+        weight.push(0);
+        for s in 0..ns {
+            children[parent[s]].push(s);
+            weight[parent[s]] += weight[s];
+        }
+        let total = weight[ns];
+        // Down the heaviest child from the root: at each node, its heaviest child's subtree
+        // against all its other children's.
+        let (mut node, mut above, mut best) = (ns, 0, (total, ns));
+        loop {
+            let kids = &children[node];
+            let Some(&heaviest) = kids.iter().max_by_key(|&&k| (weight[k], k)) else {
+                break;
+            };
+            let below: usize = kids.iter().map(|&k| weight[k]).sum();
+            above += weight[node] - below;
+            let rest = below - weight[heaviest];
+            let wall = above + weight[heaviest].max(rest);
+            if wall < best.0 {
+                best = (wall, node);
+            }
+            if rest >= weight[heaviest] {
+                break;
+            }
+            above += rest;
+            node = heaviest;
+        }
+        let (wall, node) = best;
+        if wall * 10 > total * 9 {
+            return None;
+        }
+        let heaviest = *children[node].iter().max_by_key(|&&k| (weight[k], k))?;
+        // Parents come after their children: mark downwards from the roots.
+        let mut part = vec![2u8; ns + 1];
+        for s in (0..ns).rev() {
+            part[s] = if s == heaviest {
+                0
+            } else if parent[s] == node {
+                1
+            } else {
+                part[parent[s]]
+            };
+        }
+        let members = |p: u8| (0..ns).filter(|&s| part[s] == p).collect::<Vec<_>>();
+        Some(Split {
+            branches: [members(0), members(1)],
+            stem: members(2),
+        })
+    }
+
+    fn columns<'a>(
+        &self,
+        factor: &'a Factor,
+        members: &'a [usize],
+    ) -> impl Iterator<Item = usize> + 'a {
+        members.iter().flat_map(|&s| factor.begin[s]..factor.end[s])
+    }
+
+    fn stem_columns<'a>(&'a self, factor: &'a Factor) -> impl Iterator<Item = usize> + 'a {
+        self.columns(factor, &self.stem)
+    }
 }
 
 /// Σ a_i b_i in four interleaved partial sums, which the compiler keeps in one vector

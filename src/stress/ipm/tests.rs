@@ -589,15 +589,17 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
             faer::Par::Seq,
             faer::dyn_stack::MemStack::new(&mut space.buffer),
         );
-    // Both directions of the backward solve's reading.
-    for downwards in [false, true] {
+    // Both directions of the backward solve's reading, in sequence and on two threads.
+    let split = supernodal::Split::new(symbolic, 0).expect("a tree worth splitting");
+    for (downwards, split) in [(false, None), (true, None), (true, Some(&split))] {
         let mut own = b.clone();
         assert!(supernodal::solve_in_place_reading(
             symbolic,
             &space.l_values,
             &mut own,
             &mut Vec::new(),
-            downwards
+            downwards,
+            split
         ));
         // A x from the factored lower triangle.
         let (col_ptr, row_idx) = (&normal.pattern.col_ptr, &normal.pattern.row_idx);
@@ -619,12 +621,14 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
         let residual = max_gap(&ax, &b);
         assert!(
             residual <= 1e-12 * inf_norm(&b),
-            "downwards {downwards}: residual {residual:e}"
+            "downwards {downwards}, split {}: residual {residual:e}",
+            split.is_some()
         );
         let gap = max_gap(&own, &theirs);
         assert!(
             gap <= 1e-12 * inf_norm(&theirs),
-            "downwards {downwards}: own against faer's: {gap:e}"
+            "downwards {downwards}, split {}: own against faer's: {gap:e}",
+            split.is_some()
         );
     }
 }
