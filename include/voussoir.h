@@ -668,8 +668,9 @@ VsrStatus vsr_result_force_densities(const struct VsrResult *result, double *out
 /**
  * Airy stress function value φ per vertex, #V doubles (force × length; 0 at vertices used by
  * no triangle). φ is defined up to an affine function, which changes no force: the reduced
- * formulation pins it to 0 at three free vertices far apart, the edge-based one integrates
- * it from the first face; compare forces, not φ, between runs.
+ * formulation pins it to 0 at three free vertices far apart in each connected part (at the
+ * first face where there are no three such), the edge-based one integrates it from the
+ * first face; compare forces, not φ, between runs.
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -680,7 +681,8 @@ VsrStatus vsr_result_airy(const struct VsrResult *result, double *out, size_t le
  * Vertex weights w = x² + y² − 2 φ, #V doubles (the power diagram of the plan points with
  * these weights is the force diagram, except along the cuts of holes whose jump is non-zero,
  * where φ is multivalued; units as in the paper, length² and force × length mixed, so
- * meaningful for unit loads).
+ * meaningful for unit loads). Like φ, defined up to an affine function (see
+ * `vsr_result_airy`).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
@@ -750,7 +752,8 @@ VsrStatus vsr_result_hole_coefficients(const struct VsrResult *result, double *o
  * Force diagram points: one per face, the gradient of the Airy function on it, #F by 2
  * doubles (force), row-major, in face order. This is the power centre of the face's weighted
  * vertices except on the faces along a hole's cut when that hole's jump is non-zero (the Airy
- * function is multivalued there; see `vsr_result_hole_coefficients`).
+ * function is multivalued there; see `vsr_result_hole_coefficients`). Defined up to a
+ * translation, as φ is up to an affine function (`vsr_result_airy`).
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.

@@ -74,7 +74,9 @@ pub struct StressResult {
     pub status: StressStatus,
     /// Force density per mesh edge (compression positive; 0 on edges that carry none).
     pub force_densities: Vec<f64>,
-    /// Airy value φ per vertex (0 at unreferenced vertices).
+    /// Airy value φ per vertex (0 at unreferenced vertices). Defined up to an affine function,
+    /// which changes no force: the reduced formulation pins it to 0 at three free vertices far
+    /// apart per component, the edge-based one integrates it from the first face.
     pub airy: Vec<f64>,
     /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram, except
     /// along the cut of a hole whose jump is non-zero (φ is multivalued there).
