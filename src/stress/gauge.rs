@@ -16,7 +16,7 @@ use std::cmp::Reverse;
 /// Per vertex, whether φ is pinned to 0 there: three free vertices of every component that
 /// are far apart in hops along edges (a choice that depends on the connectivity only, so it
 /// stays the same through a form finding), or the vertices of the component's first face
-/// where that triangle is no larger in the plan (fewer than three free vertices, or a mesh
+/// with a free vertex where that triangle is no larger in the plan (fewer than three free vertices, or a mesh
 /// so thin that they line up; then the plan decides, and smoothing may flip the choice
 /// between steps, which only costs the next step its cached structure).
 pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
@@ -28,9 +28,19 @@ pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
             list.push(v);
         }
     }
+    // The fallback: the component's first face with a free vertex (all three of its
+    // vertices then enter active rows), or its first face.
     let mut first_face = vec![None; mesh.n_components];
+    let has_free = |t: usize| {
+        mesh.faces[t]
+            .iter()
+            .any(|&v| mesh.is_non_anchored(v as usize))
+    };
     for (t, &c) in mesh.face_component.iter().enumerate() {
-        first_face[c as usize].get_or_insert(t);
+        let slot = &mut first_face[c as usize];
+        if slot.is_none_or(|f: usize| !has_free(f) && has_free(t)) {
+            *slot = Some(t);
+        }
     }
     let mut pinned = vec![false; n];
     let mut hops = Hops::new(mesh, n);
@@ -178,15 +188,18 @@ mod tests {
     }
 
     #[test]
-    fn too_few_free_vertices_fall_back_to_the_first_face() {
-        // A fan of six triangles around one free centre vertex.
+    fn too_few_free_vertices_fall_back_to_the_first_face_with_one() {
+        // A fan of six triangles around one free centre vertex, after a face of three
+        // anchored vertices outside its first edge.
         let mut positions = vec![[0.0, 0.0, 1.0]];
         for k in 0..6 {
             let a = k as f64 * std::f64::consts::PI / 3.0;
             positions.push([a.cos(), a.sin(), 0.0]);
         }
-        let faces: Vec<[u32; 3]> = (0..6).map(|k| [0, 1 + k, 1 + (k + 1) % 6]).collect();
-        let mesh = Mesh::new(positions, faces, &[1, 2, 3, 4, 5, 6]).unwrap();
+        positions.push([1.2, 0.9, 0.0]);
+        let mut faces = vec![[2, 1, 7]];
+        faces.extend((0..6).map(|k| [0, 1 + k, 1 + (k + 1) % 6]));
+        let mesh = Mesh::new(positions, faces, &[1, 2, 3, 4, 5, 6, 7]).unwrap();
         let (vertices, _) = pinned(&mesh);
         assert_eq!(vertices, vec![0, 1, 2]);
     }
