@@ -206,13 +206,10 @@ fn reduced_equals_edge_based_on_every_real_model() {
     }
 }
 
-/// Models on which the structured interior-point method does not converge yet (it reports
-/// failure and clarabel answers): four_holes' reduced QP (free holes of 4–6 vertices).
-const NATIVE_FALLS_BACK: [&str; 1] = ["four_holes"];
-
 /// The structured interior-point solver reaches the optimum of clarabel (the reference) on
 /// every real model, in both formulations, with plain compression and with the form-finding
-/// bound q_min, and answers itself except where it is known to fall back.
+/// bound q_min, and answers itself (four_holes' reduced QPs, with free holes of 4–6
+/// vertices, fell back to clarabel until the Airy gauge was spread over the mesh).
 #[test]
 fn native_solver_equals_clarabel_on_every_real_model() {
     let plain = StressSettings::default();
@@ -238,10 +235,8 @@ fn native_solver_equals_clarabel_on_every_real_model() {
             let reference = analyse(&problem, &with(QpSolver::Clarabel)).unwrap();
             assert_eq!(reference.solver, QpSolver::Clarabel);
             let label = format!("{name} {formulation:?} q_min {:?}", base.q_min);
-            if formulation == Formulation::EdgeBased || !NATIVE_FALLS_BACK.contains(&name) {
-                assert_eq!(native.solver, QpSolver::Native, "{label}: fell back");
-                assert_eq!(native.formulation, formulation, "{label}");
-            }
+            assert_eq!(native.solver, QpSolver::Native, "{label}: fell back");
+            assert_eq!(native.formulation, formulation, "{label}");
             assert_same_results(&label, &problem, native, reference);
         }
     }
