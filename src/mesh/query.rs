@@ -45,6 +45,23 @@ impl Mesh {
         self.edges.binary_search_by(|e| e.v.cmp(&key)).ok()
     }
 
+    /// The end of edge `e` that is not `v` (`v` must be one of its ends).
+    pub fn other_end(&self, e: usize, v: u32) -> u32 {
+        let [a, b] = self.edges[e].v;
+        if a == v {
+            b
+        } else {
+            a
+        }
+    }
+
+    /// The vertices joined to `v` by an edge, in the order of `edges_at`.
+    pub fn neighbours(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        self.edges_at(v as usize)
+            .iter()
+            .map(move |&e| self.other_end(e as usize, v))
+    }
+
     /// Ids of the edges incident to vertex `v`, in increasing order (empty for out-of-range
     /// or unreferenced vertices).
     pub fn edges_at(&self, v: usize) -> &[u32] {

@@ -16,9 +16,9 @@ use std::cmp::Reverse;
 /// Per vertex, whether φ is pinned to 0 there: three free vertices of every component that
 /// are far apart in hops along edges (a choice that depends on the connectivity only, so it
 /// stays the same through a form finding), or the vertices of the component's first face
-/// with a free vertex where that triangle is no larger in the plan (fewer than three free vertices, or a mesh
-/// so thin that they line up; then the plan decides, and smoothing may flip the choice
-/// between steps, which only costs the next step its cached structure).
+/// with a free vertex where that triangle is no larger in the plan (fewer than three free
+/// vertices, or a mesh so thin that they line up; then the plan decides, and smoothing may
+/// flip the choice between steps, which only costs the next step its cached structure).
 pub fn pinned_vertices(mesh: &Mesh, plan: &Plan) -> Vec<bool> {
     let n = mesh.positions.len();
     let mut free: Vec<Vec<usize>> = vec![Vec::new(); mesh.n_components];
@@ -104,9 +104,7 @@ impl<'a> Hops<'a> {
         let mut next = 0;
         while let Some(&v) = self.queue.get(next) {
             next += 1;
-            for &e in mesh.edges_at(v) {
-                let [p, q] = mesh.edges[e as usize].v;
-                let w = if p as usize == v { q } else { p } as usize;
+            for w in mesh.neighbours(v as u32).map(|w| w as usize) {
                 if self.hops[w] == u32::MAX {
                     self.hops[w] = self.hops[v] + 1;
                     self.queue.push(w);

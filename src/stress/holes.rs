@@ -88,24 +88,8 @@ fn shortest_path(mesh: &Mesh, h: usize, loop_of: &[usize]) -> Option<Vec<u32>> {
         parent[v as usize] = v;
         queue.push_back(v);
     }
-    let neighbours = |v: u32| {
-        let (s, e) = (
-            mesh.vertex_edge_start[v as usize],
-            mesh.vertex_edge_start[v as usize + 1],
-        );
-        mesh.vertex_edges[s as usize..e as usize]
-            .iter()
-            .map(move |&ed| {
-                let ed = &mesh.edges[ed as usize];
-                if ed.v[0] == v {
-                    ed.v[1]
-                } else {
-                    ed.v[0]
-                }
-            })
-    };
     while let Some(v) = queue.pop_front() {
-        for w in neighbours(v) {
+        for w in mesh.neighbours(v) {
             if parent[w as usize] != u32::MAX {
                 continue;
             }
@@ -161,18 +145,10 @@ fn right_sector(mesh: &Mesh, path: &[u32], k: usize, out: &mut Vec<u32>) {
 /// The first face of a boundary vertex's fan in counter-clockwise order: the face (v, x, y)
 /// whose edge v–x is a boundary edge.
 fn fan_start(mesh: &Mesh, v: u32) -> Option<(u32, u32)> {
-    let (s, e) = (
-        mesh.vertex_edge_start[v as usize],
-        mesh.vertex_edge_start[v as usize + 1],
-    );
-    mesh.vertex_edges[s as usize..e as usize]
-        .iter()
-        .find_map(|&ed| {
-            let ed = &mesh.edges[ed as usize];
-            if !ed.is_boundary() {
-                return None;
-            }
-            let x = if ed.v[0] == v { ed.v[1] } else { ed.v[0] };
-            face_of_directed(mesh, v, x)
-        })
+    mesh.edges_at(v as usize).iter().find_map(|&e| {
+        if !mesh.edges[e as usize].is_boundary() {
+            return None;
+        }
+        face_of_directed(mesh, v, mesh.other_end(e as usize, v))
+    })
 }

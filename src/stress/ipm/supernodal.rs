@@ -44,7 +44,7 @@ pub(super) fn solve_in_place_reading(
     match split {
         Some(split) => factor.solve_split(split, x, dot),
         None => {
-            let all = 0..factor.n_supernodes();
+            let all = 0..factor.n_supernodes;
             all.clone().for_each(|s| factor.forward(s, x, scratch));
             factor.scale(x);
             all.rev().for_each(|s| factor.backward(s, x, scratch, dot));
@@ -85,10 +85,6 @@ impl<'a> Factor<'a> {
         })
     }
 
-    fn n_supernodes(&self) -> usize {
-        self.n_supernodes
-    }
-
     /// Supernode s: columns start..start + ncols, stored column-major as a block of
     /// ncols + |pattern| rows (the unit lower triangle with D on its diagonal, then the rows
     /// `pattern` below it).
@@ -125,7 +121,7 @@ impl<'a> Factor<'a> {
 
     /// D z = y.
     fn scale(&self, x: &mut [f64]) {
-        for s in 0..self.n_supernodes() {
+        for s in 0..self.n_supernodes {
             let (start, ncols, _, l, nrows) = self.block(s);
             for j in 0..ncols {
                 x[start + j] /= l[j * nrows + j];
@@ -254,11 +250,7 @@ impl Split {
         // A supernode's parent owns the first row below its columns; ns stands for a root
         // above the roots of a forest.
         let parent: Vec<usize> = (0..ns)
-            .map(|s| {
-                row_idx
-                    .get(row_ptr[s])
-                    .filter(|_| row_ptr[s] < row_ptr[s + 1])
-            })
+            .map(|s| row_idx[row_ptr[s]..row_ptr[s + 1]].first())
             .map(|first| first.map_or(ns, |&r| owner[r]))
             .collect();
         let mut children = vec![Vec::new(); ns + 1];
