@@ -404,6 +404,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         h.push(0.0);
     }
     let groups = balanced_stars(inp, &incident, &lower_row);
+    let positions = unknown_positions(inp, &tau_col, n);
     let out = ipm::solve(
         &ipm::Qp {
             quad: &quad,
@@ -415,6 +416,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             ineq: &ineq,
             h: &h,
             groups: &groups,
+            positions: Some(&positions),
         },
         &if coarse {
             ipm::Tolerances::for_form_finding(n)
@@ -438,6 +440,30 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         },
         iterations: out.iterations,
     }
+}
+
+/// The plan position of each unknown of `solve_native`: for y, the mean of the midpoints of
+/// the edges whose force density it enters; for τ, its vertex. (For the nested-dissection
+/// ordering of large QPs: only nearness matters.)
+fn unknown_positions(inp: &QpInput, tau_col: &[Option<usize>], n: usize) -> Vec<[f64; 2]> {
+    let mut sum = vec![[0.0; 2]; n];
+    let mut count = vec![0usize; n];
+    for (e, ev) in inp.edges.iter().enumerate() {
+        let [a, b] = ev.map(|v| inp.u[v as usize]);
+        for (col, _) in inp.s.row(e) {
+            sum[col] = [sum[col][0] + a[0] + b[0], sum[col][1] + a[1] + b[1]];
+            count[col] += 2;
+        }
+    }
+    for (v, col) in tau_col.iter().enumerate() {
+        if let Some(col) = *col {
+            (sum[col], count[col]) = (inp.u[v], 1);
+        }
+    }
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &k)| s.map(|s| s / k.max(1) as f64))
+        .collect()
 }
 
 /// The lower-bound rows of the edges around each vertex where Σ_e (u_i − u_j) S_e = 0 holds

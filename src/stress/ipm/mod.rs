@@ -13,8 +13,10 @@
 //! matrix has the two-ring pattern of the mesh: much smaller than a generic conic solver's
 //! KKT system (MATH §8).
 //!
-//! The unknowns are relabelled once in a fill-reducing (AMD) order, so that no factorisation
-//! permutes the matrix again. Gondzio's centrality correctors lengthen steps that a few
+//! The unknowns are relabelled once in a fill-reducing order (AMD's, or beyond 40k unknowns a
+//! nested dissection by their plan positions: `ordering`), so that no factorisation permutes
+//! the matrix again; large factors are factored and solved on two threads (`factorise`,
+//! `supernodal`). Gondzio's centrality correctors lengthen steps that a few
 //! products s_i z_i would otherwise cut short; they reuse the factor with coarse solves. Near
 //! the optimum the active set is solved for directly ("polishing"): with an objective that is
 //! nearly zero at the optimum, the gap alone would creep towards the tolerance in rounding.
@@ -24,8 +26,10 @@
 
 use super::sparse::Csr;
 
+mod factorise;
 mod kkt;
 mod newton;
+mod ordering;
 mod pattern;
 mod polish;
 mod row_groups;
@@ -52,6 +56,9 @@ pub struct Qp<'a> {
     /// Inequality rows known to be dependent when all of a group are active (see
     /// `RowGroups`); empty when none are known.
     pub groups: &'a RowGroups,
+    /// Plan position of each unknown, for the nested-dissection ordering of large QPs
+    /// (`ordering`); None: AMD's order at every size.
+    pub positions: Option<&'a [[f64; 2]]>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -317,6 +324,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
             ineq: &ineq,
             h: &h,
             groups: &groups,
+            positions: qp.positions,
         },
         &start_units,
         tol,
@@ -339,7 +347,7 @@ fn solve_scaled(
 ) -> IpmOutput {
     let n = qp.c.len();
     let cons = stacked(qp.eq, qp.ineq);
-    let Some((pattern, reused)) = cache.pattern(qp.quad, &cons, qp.eq.nrows()) else {
+    let Some((pattern, reused)) = cache.pattern(qp.quad, &cons, qp.eq.nrows(), qp.positions) else {
         return IpmOutput {
             x: vec![0.0; n],
             status: IpmStatus::NumericalError,

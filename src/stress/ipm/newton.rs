@@ -1,8 +1,8 @@
 //! The Newton system of the interior-point method in augmented form, solved with the
 //! regularised factor of the normal matrix and refined against the exact system.
 
-use super::supernodal;
 use super::*;
+use super::{factorise, supernodal};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
@@ -15,6 +15,7 @@ use faer::{Conj, MatMut, Par};
 /// 100k-vertex dome stalled at a dual residual near 1e-8 (and fell back to clarabel); 1e-10
 /// failed already at 6k.
 pub(super) const DELTA: f64 = 1e-7;
+
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
@@ -46,6 +47,8 @@ pub(super) struct FactorSpace {
     pub(super) scratch: Vec<f64>,
     /// Large factors' solves on two threads.
     pub(super) split: Option<supernodal::Split>,
+    /// Large factors' factorisation on two threads.
+    pub(super) plan: Option<factorise::Plan>,
 }
 
 impl FactorSpace {
@@ -60,7 +63,8 @@ impl FactorSpace {
             l_values: vec![0.0; symbolic.len_val()],
             buffer: MemBuffer::try_new(scratch).ok()?,
             scratch: Vec::new(),
-            split: supernodal::Split::new(symbolic, supernodal::SPLIT_FROM),
+            split: supernodal::Split::for_solve(symbolic),
+            plan: factorise::Plan::new(symbolic),
         })
     }
 }
@@ -96,26 +100,45 @@ impl<'a> Newton<'a> {
         for &k in &pattern.diag {
             values[k] += reg;
         }
-        let matrix = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx),
-            &values[..],
-        );
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
-        let factored = pattern.symbolic.factorize_numeric_ldlt(
-            &mut space.l_values,
-            matrix,
-            faer::Side::Lower,
-            LdltRegularization {
-                dynamic_regularization_signs: Some(&space.signs),
-                dynamic_regularization_delta: 1e20,
-                dynamic_regularization_epsilon: 1e-14,
-            },
-            Par::Seq,
-            MemStack::new(&mut space.buffer),
-            Default::default(),
-        );
-        factored.ok()?;
+        let factored = match &space.plan {
+            Some(plan) => plan.factorise(
+                (&pattern.col_ptr, &pattern.row_idx, &space.values),
+                &mut space.l_values,
+            ),
+            None => {
+                let matrix = SparseColMatRef::new(
+                    SymbolicSparseColMatRef::new_checked(
+                        n,
+                        n,
+                        &pattern.col_ptr,
+                        None,
+                        &pattern.row_idx,
+                    ),
+                    &space.values[..],
+                );
+                pattern
+                    .symbolic
+                    .factorize_numeric_ldlt(
+                        &mut space.l_values,
+                        matrix,
+                        faer::Side::Lower,
+                        LdltRegularization {
+                            dynamic_regularization_signs: Some(&space.signs),
+                            dynamic_regularization_delta: factorise::HUGE_PIVOT,
+                            dynamic_regularization_epsilon: factorise::TINY_PIVOT,
+                        },
+                        Par::Seq,
+                        MemStack::new(&mut space.buffer),
+                        Default::default(),
+                    )
+                    .is_ok()
+            }
+        };
+        if !factored {
+            return None;
+        }
         Some(Newton {
             normal,
             cons,

@@ -213,21 +213,50 @@ fn on_two_threads<T: Send>(work: impl Fn(usize) -> T + Sync) -> [T; 2] {
 /// models' rounding stays as it was.
 pub(super) const SPLIT_FROM: usize = 1 << 22;
 
+/// Factors with more values than this are factored on two threads (`factorise`): from about
+/// 10k vertices. Measured on the generated domes with a hole, one analysis each, time in
+/// factorisations over their number: 10k vertices (1.07M values) 12.4 → 7.4 ms, 20k 26.6 →
+/// 20.4 ms, 100k 0.26 → 0.19 s with AMD's order (0.15 s with `ordering`'s); 6k (0.57M) only
+/// 4.8 → 4.1 ms, and the shared models keep faer's factorisation and its rounding.
+pub(super) const FACTOR_SPLIT_FROM: usize = 1 << 20;
+
+/// At most this many subtrees are expanded into their children in search of a balanced
+/// `Split`.
+const MAX_EXPANSIONS: usize = 64;
+
 /// A division of a factor's supernodes into two branches, independent subtrees of its
 /// elimination tree, and the stem, the rest: the branches can be solved at the same time.
 /// The solves with large factors are limited by reading them from memory, which two cores
 /// do faster than one. On the 100k dome's factor the longer branch and the stem hold 67% of
 /// its values.
 pub(super) struct Split {
-    branches: [Vec<usize>; 2],
-    stem: Vec<usize>,
+    pub(super) branches: [Vec<usize>; 2],
+    pub(super) stem: Vec<usize>,
 }
 
 impl Split {
-    /// The split of `symbolic`'s tree whose longest branch plus stem holds the fewest factor
-    /// values, if the factor has more than `min_values` of them, the machine at least two
-    /// threads, and the split saves at least a tenth of the values read in sequence.
-    pub(super) fn new(symbolic: &SymbolicCholesky<usize>, min_values: usize) -> Option<Split> {
+    /// The split for solves (`SPLIT_FROM`), balancing the factor values each part reads.
+    pub(super) fn for_solve(symbolic: &SymbolicCholesky<usize>) -> Option<Split> {
+        Split::new(symbolic, SPLIT_FROM, |ncols, nrows| ncols * nrows)
+    }
+
+    /// The split for the factorisation (`FACTOR_SPLIT_FROM`), balancing the multiply-adds of
+    /// each part's supernodes: Σ_j (nrows − j)² over a supernode's columns j.
+    pub(super) fn for_factor(symbolic: &SymbolicCholesky<usize>) -> Option<Split> {
+        Split::new(symbolic, FACTOR_SPLIT_FROM, |ncols, nrows| {
+            (0..ncols).map(|j| (nrows - j) * (nrows - j)).sum()
+        })
+    }
+
+    /// The split of `symbolic`'s tree whose longest branch plus stem has the least
+    /// `weight(ncols, nrows)` summed over its supernodes, if the factor has more than
+    /// `min_values` values, the machine at least two threads, and the split saves at least a
+    /// tenth of the weight done in sequence.
+    pub(super) fn new(
+        symbolic: &SymbolicCholesky<usize>,
+        min_values: usize,
+        weight_of: impl Fn(usize, usize) -> usize,
+    ) -> Option<Split> {
         let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
             return None;
         };
@@ -235,12 +264,11 @@ impl Split {
         if symbolic.len_val() <= min_values || !two_threads {
             return None;
         }
-        let (begin, end, row_ptr, row_idx, val_ptr) = (
+        let (begin, end, row_ptr, row_idx) = (
             sym.supernode_begin(),
             sym.supernode_end(),
             sym.col_ptr_for_row_idx(),
             sym.row_idx(),
-            sym.col_ptr_for_val(),
         );
         let ns = sym.n_supernodes();
         let mut owner = vec![0; symbolic.nrows()];
@@ -254,49 +282,60 @@ impl Split {
             .map(|first| first.map_or(ns, |&r| owner[r]))
             .collect();
         let mut children = vec![Vec::new(); ns + 1];
-        let mut weight: Vec<usize> = (0..ns).map(|s| val_ptr[s + 1] - val_ptr[s]).collect();
+        let mut weight: Vec<usize> = (0..ns)
+            .map(|s| {
+                let ncols = end[s] - begin[s];
+                weight_of(ncols, ncols + row_ptr[s + 1] - row_ptr[s])
+            })
+            .collect();
         weight.push(0);
         for s in 0..ns {
             children[parent[s]].push(s);
             weight[parent[s]] += weight[s];
         }
         let total = weight[ns];
-        // Down the heaviest child from the root: at each node, its heaviest child's subtree
-        // against all its other children's.
-        let (mut node, mut above, mut best) = (ns, 0, (total, ns));
-        loop {
-            let kids = &children[node];
-            let Some(&heaviest) = kids.iter().max_by_key(|&&k| (weight[k], k)) else {
-                break;
-            };
-            let below: usize = kids.iter().map(|&k| weight[k]).sum();
-            above += weight[node] - below;
-            let rest = below - weight[heaviest];
-            let wall = above + weight[heaviest].max(rest);
-            if wall < best.0 {
-                best = (wall, node);
+        // Independent subtrees (a frontier across the tree) go to two threads, the heaviest
+        // first to the less loaded; the supernodes above them are the stem. From the roots'
+        // subtrees, the heaviest subtree is replaced by its children, its root joining the
+        // stem, while that shortens the wall: stem plus the more loaded thread.
+        let mut frontier = children[ns].clone();
+        let mut stem = 0;
+        let mut best: Option<(usize, Vec<usize>, Vec<u8>)> = None;
+        for _ in 0..MAX_EXPANSIONS {
+            frontier.sort_unstable_by_key(|&k| std::cmp::Reverse((weight[k], k)));
+            let mut load = [0, 0];
+            let thread: Vec<u8> = (frontier.iter())
+                .map(|&k| {
+                    let t = usize::from(load[1] < load[0]);
+                    load[t] += weight[k];
+                    t as u8
+                })
+                .collect();
+            let wall = stem + load[0].max(load[1]);
+            if best.as_ref().is_none_or(|(w, ..)| wall < *w) {
+                best = Some((wall, frontier.clone(), thread));
             }
-            if rest >= weight[heaviest] {
+            let heaviest = frontier[0];
+            if children[heaviest].is_empty() {
                 break;
             }
-            above += rest;
-            node = heaviest;
+            stem += weight[heaviest] - children[heaviest].iter().map(|&k| weight[k]).sum::<usize>();
+            frontier.swap_remove(0);
+            frontier.extend_from_slice(&children[heaviest]);
         }
-        let (wall, node) = best;
+        let (wall, frontier, thread) = best?;
         if wall * 10 > total * 9 {
             return None;
         }
-        let heaviest = *children[node].iter().max_by_key(|&&k| (weight[k], k))?;
         // Parents come after their children: mark downwards from the roots.
         let mut part = vec![2u8; ns + 1];
+        for (&k, &t) in frontier.iter().zip(&thread) {
+            part[k] = t;
+        }
         for s in (0..ns).rev() {
-            part[s] = if s == heaviest {
-                0
-            } else if parent[s] == node {
-                1
-            } else {
-                part[parent[s]]
-            };
+            if part[s] == 2 {
+                part[s] = part[parent[s]];
+            }
         }
         let members = |p: u8| (0..ns).filter(|&s| part[s] == p).collect::<Vec<_>>();
         Some(Split {

@@ -73,7 +73,7 @@ fn product_slots_point_at_their_entries() {
         m
     };
     let (quad, cons) = (rows(30), rows(25));
-    let pattern = Pattern::new(&quad, &cons, 3).expect("pattern");
+    let pattern = Pattern::new(&quad, &cons, 3, None).expect("pattern");
     for (m, slots) in [(&quad, &pattern.quad_slot), (&cons, &pattern.row_slot)] {
         let pairs: Vec<(usize, usize)> = products(m).map(|(_, a, b, ..)| (a, b)).collect();
         assert_eq!(pairs.len(), slots.len());
@@ -110,6 +110,7 @@ fn small_qp_with_active_bound_and_equality() {
             ineq: &ineq,
             h: &[1.8],
             groups: &RowGroups::default(),
+            positions: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -129,7 +130,9 @@ fn polish_at(
 ) -> Result<Vec<f64>, PolishFailure> {
     let cons = stacked(qp.eq, qp.ineq);
     let mut cache = PatternCache::default();
-    let (pattern, _) = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+    let (pattern, _) = cache
+        .pattern(qp.quad, &cons, 0, None)
+        .expect("normal matrix");
     let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
     let label = &normal.pattern.label;
     let relabelled = Relabelled::new(qp, label);
@@ -172,6 +175,7 @@ fn polishing_corrects_a_wrongly_dropped_row() {
         ineq: &csr(2, &[&[(1, 1.0)]]),
         h: &[0.0],
         groups: &RowGroups::default(),
+        positions: None,
     };
     let x = polish_at(&qp, &[2.0, 1e-3], &[1e-3], &[1e-7], &Tolerances::default())
         .expect("the corrected guess is optimal");
@@ -194,6 +198,7 @@ fn active_bounds<R>(k: usize, run: impl FnOnce(&Qp) -> R) -> R {
         ineq: &quad,
         h: &vec![0.0; k],
         groups: &RowGroups::default(),
+        positions: None,
     })
 }
 
@@ -210,7 +215,9 @@ fn a_hopeless_guess_shows_its_wrong_rows_before_refinement() {
     active_bounds(40, |qp| {
         let cons = stacked(qp.eq, qp.ineq);
         let mut cache = PatternCache::default();
-        let (pattern, _) = cache.pattern(qp.quad, &cons, 0).expect("normal matrix");
+        let (pattern, _) = cache
+            .pattern(qp.quad, &cons, 0, None)
+            .expect("normal matrix");
         let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
         let mut space = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len())
             .expect("factor space");
@@ -326,6 +333,7 @@ fn polished_active_rows_count_on_their_bounds_in_the_gap() {
         ineq: &ineq,
         h: &vec![bound; n - 1],
         groups: &RowGroups::default(),
+        positions: None,
     };
     let active = |i: usize| target[i] < bound;
     let mut optimum = vec![1e7];
@@ -391,6 +399,7 @@ fn large_unknowns_with_small_differences_converge_at_the_rounding_floor() {
             ineq: &quad,
             h: &vec![0.0; n - 1],
             groups: &RowGroups::default(),
+            positions: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -442,6 +451,7 @@ fn bound_constrained_least_squares_finds_the_active_set() {
             ineq: &identity,
             h: &vec![0.0; n],
             groups: &RowGroups::default(),
+            positions: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -480,6 +490,7 @@ fn far_from_balance_skips_the_last_active_set_only_beyond_20k_unknowns() {
             ineq: &identity,
             h: &vec![0.0; n],
             groups: &RowGroups::default(),
+            positions: None,
         };
         let tol = Tolerances::for_size(n);
         let mut cache = PatternCache::default();
@@ -568,7 +579,7 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
     let ineq = csr(n, &bound_rows);
     let cons = stacked(&csr(n, &[]), &ineq);
     let mut cache = PatternCache::default();
-    let (pattern, _) = cache.pattern(&quad, &cons, 0).expect("normal matrix");
+    let (pattern, _) = cache.pattern(&quad, &cons, 0, None).expect("normal matrix");
     let normal = Normal::new(pattern, &quad, &vec![1.0; n], &cons);
     let mut space =
         FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()).expect("factor space");
@@ -590,7 +601,8 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
             faer::dyn_stack::MemStack::new(&mut space.buffer),
         );
     // Both directions of the backward solve's reading, in sequence and on two threads.
-    let split = supernodal::Split::new(symbolic, 0).expect("a tree worth splitting");
+    let split = supernodal::Split::new(symbolic, 0, |ncols, nrows| ncols * nrows)
+        .expect("a tree worth splitting");
     for (downwards, split) in [(false, None), (true, None), (true, Some(&split))] {
         let mut own = b.clone();
         assert!(supernodal::solve_in_place_reading(
@@ -631,4 +643,153 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
             split.is_some()
         );
     }
+}
+
+/// The quadratic rows of a k × k grid's five-point stencils (a two-ring normal matrix), one
+/// bound per unknown, and the grid positions of the unknowns.
+fn grid_qp(k: usize) -> (Csr, Csr, Vec<[f64; 2]>) {
+    let n = k * k;
+    let stencils: Vec<Vec<(usize, f64)>> = (0..n)
+        .map(|v| {
+            let (i, j) = (v / k, v % k);
+            let mut row = vec![(v, 4.0 + 0.1 * (v % 7) as f64)];
+            let neighbours = [
+                (i + 1, j),
+                (i, j + 1),
+                (i.wrapping_sub(1), j),
+                (i, j.wrapping_sub(1)),
+            ];
+            for (a, b) in neighbours.into_iter().filter(|&(a, b)| a < k && b < k) {
+                row.push((a * k + b, -1.0 - 0.01 * ((a * k + b) % 5) as f64));
+            }
+            row.sort_by_key(|e| e.0);
+            row
+        })
+        .collect();
+    let rows: Vec<&[(usize, f64)]> = stencils.iter().map(|r| r.as_slice()).collect();
+    let bounds: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+    let bound_rows: Vec<&[(usize, f64)]> = bounds.iter().map(|r| r.as_slice()).collect();
+    let cons = stacked(&csr(n, &[]), &csr(n, &bound_rows));
+    let positions = (0..n).map(|v| [(v / k) as f64, (v % k) as f64]).collect();
+    (csr(n, &rows), cons, positions)
+}
+
+/// The two-thread factorisation (and the same code on one thread) gives faer's factor of a
+/// grid's normal matrix, to rounding: a dropped or misplaced update would change it by the
+/// size of the entries.
+#[test]
+fn own_factorisation_equals_faers() {
+    let (quad, cons, _) = grid_qp(40);
+    let n = quad.ncols;
+    let mut cache = PatternCache::default();
+    let (pattern, _) = cache.pattern(&quad, &cons, 0, None).expect("normal matrix");
+    let normal = Normal::new(pattern, &quad, &vec![1.0; n], &cons);
+    let symbolic = &normal.pattern.symbolic;
+    let mut space = FactorSpace::new(symbolic, normal.p_values.len()).expect("factor space");
+    assert!(space.plan.is_none(), "faer factors a matrix this small");
+    let d: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+    drop(Newton::new(&normal, &cons, d, 1e-12, &mut space).expect("a sound factor"));
+    let theirs = space.l_values.clone();
+    let scale = inf_norm(&theirs);
+    let work = |ncols: usize, nrows: usize| (0..ncols).map(|j| (nrows - j).pow(2)).sum();
+    let split = supernodal::Split::new(symbolic, 0, work).expect("a tree worth splitting");
+    let (first, second) = (split.branches[0].len(), split.branches[1].len());
+    assert!(
+        first > 10 && second > 10,
+        "branches of {first} and {second} supernodes"
+    );
+    for split in [Some(split), None] {
+        let threads = if split.is_some() { 2 } else { 1 };
+        let plan = factorise::Plan::with_split(symbolic, split).expect("a supernodal plan");
+        let mut own = vec![f64::NAN; theirs.len()];
+        let matrix = (
+            &pattern.col_ptr[..],
+            &pattern.row_idx[..],
+            &space.values[..],
+        );
+        assert!(plan.factorise(matrix, &mut own));
+        let gap = (own.iter().zip(&theirs))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            gap <= 1e-12 * scale,
+            "{threads} threads: {gap:e} against {scale:e}"
+        );
+    }
+}
+
+/// The nested dissection of a grid: a permutation whose factor splits into two branches of
+/// comparable work (what the two-thread factorisation needs; the first cut halves the grid),
+/// with far less fill than the grid's own order; an unknown coupled to many is ordered last,
+/// and unknowns all at one point are still ordered (by AMD alone).
+#[test]
+fn dissection_splits_a_grid_into_halves() {
+    let k = 64;
+    let (mut quad, cons, mut positions) = grid_qp(k);
+    let n = k * k;
+    // A hub in a constraint with each unknown of four rows of the grid (as a hole's
+    // coefficient is with the vertices around the hole): 8× the mean coupling and more.
+    let hub = n;
+    let mut wide = Csr::new(n + 1);
+    for r in 0..quad.nrows() {
+        wide.push_row(quad.row(r).collect());
+    }
+    let mut cons_wide = Csr::new(n + 1);
+    for r in 0..cons.nrows() {
+        cons_wide.push_row(cons.row(r).collect());
+    }
+    for v in 0..4 * k {
+        cons_wide.push_row(vec![(v, 1.0), (hub, 1.0)]);
+    }
+    (quad, positions) = (wide, [positions, vec![[0.0, 0.0]]].concat());
+    let (col_ptr, row_idx) = product_pattern([&quad, &cons_wide], n + 1);
+    let label = ordering::nested_dissection_labels(&col_ptr, &row_idx, &positions);
+    let mut seen = vec![false; n + 1];
+    label.iter().for_each(|&l| seen[l] = true);
+    assert!(seen.iter().all(|&s| s), "not a permutation");
+    assert_eq!(label[hub], n, "the hub is ordered last");
+    let factor = |label: &[usize]| {
+        let (col_ptr, row_idx) = relabelled_lower(n + 1, &col_ptr, &row_idx, label);
+        let (up_ptr, up_idx) = transpose(n + 1, &col_ptr, &row_idx);
+        symbolic_cholesky(n + 1, &up_ptr, &up_idx).expect("a symbolic factor")
+    };
+    let dissected = factor(&label);
+    let grid_order = factor(&(0..=n).collect::<Vec<_>>());
+    let (ours, banded) = (dissected.len_val(), grid_order.len_val());
+    let amd = factor(&amd_labels(n + 1, &col_ptr, &row_idx).unwrap()).len_val();
+    eprintln!("AMD {amd} ours {ours} banded {banded}");
+    if let Ok(t) = std::fs::read_to_string("/tmp/grid_iperm.txt") {
+        let l: Vec<usize> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        eprintln!("METIS {}", factor(&l).len_val());
+    }
+    assert!(
+        2 * ours < banded,
+        "{ours} factor values against {banded} in grid order"
+    );
+    let work = |ncols: usize, nrows: usize| (0..ncols).map(|j| (nrows - j).pow(2)).sum();
+    let split = supernodal::Split::new(&dissected, 0, work).expect("a split");
+    let faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(sym) = dissected.raw()
+    else {
+        panic!("supernodal");
+    };
+    let weight = |members: &[usize]| -> usize {
+        (members.iter())
+            .map(|&s| {
+                let ncols = sym.supernode_end()[s] - sym.supernode_begin()[s];
+                let nrows = ncols + sym.col_ptr_for_row_idx()[s + 1] - sym.col_ptr_for_row_idx()[s];
+                work(ncols, nrows)
+            })
+            .sum()
+    };
+    let [first, second] = [0, 1].map(|b| weight(&split.branches[b]));
+    let total = first + second + weight(&split.stem);
+    assert!(
+        5 * first.min(second) > 2 * first.max(second) && 10 * (first + second) > 7 * total,
+        "branches {first} and {second} of {total}"
+    );
+    // Everything at one point: no line separates anything.
+    let label = ordering::nested_dissection_labels(&col_ptr, &row_idx, &vec![[1.0, 2.0]; n + 1]);
+    let mut seen = vec![false; n + 1];
+    label.iter().for_each(|&l| seen[l] = true);
+    assert!(seen.iter().all(|&s| s), "not a permutation");
 }
