@@ -720,8 +720,8 @@ fn own_factorisation_equals_faers() {
 
 /// The nested dissection of a grid: a permutation whose factor splits into two branches of
 /// comparable work (what the two-thread factorisation needs; the first cut halves the grid),
-/// with far less fill than the grid's own order; an unknown coupled to many is ordered last,
-/// and unknowns all at one point are still ordered (by AMD alone).
+/// with less than half the fill of the grid's own order and near AMD's; an unknown coupled
+/// to many is ordered last, and unknowns all at one point are still ordered (as one leaf).
 #[test]
 fn dissection_splits_a_grid_into_halves() {
     let k = 64;
@@ -756,12 +756,13 @@ fn dissection_splits_a_grid_into_halves() {
     let dissected = factor(&label);
     let grid_order = factor(&(0..=n).collect::<Vec<_>>());
     let (ours, banded) = (dissected.len_val(), grid_order.len_val());
-    let amd = factor(&amd_labels(n + 1, &col_ptr, &row_idx).unwrap()).len_val();
-    eprintln!("AMD {amd} ours {ours} banded {banded}");
-    if let Ok(t) = std::fs::read_to_string("/tmp/grid_iperm.txt") {
-        let l: Vec<usize> = t.split_whitespace().map(|x| x.parse().unwrap()).collect();
-        eprintln!("METIS {}", factor(&l).len_val());
-    }
+    // Near AMD's fill at this size: 306k stored values against 260k. (Before the postorder,
+    // 283k; with the leaves ordered by AMD on their own, 344k.)
+    let amd = factor(&amd_labels(n + 1, &col_ptr, &row_idx).expect("AMD")).len_val();
+    assert!(
+        100 * ours < 125 * amd,
+        "{ours} factor values against AMD's {amd}"
+    );
     assert!(
         2 * ours < banded,
         "{ours} factor values against {banded} in grid order"
