@@ -7,10 +7,10 @@
 //! regularisation), the triangular solve below it and the products of the updates.
 //!
 //! On one thread this code takes faer's time (the 100k dome: 255 against 260 ms a
-//! factorisation); on two, 164 ms with AMD's order and 132 ms with the nested dissection's
-//! (`ordering`). Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
+//! factorisation); on two, 164 ms with AMD's order and 121–126 ms with the nested
+//! dissection's (`ordering`). Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
 
-use super::supernodal::Split;
+use super::supernodal::{both, Split};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch};
@@ -120,8 +120,8 @@ impl Plan {
 
     /// The factor L D Lᵀ (D on L's diagonal) of the symmetric matrix whose lower triangle is
     /// `col_ptr`, `row_idx`, `values` (rows sorted in each column), into `l_values`, its two
-    /// branches on two threads. False if a supernode's pivot is exactly zero (the dynamic
-    /// regularisation replaces the small ones).
+    /// branches on two threads. False if a pivot is not finite (the dynamic regularisation
+    /// replaces the small ones).
     pub(super) fn factorise(
         &self,
         matrix: (&[usize], &[usize], &[f64]),
@@ -160,14 +160,8 @@ impl Plan {
             self.factor_in_order(members, matrix, blocks, |s| position[s])
         };
         let [mut first, mut second] = taken;
-        let factored = std::thread::scope(|scope| {
-            let first = scope.spawn(|| branch(0, &mut first));
-            let second = branch(1, &mut second);
-            let first = first
-                .join()
-                .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-            first && second
-        });
+        let (first_done, second_done) = both(|| branch(0, &mut first), || branch(1, &mut second));
+        let factored = first_done && second_done;
         // Back in supernode order for the stem.
         let (mut first, mut second, mut stem) =
             (first.into_iter(), second.into_iter(), stem.into_iter());

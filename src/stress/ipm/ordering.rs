@@ -2,10 +2,10 @@
 //! of its unknowns. Cut by straight lines, the mesh falls into halves, quarters and so on:
 //! independent subtrees of the elimination tree, which two threads factor at once
 //! (`factorise`), in a factor that needs less work than with AMD's order. On the 100k-vertex
-//! dome (one analysis each, the same code otherwise): 4.7e9 multiply-adds (Σ (nrows − j)²
-//! over the supernodes' columns) against 6.7e9, 2.7e9 of them in sequence with two threads
-//! against 3.9e9, and 132 against 164 ms a factorisation; the ordering takes 0.28 s against
-//! AMD's 0.1 s, once per form finding. (METIS's nested dissection, through pymetis, reached
+//! dome (one analysis each, the same code otherwise): 4.5e9 multiply-adds (Σ (nrows − j)²
+//! over the supernodes' columns) against 6.7e9, 2.6e9 of them in sequence with two threads
+//! against 3.9e9, and 121–126 against 164 ms a factorisation; the ordering takes about 0.3 s
+//! against AMD's 0.1 s, once per form finding. (METIS's nested dissection, through pymetis, reached
 //! 3.6e9 multiply-adds in 0.7 s, and would be a C dependency.)
 //!
 //! A part is cut by the line that leaves the fewest unknowns next to it among a few
@@ -13,7 +13,7 @@
 //! separator, ordered after both sides. Parts of up to `LEAF` unknowns are ordered by minimum
 //! degree, counting their couplings to the separators around them.
 
-use super::pattern::{bucketed, entries};
+use super::pattern::{amd_labels, bucketed, entries};
 
 /// Parts of up to this many unknowns are ordered by minimum degree (`order_leaf`; with AMD
 /// on the 100k dome, 256 gave the least work of 16, 64, 256, 1000, 5000 and 30000).
@@ -21,12 +21,16 @@ const LEAF: usize = 256;
 
 /// Parts of at least this many unknowns try `DIRECTIONS` directions of cut and `OFFSETS` + 1
 /// offsets in each, from `BALANCE` of the part to 1 − `BALANCE`; smaller parts are cut across
-/// their principal axis at the median. On the 100k dome the search took the work from 6.1e9
-/// to 4.7e9 multiply-adds; a balance of 0.35 or 0.3, or 16 directions, did no better.
+/// their principal axis at the median. On the 100k dome adding the search took the work from
+/// 6.1e9 to 4.9e9 multiply-adds; a balance of 0.35 or 0.3, or 16 directions, did no better.
 const SEARCH_FROM: usize = 500;
 const DIRECTIONS: usize = 8;
 const OFFSETS: usize = 10;
 const BALANCE: f64 = 0.4;
+
+/// Parts still above `LEAF` after this many cuts (only where cuts keep leaving nearly all of
+/// a part on one side) are ordered by AMD.
+const MAX_LEVELS: usize = 64;
 
 /// Unknowns coupled to more than this many times the mean number of others (a hole's
 /// coefficient, coupled to every vertex around the hole) are ordered last: in a part they
@@ -40,39 +44,20 @@ pub(super) fn nested_dissection_labels(
     row_idx: &[usize],
     positions: &[[f64; 2]],
 ) -> Vec<usize> {
-    let n = positions.len();
-    let off_diagonal = || entries(col_ptr, row_idx).filter(|(r, c)| r != c);
-    let (adj_ptr, adj) = bucketed(n, 2 * off_diagonal().count(), || {
-        off_diagonal().flat_map(|(r, c)| [(r, c), (c, r)])
-    });
-    let mean_degree = adj.len() as f64 / n.max(1) as f64;
-    let degree = |v: usize| (adj_ptr[v + 1] - adj_ptr[v]) as f64;
-    let (dense, rest): (Vec<usize>, Vec<usize>) =
-        (0..n).partition(|&v| degree(v) > DENSE_FACTOR * mean_degree);
-    let mut dissection = Dissection {
-        adj_ptr,
-        adj,
-        positions,
-        stamp: vec![0; n],
-        next_stamp: 0,
-        local: vec![0; n],
-        order: Vec::with_capacity(n),
-    };
-    dissection.dissect(rest);
+    let mut dissection = Dissection::new(col_ptr, row_idx, positions);
+    let mean_degree = dissection.adj.len() as f64 / positions.len().max(1) as f64;
+    let (dense, rest): (Vec<usize>, Vec<usize>) = (0..positions.len())
+        .partition(|&v| dissection.neighbours(v).len() as f64 > DENSE_FACTOR * mean_degree);
+    dissection.dissect(rest, 0);
     dissection.order.extend(dense);
-    let Dissection {
-        adj_ptr,
-        adj,
-        order,
-        ..
-    } = dissection;
-    postordered(&order, &adj_ptr, &adj)
+    postordered(&dissection.order, &dissection.adj_ptr, &dissection.adj)
 }
 
 /// The labels of the elimination order `order` (unknowns in order), renumbered in a
-/// postorder of its elimination tree: the same factor, with each subtree's columns
-/// contiguous, so that chains of columns merge into supernodes (the leaves' minimum-degree
-/// orders are not postordered; on the 100k dome: 11.8k supernodes against 30.5k).
+/// postorder of its elimination tree: the same fill, with each subtree's columns contiguous,
+/// so that chains of columns merge into supernodes (the leaves' minimum-degree orders are
+/// not postordered; on the 100k dome 11.8k supernodes against 30.5k, though faer's merging
+/// of small supernodes then stores 15.5M values against 14.9M).
 fn postordered(order: &[usize], adj_ptr: &[usize], adj: &[usize]) -> Vec<usize> {
     let n = order.len();
     let mut label = vec![0; n];
@@ -143,7 +128,25 @@ struct Dissection<'a> {
     order: Vec<usize>,
 }
 
-impl Dissection<'_> {
+impl<'a> Dissection<'a> {
+    /// The dissection of the symmetric pattern given by its lower triangle, nothing ordered.
+    fn new(col_ptr: &[usize], row_idx: &[usize], positions: &'a [[f64; 2]]) -> Dissection<'a> {
+        let n = positions.len();
+        let off_diagonal = || entries(col_ptr, row_idx).filter(|(r, c)| r != c);
+        let (adj_ptr, adj) = bucketed(n, 2 * off_diagonal().count(), || {
+            off_diagonal().flat_map(|(r, c)| [(r, c), (c, r)])
+        });
+        Dissection {
+            adj_ptr,
+            adj,
+            positions,
+            stamp: vec![0; n],
+            next_stamp: 0,
+            local: vec![0; n],
+            order: Vec::with_capacity(n),
+        }
+    }
+
     fn neighbours(&self, v: usize) -> &[usize] {
         &self.adj[self.adj_ptr[v]..self.adj_ptr[v + 1]]
     }
@@ -158,18 +161,21 @@ impl Dissection<'_> {
     }
 
     /// Appends `part` to the order: both sides first, recursively, then the separator.
-    fn dissect(&mut self, part: Vec<usize>) {
+    /// `level` counts the cuts above it.
+    fn dissect(&mut self, part: Vec<usize>, level: usize) {
         if part.len() <= LEAF {
             return self.order_leaf(&part);
         }
+        if level >= MAX_LEVELS {
+            return self.order_by_amd(&part);
+        }
         let (near, separator, far) = self.split(part);
         if near.is_empty() || far.is_empty() {
-            // Nothing separated (all the part's unknowns at one point): AMD alone.
-            let all = [near, separator, far].concat();
-            return self.order_leaf(&all);
+            // Nothing separated (the part's unknowns all at one point, or along the cut).
+            return self.order_by_amd(&[near, separator, far].concat());
         }
-        self.dissect(near);
-        self.dissect(far);
+        self.dissect(near, level + 1);
+        self.dissect(far, level + 1);
         self.order.extend(separator);
     }
 
@@ -203,7 +209,7 @@ impl Dissection<'_> {
         let median = sorted[part.len() / 2];
         let first = self.cut(&part, &t, median);
         let depth = (first.1.iter())
-            .map(|&v| median - t[self.local_of(v, &part)])
+            .map(|&v| (t[self.local_of(v, &part)] - median).abs())
             .fold(0.0, f64::max);
         if part.len() < SEARCH_FROM || depth <= 0.0 {
             return first;
@@ -238,8 +244,9 @@ impl Dissection<'_> {
     }
 
     /// `part[i]` is the unknown at `t[i]` along some axis: (near, separator, far) of the cut
-    /// at `at`, far being from `at` on. The separator is the smaller of the two sides'
-    /// unknowns coupled to the other side, less those coupled to one side only.
+    /// at `at`, far being from `at` on or below it. The separator is the smaller of the two
+    /// sides' sets of unknowns coupled to the other side (its side is then the near one);
+    /// those of it coupled to no other near unknown join the far side.
     fn cut(&mut self, part: &[usize], t: &[f64], at: f64) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
         for (i, &v) in part.iter().enumerate() {
             self.local[v] = i;
@@ -247,28 +254,21 @@ impl Dissection<'_> {
         let (low, high): (Vec<usize>, Vec<usize>) = (0..part.len()).partition(|&i| t[i] < at);
         let [low, high] =
             [low, high].map(|side| side.into_iter().map(|i| part[i]).collect::<Vec<_>>());
-        let [low_mark, high_mark] = [self.mark(&low), 0];
-        let _ = high_mark;
-        // The boundary of each side towards the other.
         let coupled_to = |this: &Self, v: usize, mark: usize| {
             this.neighbours(v).iter().any(|&w| this.stamp[w] == mark)
         };
-        let low_boundary: Vec<usize> = high
-            .iter()
-            .copied()
+        let low_mark = self.mark(&low);
+        let high_next_to_low: Vec<usize> = (high.iter().copied())
             .filter(|&v| coupled_to(self, v, low_mark))
             .collect();
         let high_mark = self.mark(&high);
-        let high_boundary: Vec<usize> = low
-            .iter()
-            .copied()
+        let low_next_to_high: Vec<usize> = (low.iter().copied())
             .filter(|&v| coupled_to(self, v, high_mark))
             .collect();
-        // low_boundary: high's unknowns next to low; high_boundary: low's next to high.
-        let (mut near, mut far, separator) = if high_boundary.len() <= low_boundary.len() {
-            (low, high, high_boundary)
+        let (mut near, mut far, separator) = if low_next_to_high.len() <= high_next_to_low.len() {
+            (low, high, low_next_to_high)
         } else {
-            (high, low, low_boundary)
+            (high, low, high_next_to_low)
         };
         // The separator is on the near side: those of its unknowns coupled to no other near
         // unknown join the far side.
@@ -296,6 +296,37 @@ impl Dissection<'_> {
     fn local_of(&self, v: usize, part: &[usize]) -> usize {
         debug_assert_eq!(part[self.local[v]], v);
         self.local[v]
+    }
+
+    /// Appends `part` in AMD's order of the pattern it induces (a part no line divides).
+    fn order_by_amd(&mut self, part: &[usize]) {
+        let in_part = self.mark(part);
+        for (i, &v) in part.iter().enumerate() {
+            self.local[v] = i;
+        }
+        let (mut col_ptr, mut row_idx) = (vec![0], Vec::new());
+        for &v in part {
+            let (first, c) = (row_idx.len(), self.local[v]);
+            row_idx.push(c);
+            for &w in self.neighbours(v) {
+                if self.stamp[w] == in_part && self.local[w] > c {
+                    row_idx.push(self.local[w]);
+                }
+            }
+            row_idx[first..].sort_unstable();
+            col_ptr.push(row_idx.len());
+        }
+        match amd_labels(part.len(), &col_ptr, &row_idx) {
+            Some(label) => {
+                let mut ordered = vec![0; part.len()];
+                for (i, &v) in part.iter().enumerate() {
+                    ordered[label[i]] = v;
+                }
+                self.order.extend(ordered);
+            }
+            // AMD's workspace could not be had: any order is a valid one.
+            None => self.order.extend_from_slice(part),
+        }
     }
 
     /// Appends `part` in a minimum-degree order that counts its couplings to unknowns
@@ -360,6 +391,66 @@ impl Dissection<'_> {
                 adj[u * words + u / 64] &= !(1 << (u % 64));
                 adj[u * words + v / 64] &= !(1 << (v % 64));
                 deg[u] = degree(&adj, u);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stress::ipm::pattern::product_pattern;
+    use crate::stress::sparse::Csr;
+
+    /// Every cut of a dome-like disc with a hole leaves no coupling between its two sides,
+    /// and near, separator and far are the part: the searched cut of a large part and the
+    /// median cut of a small one.
+    #[test]
+    fn cuts_separate_their_sides() {
+        // A k × k grid of two-ring couplings (five-point rows), the unknowns outside a
+        // radius or inside a hole left uncoupled.
+        let k = 48;
+        let at = |i: usize, j: usize| [i as f64 - 23.5, j as f64 - 23.5];
+        let inside = |p: [f64; 2]| {
+            let (r, h) = (p[0].hypot(p[1]), (p[0] - 8.0).hypot(p[1] - 3.0));
+            r < 23.0 && h > 5.0
+        };
+        let mut rows = Csr::new(k * k);
+        for i in 0..k {
+            for j in 0..k {
+                if !inside(at(i, j)) {
+                    continue;
+                }
+                let mut row = vec![(i * k + j, 1.0)];
+                for (a, b) in [(i + 1, j), (i, j + 1)] {
+                    if a < k && b < k && inside(at(a, b)) {
+                        row.push((a * k + b, 1.0));
+                    }
+                }
+                rows.push_row(row);
+            }
+        }
+        let (col_ptr, row_idx) = product_pattern([&rows, &Csr::new(k * k)], k * k);
+        let positions: Vec<[f64; 2]> = (0..k * k).map(|v| at(v / k, v % k)).collect();
+        let disc: Vec<usize> = (0..k * k).filter(|&v| inside(positions[v])).collect();
+        let mut dissection = Dissection::new(&col_ptr, &row_idx, &positions);
+        for part in [disc.clone(), disc[..300].to_vec()] {
+            let (near, separator, far) = dissection.split(part.clone());
+            assert!(!near.is_empty() && !far.is_empty() && !separator.is_empty());
+            let mut all = [near.clone(), separator, far.clone()].concat();
+            all.sort_unstable();
+            let mut expected = part.clone();
+            expected.sort_unstable();
+            assert_eq!(all, expected);
+            let far_mark = dissection.mark(&far);
+            for &v in &near {
+                assert!(
+                    dissection
+                        .neighbours(v)
+                        .iter()
+                        .all(|&w| dissection.stamp[w] != far_mark),
+                    "{v} on the near side is coupled to the far side"
+                );
             }
         }
     }

@@ -293,7 +293,8 @@ pub(super) fn symbolic_cholesky(
 
 impl Pattern {
     /// Whether the pattern was built from matrices with entries where `quad` and `cons` have
-    /// them (compared in place: no copy per step).
+    /// them (compared in place: no copy per step). The unknowns' positions only chose the
+    /// order, which stays valid (and is kept) whatever positions later QPs bring.
     pub(super) fn fits(&self, quad: &Csr, cons: &Csr, m_eq: usize) -> bool {
         let [quad_start, quad_col, cons_start, cons_col] = &self.built_from;
         (self.n, self.m_eq) == (cons.ncols, m_eq)
@@ -313,7 +314,11 @@ impl Pattern {
         // One symbolic analysis in the new labels: the ordering alone comes from AMD or the
         // dissection, so that the pattern is not analysed twice.
         let label = match positions {
-            Some(positions) if n >= DISSECT_FROM && positions.len() == n => {
+            Some(positions)
+                if n >= DISSECT_FROM
+                    && positions.len() == n
+                    && positions.iter().flatten().all(|x| x.is_finite()) =>
+            {
                 nested_dissection_labels(&col_ptr, &row_idx, positions)
             }
             _ => amd_labels(n, &col_ptr, &row_idx)?,

@@ -193,15 +193,36 @@ impl<'a> Factor<'a> {
     }
 }
 
-/// `work(0)` on a second thread and `work(1)` on this one.
+/// `work(0)` on a second thread and `work(1)` on this one (both here, in turn, if no
+/// thread can be started).
 fn on_two_threads<T: Send>(work: impl Fn(usize) -> T + Sync) -> [T; 2] {
+    let (first, second) = both(|| work(0), || work(1));
+    [first, second]
+}
+
+/// `first()` on a second thread and `second()` on this one; if no thread can be started,
+/// both here, `first` first.
+pub(super) fn both<A: Send, B>(
+    first: impl FnOnce() -> A + Send,
+    second: impl FnOnce() -> B,
+) -> (A, B) {
+    // The spawn takes the closure even when it fails: it is handed over through a slot.
+    let slot = std::sync::Mutex::new(Some(first));
+    let take = || slot.lock().ok().and_then(|mut f| f.take());
     std::thread::scope(|scope| {
-        let first = scope.spawn(|| work(0));
-        let second = work(1);
-        let first = first
-            .join()
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        [first, second]
+        let spawned = std::thread::Builder::new().spawn_scoped(scope, || take().map(|f| f()));
+        let b = second();
+        let a = match spawned {
+            Ok(handle) => handle
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+            Err(_) => None,
+        };
+        let a = a.or_else(|| take().map(|f| f()));
+        (
+            a.expect("the first closure ran on one thread or the other"),
+            b,
+        )
     })
 }
 
@@ -216,52 +237,62 @@ pub(super) const SPLIT_FROM: usize = 1 << 22;
 /// Factors with more values than this are factored on two threads (`factorise`): from about
 /// 10k vertices. Measured on the generated domes with a hole, one analysis each, time in
 /// factorisations over their number: 10k vertices (1.07M values) 12.4 → 7.4 ms, 20k 26.6 →
-/// 20.4 ms, 100k 0.26 → 0.19 s with AMD's order (0.15 s with `ordering`'s); 6k (0.57M) only
-/// 4.8 → 4.1 ms, and the shared models keep faer's factorisation and its rounding.
+/// 20.4 ms (AMD's order both); 6k (0.57M) only 4.8 → 4.1 ms, and the shared models keep
+/// faer's factorisation and its rounding. At 100k see `factorise`.
 pub(super) const FACTOR_SPLIT_FROM: usize = 1 << 20;
 
 /// At most this many subtrees are expanded into their children in search of a balanced
 /// `Split`.
 const MAX_EXPANSIONS: usize = 64;
 
-/// A division of a factor's supernodes into two branches, independent subtrees of its
-/// elimination tree, and the stem, the rest: the branches can be solved at the same time.
-/// The solves with large factors are limited by reading them from memory, which two cores
-/// do faster than one. On the 100k dome's factor the longer branch and the stem hold 67% of
-/// its values.
+/// A division of a factor's supernodes into two branches, each a set of whole subtrees of
+/// its elimination tree, and the stem, the rest: the branches can be solved or factored at
+/// the same time. The solves with large factors are limited by reading them from memory,
+/// which two cores do faster than one. On the 100k dome's factor (the dissection's order)
+/// the more loaded branch and the stem hold 54% of its values and 59% of its
+/// factorisation's multiply-adds.
 pub(super) struct Split {
     pub(super) branches: [Vec<usize>; 2],
     pub(super) stem: Vec<usize>,
 }
 
+/// Whether the machine runs two threads at once.
+fn two_threads() -> bool {
+    std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+}
+
+/// The multiply-adds of factoring a supernode of `ncols` columns and `nrows` rows (its
+/// diagonal block's included): Σ_j (nrows − j)² over its columns j.
+pub(super) fn factor_work(ncols: usize, nrows: usize) -> u64 {
+    (0..ncols).map(|j| ((nrows - j) as u64).pow(2)).sum()
+}
+
 impl Split {
     /// The split for solves (`SPLIT_FROM`), balancing the factor values each part reads.
     pub(super) fn for_solve(symbolic: &SymbolicCholesky<usize>) -> Option<Split> {
-        Split::new(symbolic, SPLIT_FROM, |ncols, nrows| ncols * nrows)
+        let values = |ncols: usize, nrows: usize| (ncols * nrows) as u64;
+        two_threads().then(|| Split::new(symbolic, SPLIT_FROM, values))?
     }
 
     /// The split for the factorisation (`FACTOR_SPLIT_FROM`), balancing the multiply-adds of
-    /// each part's supernodes: Σ_j (nrows − j)² over a supernode's columns j.
+    /// each part's supernodes (`factor_work`).
     pub(super) fn for_factor(symbolic: &SymbolicCholesky<usize>) -> Option<Split> {
-        Split::new(symbolic, FACTOR_SPLIT_FROM, |ncols, nrows| {
-            (0..ncols).map(|j| (nrows - j) * (nrows - j)).sum()
-        })
+        two_threads().then(|| Split::new(symbolic, FACTOR_SPLIT_FROM, factor_work))?
     }
 
-    /// The split of `symbolic`'s tree whose longest branch plus stem has the least
+    /// The split of `symbolic`'s tree whose more loaded branch plus stem has the least
     /// `weight(ncols, nrows)` summed over its supernodes, if the factor has more than
-    /// `min_values` values, the machine at least two threads, and the split saves at least a
-    /// tenth of the weight done in sequence.
+    /// `min_values` values and the split saves at least a tenth of the weight done in
+    /// sequence.
     pub(super) fn new(
         symbolic: &SymbolicCholesky<usize>,
         min_values: usize,
-        weight_of: impl Fn(usize, usize) -> usize,
+        weight_of: impl Fn(usize, usize) -> u64,
     ) -> Option<Split> {
         let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
             return None;
         };
-        let two_threads = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
-        if symbolic.len_val() <= min_values || !two_threads {
+        if symbolic.len_val() <= min_values {
             return None;
         }
         let (begin, end, row_ptr, row_idx) = (
@@ -282,7 +313,7 @@ impl Split {
             .map(|first| first.map_or(ns, |&r| owner[r]))
             .collect();
         let mut children = vec![Vec::new(); ns + 1];
-        let mut weight: Vec<usize> = (0..ns)
+        let mut weight: Vec<u64> = (0..ns)
             .map(|s| {
                 let ncols = end[s] - begin[s];
                 weight_of(ncols, ncols + row_ptr[s + 1] - row_ptr[s])
@@ -297,10 +328,11 @@ impl Split {
         // Independent subtrees (a frontier across the tree) go to two threads, the heaviest
         // first to the less loaded; the supernodes above them are the stem. From the roots'
         // subtrees, the heaviest subtree is replaced by its children, its root joining the
-        // stem, while that shortens the wall: stem plus the more loaded thread.
+        // stem, up to MAX_EXPANSIONS times or until the heaviest is one supernode; the
+        // frontier with the shortest wall (stem plus the more loaded thread) is kept.
         let mut frontier = children[ns].clone();
         let mut stem = 0;
-        let mut best: Option<(usize, Vec<usize>, Vec<u8>)> = None;
+        let mut best: Option<(u64, Vec<usize>, Vec<u8>)> = None;
         for _ in 0..MAX_EXPANSIONS {
             frontier.sort_unstable_by_key(|&k| std::cmp::Reverse((weight[k], k)));
             let mut load = [0, 0];
@@ -319,7 +351,7 @@ impl Split {
             if children[heaviest].is_empty() {
                 break;
             }
-            stem += weight[heaviest] - children[heaviest].iter().map(|&k| weight[k]).sum::<usize>();
+            stem += weight[heaviest] - children[heaviest].iter().map(|&k| weight[k]).sum::<u64>();
             frontier.swap_remove(0);
             frontier.extend_from_slice(&children[heaviest]);
         }

@@ -601,7 +601,7 @@ fn supernodal_solve_matches_the_matrix_and_faer() {
             faer::dyn_stack::MemStack::new(&mut space.buffer),
         );
     // Both directions of the backward solve's reading, in sequence and on two threads.
-    let split = supernodal::Split::new(symbolic, 0, |ncols, nrows| ncols * nrows)
+    let split = supernodal::Split::new(symbolic, 0, |ncols, nrows| (ncols * nrows) as u64)
         .expect("a tree worth splitting");
     for (downwards, split) in [(false, None), (true, None), (true, Some(&split))] {
         let mut own = b.clone();
@@ -691,8 +691,8 @@ fn own_factorisation_equals_faers() {
     drop(Newton::new(&normal, &cons, d, 1e-12, &mut space).expect("a sound factor"));
     let theirs = space.l_values.clone();
     let scale = inf_norm(&theirs);
-    let work = |ncols: usize, nrows: usize| (0..ncols).map(|j| (nrows - j).pow(2)).sum();
-    let split = supernodal::Split::new(symbolic, 0, work).expect("a tree worth splitting");
+    let split = supernodal::Split::new(symbolic, 0, supernodal::factor_work)
+        .expect("a tree worth splitting");
     let (first, second) = (split.branches[0].len(), split.branches[1].len());
     assert!(
         first > 10 && second > 10,
@@ -718,10 +718,11 @@ fn own_factorisation_equals_faers() {
     }
 }
 
-/// The nested dissection of a grid: a permutation whose factor splits into two branches of
-/// comparable work (what the two-thread factorisation needs; the first cut halves the grid),
-/// with less than half the fill of the grid's own order and near AMD's; an unknown coupled
-/// to many is ordered last, and unknowns all at one point are still ordered (as one leaf).
+/// The nested dissection of a grid: a permutation, postordered, whose factor splits into
+/// two branches of comparable work (what the two-thread factorisation needs; the first cut
+/// halves the grid), with less than half the fill of the grid's own order and near AMD's; an
+/// unknown coupled to many is ordered last, and unknowns all at one point are still ordered
+/// (by AMD).
 #[test]
 fn dissection_splits_a_grid_into_halves() {
     let k = 64;
@@ -767,13 +768,13 @@ fn dissection_splits_a_grid_into_halves() {
         2 * ours < banded,
         "{ours} factor values against {banded} in grid order"
     );
-    let work = |ncols: usize, nrows: usize| (0..ncols).map(|j| (nrows - j).pow(2)).sum();
+    let work = supernodal::factor_work;
     let split = supernodal::Split::new(&dissected, 0, work).expect("a split");
     let faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(sym) = dissected.raw()
     else {
         panic!("supernodal");
     };
-    let weight = |members: &[usize]| -> usize {
+    let weight = |members: &[usize]| -> u64 {
         (members.iter())
             .map(|&s| {
                 let ncols = sym.supernode_end()[s] - sym.supernode_begin()[s];
@@ -782,6 +783,26 @@ fn dissection_splits_a_grid_into_halves() {
             })
             .sum()
     };
+    // Postordered: every supernode's subtree is the run of supernodes ending at it.
+    let (begin, end, row_ptr) = (
+        sym.supernode_begin(),
+        sym.supernode_end(),
+        sym.col_ptr_for_row_idx(),
+    );
+    let ns = sym.n_supernodes();
+    let owner = |col: usize| (0..ns).find(|&s| begin[s] <= col && col < end[s]);
+    let (mut lowest, mut size) = ((0..ns).collect::<Vec<_>>(), vec![1; ns]);
+    for s in 0..ns {
+        if let Some(&r) = sym.row_idx()[row_ptr[s]..row_ptr[s + 1]].first() {
+            let p = owner(r).expect("a parent");
+            (lowest[p], size[p]) = (lowest[p].min(lowest[s]), size[p] + size[s]);
+        }
+        assert_eq!(
+            s + 1 - lowest[s],
+            size[s],
+            "supernode {s}'s subtree is not a run"
+        );
+    }
     let [first, second] = [0, 1].map(|b| weight(&split.branches[b]));
     let total = first + second + weight(&split.stem);
     assert!(
