@@ -552,32 +552,8 @@ fn a_stall_is_a_window_without_halved_residuals_or_a_tenfold_gap() {
 /// supernodes): its solution solves the assembled matrix to rounding and equals faer's solve.
 #[test]
 fn supernodal_solve_matches_the_matrix_and_faer() {
-    let k: usize = 15;
-    let n = k * k;
-    let stencils: Vec<Vec<(usize, f64)>> = (0..n)
-        .map(|v| {
-            let (i, j) = (v / k, v % k);
-            let mut row = vec![(v, 4.0 + 0.1 * (v % 7) as f64)];
-            let neighbours = [
-                (i + 1, j),
-                (i, j + 1),
-                (i.wrapping_sub(1), j),
-                (i, j.wrapping_sub(1)),
-            ];
-            for (a, b) in neighbours.into_iter().filter(|&(a, b)| a < k && b < k) {
-                let u = a * k + b;
-                row.push((u, -1.0 - 0.01 * (u % 5) as f64));
-            }
-            row.sort_by_key(|e| e.0);
-            row
-        })
-        .collect();
-    let rows: Vec<&[(usize, f64)]> = stencils.iter().map(|r| r.as_slice()).collect();
-    let quad = csr(n, &rows);
-    let bounds: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
-    let bound_rows: Vec<&[(usize, f64)]> = bounds.iter().map(|r| r.as_slice()).collect();
-    let ineq = csr(n, &bound_rows);
-    let cons = stacked(&csr(n, &[]), &ineq);
+    let (quad, cons, _) = grid_qp(15);
+    let n = quad.ncols;
     let mut cache = PatternCache::default();
     let (pattern, _) = cache.pattern(&quad, &cons, 0, None).expect("normal matrix");
     let normal = Normal::new(pattern, &quad, &vec![1.0; n], &cons);
