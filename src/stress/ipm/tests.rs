@@ -650,6 +650,63 @@ fn grid_qp(k: usize) -> (Csr, Csr, Vec<[f64; 2]>) {
     (csr(n, &rows), cons, positions)
 }
 
+/// A QP of 44k unknowns (a grid's two-ring normal matrix, part of its bounds active) solved
+/// in the nested-dissection order of its unknowns' positions and in AMD's order: the same
+/// optimum. This is the path of large stress QPs: the dissection from 40k unknowns, the
+/// factorisation and the solves on two threads.
+#[test]
+fn dissection_order_solves_a_large_qp_as_amds_does() {
+    let k = 210;
+    let (quad, cons, positions) = grid_qp(k);
+    let n = k * k;
+    let (weight, eq) = (vec![1.0; n], csr(n, &[]));
+    let c: Vec<f64> = (0..n).map(|v| ((v * 7919) % 13) as f64 - 6.0).collect();
+    let h: Vec<f64> = (0..n).map(|v| ((v * 31) % 5) as f64 * 0.1).collect();
+    let groups = RowGroups::default();
+    let qp = |positions| Qp {
+        quad: &quad,
+        quad_weight: &weight,
+        c: &c,
+        constant: 0.0,
+        eq: &eq,
+        f: &[],
+        ineq: &cons,
+        h: &h,
+        groups: &groups,
+        positions,
+    };
+    let (mut dissected, mut amd) = (PatternCache::default(), PatternCache::default());
+    let tol = Tolerances::for_size(n);
+    let ours = solve(&qp(Some(&positions)), &tol, &mut dissected);
+    let theirs = solve(&qp(None), &tol, &mut amd);
+    let label = |cache: &PatternCache| cache.pattern.as_ref().expect("a pattern").label.clone();
+    assert_ne!(
+        label(&dissected),
+        label(&amd),
+        "the same order: no dissection"
+    );
+    for out in [&ours, &theirs] {
+        assert_eq!(out.status, IpmStatus::Solved);
+    }
+    let active = ours
+        .x
+        .iter()
+        .zip(&h)
+        .filter(|(x, h)| *x - *h < 1e-6)
+        .count();
+    assert!(
+        active > n / 20 && active < n - n / 20,
+        "{active} of {n} bounds active"
+    );
+    let gap = (ours.x.iter().zip(&theirs.x))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        gap <= 1e-6 * inf_norm(&theirs.x),
+        "orders differ by {gap:e}"
+    );
+}
+
 /// The two-thread factorisation (and the same code on one thread) gives faer's factor of a
 /// grid's normal matrix, to rounding: a dropped or misplaced update would change it by the
 /// size of the entries.
