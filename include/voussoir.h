@@ -31,7 +31,10 @@
  * threads at once; a handle passed non-const (setters, destroy) needs exclusive access: no
  * other thread may use it during the call. Solves on different or shared-const handles run
  * concurrently and give the same results as run one after another. The last error message is
- * per thread. A progress callback runs on the thread that called vsr_form_find.
+ * per thread. A progress callback runs on the thread that called vsr_form_find. Within a
+ * solve, large stress QPs (from about 10k vertices) factor and solve their normal matrix on
+ * the calling thread and one more, started and joined inside each factorisation or solve;
+ * the results do not depend on the threads' timing.
  *
  * Versions. VSR_VERSION_MAJOR/MINOR/PATCH and VSR_VERSION_STRING are the version of the
  * crate this header was generated from; vsr_version() is the library's. VSR_ABI_VERSION
