@@ -4,9 +4,9 @@
 //! (`factorise`), in a factor that needs less work than with AMD's order. On the 100k-vertex
 //! dome (one analysis each, the same code otherwise): 4.5e9 multiply-adds (Σ (nrows − j)²
 //! over the supernodes' columns) against 6.7e9, 2.6e9 of them in sequence with two threads
-//! against 3.9e9, and 121–126 against 164 ms a factorisation; the ordering takes about 0.3 s
-//! against AMD's 0.1 s, once per form finding. (METIS's nested dissection, through pymetis, reached
-//! 3.6e9 multiply-adds in 0.7 s, and would be a C dependency.)
+//! against 3.9e9, and 121–126 against 164 ms a factorisation; the ordering takes about
+//! 0.3 s against AMD's 0.1 s, once per form finding. (METIS's nested dissection, through
+//! pymetis, reached 3.6e9 multiply-adds in 0.7 s, and would be a C dependency.)
 //!
 //! A part is cut by the line that leaves the fewest unknowns next to it among a few
 //! directions and offsets; its near side's unknowns coupled to the far side are the
