@@ -10,7 +10,8 @@
 //! factorisation); on two, 164 ms with AMD's order and 121–126 ms with the nested
 //! dissection's (`ordering`). Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
 
-use super::supernodal::{both, Split};
+use super::pattern::bucketed;
+use super::supernodal::{both, owners, Split};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch};
@@ -68,10 +69,7 @@ impl Plan {
         let ns = sym.n_supernodes();
         let (begin, end) = (sym.supernode_begin().to_vec(), sym.supernode_end().to_vec());
         let (row_ptr, row_idx) = (sym.col_ptr_for_row_idx(), sym.row_idx());
-        let mut owner = vec![0; symbolic.nrows()];
-        for s in 0..ns {
-            owner[begin[s]..end[s]].fill(s);
-        }
+        let owner = owners(&begin, &end, symbolic.nrows());
         // (updated, updater) pairs: rows are sorted, so a supernode's owners come in runs.
         let mut pairs = Vec::new();
         for d in 0..ns {
@@ -83,20 +81,8 @@ impl Plan {
                 }
             }
         }
-        let mut updater_ptr = vec![0; ns + 1];
-        for &(s, _) in &pairs {
-            updater_ptr[s + 1] += 1;
-        }
-        for s in 0..ns {
-            updater_ptr[s + 1] += updater_ptr[s];
-        }
         // Pairs come by updater, so each supernode's updaters stay in increasing order.
-        let mut next = updater_ptr.clone();
-        let mut updaters = vec![0; pairs.len()];
-        for (s, d) in pairs {
-            updaters[next[s]] = d;
-            next[s] += 1;
-        }
+        let (updater_ptr, updaters) = bucketed(ns, pairs.len(), || pairs.iter().copied());
         Some(Plan {
             begin,
             end,

@@ -45,10 +45,6 @@ pub(super) struct FactorSpace {
     pub(super) buffer: MemBuffer,
     /// Working storage of `supernodal::solve_in_place`.
     pub(super) scratch: Vec<f64>,
-    /// Large factors' solves on two threads.
-    pub(super) split: Option<supernodal::Split>,
-    /// Large factors' factorisation on two threads.
-    pub(super) plan: Option<factorise::Plan>,
 }
 
 impl FactorSpace {
@@ -63,8 +59,6 @@ impl FactorSpace {
             l_values: vec![0.0; symbolic.len_val()],
             buffer: MemBuffer::try_new(scratch).ok()?,
             scratch: Vec::new(),
-            split: supernodal::Split::for_solve(symbolic),
-            plan: factorise::Plan::new(symbolic),
         })
     }
 }
@@ -102,7 +96,7 @@ impl<'a> Newton<'a> {
         }
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
-        let factored = match &space.plan {
+        let factored = match &pattern.plan {
             Some(plan) => plan.factorise(
                 (&pattern.col_ptr, &pattern.row_idx, &space.values),
                 &mut space.l_values,
@@ -158,7 +152,7 @@ impl<'a> Newton<'a> {
         let symbolic = &self.normal.pattern.symbolic;
         // Our own loops over the supernodes (`supernodal`); faer's solve only for a factor
         // that is not supernodal or is permuted.
-        let split = space.split.as_ref();
+        let split = self.normal.pattern.solve_split.as_ref();
         if !supernodal::solve_in_place(
             symbolic,
             &space.l_values,

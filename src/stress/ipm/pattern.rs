@@ -2,7 +2,9 @@
 //! factorisation, the value slot of every product), built once per mesh connectivity and kept
 //! in a `PatternCache`, and its values for one QP.
 
+use super::factorise::Plan;
 use super::ordering::nested_dissection_labels;
+use super::supernodal::Split;
 use super::*;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
@@ -32,6 +34,10 @@ pub(super) struct Pattern {
     pub(super) row_slot: Vec<usize>,
     pub(super) diag: Vec<usize>,
     pub(super) symbolic: SymbolicCholesky<usize>,
+    /// Large factors' solves on two threads (`supernodal::Split::for_solve`).
+    pub(super) solve_split: Option<Split>,
+    /// Large factors' factorisation on two threads (`factorise::Plan::new`).
+    pub(super) plan: Option<Plan>,
 }
 
 /// The normal matrix's structure, kept between QPs of the same structure (the steps of one
@@ -354,6 +360,8 @@ impl Pattern {
             row_start,
             row_slot,
             diag,
+            solve_split: Split::for_solve(&symbolic),
+            plan: Plan::new(&symbolic),
             symbolic,
         })
     }

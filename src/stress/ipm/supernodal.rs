@@ -256,6 +256,15 @@ pub(super) struct Split {
     pub(super) stem: Vec<usize>,
 }
 
+/// The supernode holding each of a factor's `n` columns (supernode s: begin[s]..end[s]).
+pub(super) fn owners(begin: &[usize], end: &[usize], n: usize) -> Vec<usize> {
+    let mut owner = vec![0; n];
+    for (s, (&b, &e)) in begin.iter().zip(end).enumerate() {
+        owner[b..e].fill(s);
+    }
+    owner
+}
+
 /// Whether the machine runs two threads at once.
 fn two_threads() -> bool {
     std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
@@ -302,10 +311,7 @@ impl Split {
             sym.row_idx(),
         );
         let ns = sym.n_supernodes();
-        let mut owner = vec![0; symbolic.nrows()];
-        for s in 0..ns {
-            owner[begin[s]..end[s]].fill(s);
-        }
+        let owner = owners(begin, end, symbolic.nrows());
         // A supernode's parent owns the first row below its columns; ns stands for a root
         // above the roots of a forest.
         let parent: Vec<usize> = (0..ns)
