@@ -650,3 +650,221 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
         lowest(&exact)
     );
 }
+
+/// The Airy function's jump around every hole, continued from face to face around the hole
+/// with the force densities alone (the reciprocal diagram: crossing edge a→b from its left to
+/// its right face, the gradient changes by −q J(b − a), J the quarter turn), as (c, a_x, a_y)
+/// with M(u) = c + a·u, counter-clockwise around the hole. Independent of the solver's cuts.
+fn airy_periods(mesh: &Mesh, q: &[f64]) -> Vec<[f64; 3]> {
+    let u = |v: u32| {
+        let p = mesh.positions[v as usize];
+        [p[0], p[1]]
+    };
+    let face_of_boundary_edge = |a: u32, b: u32| {
+        let e = &mesh.edges[mesh.edge_between(a, b).expect("loop edge")];
+        e.left.or(e.right).expect("boundary edge has a face").face
+    };
+    let centroid = |t: u32| {
+        let f = mesh.faces[t as usize].map(u);
+        [0, 1].map(|d| (f[0][d] + f[1][d] + f[2][d]) / 3.0)
+    };
+    let mut periods = Vec::new();
+    for lp in mesh.loops.iter().filter(|l| !l.is_outer) {
+        let vs = &lp.vertices;
+        let k = vs.len();
+        let mut face = face_of_boundary_edge(vs[k - 1], vs[0]);
+        let start = centroid(face);
+        let (mut point, mut grad, mut phi) = (start, [0.0; 2], 0.0);
+        let mut path = vec![start];
+        for i in 0..k {
+            // Around vs[i]'s fan from the face of its incoming loop edge to that of its outgoing one.
+            let (v, last) = (vs[i], face_of_boundary_edge(vs[i], vs[(i + 1) % k]));
+            let mut came = mesh
+                .edge_between(vs[(i + k - 1) % k], v)
+                .expect("loop edge");
+            while face != last {
+                let e = mesh.faces[face as usize]
+                    .iter()
+                    .filter(|&&x| x != v)
+                    .map(|&x| mesh.edge_between(v, x).expect("face edge"))
+                    .find(|&e| e != came)
+                    .expect("fan edge");
+                let edge = &mesh.edges[e];
+                let [a, b] = edge.v.map(u);
+                let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+                phi += grad[0] * (m[0] - point[0]) + grad[1] * (m[1] - point[1]);
+                let (l, r) = (edge.left.expect("interior"), edge.right.expect("interior"));
+                let sign = if l.face == face { -1.0 } else { 1.0 };
+                let jd = [-(b[1] - a[1]), b[0] - a[0]];
+                grad = [0, 1].map(|d| grad[d] + sign * q[e] * jd[d]);
+                face = if l.face == face { r.face } else { l.face };
+                (point, came) = (m, e);
+                path.push(m);
+            }
+        }
+        phi += grad[0] * (start[0] - point[0]) + grad[1] * (start[1] - point[1]);
+        // Shoelace area of the path: negative when it ran clockwise around the hole.
+        let area: f64 = (0..path.len())
+            .map(|i| {
+                let (p, n) = (path[i], path[(i + 1) % path.len()]);
+                p[0] * n[1] - n[0] * p[1]
+            })
+            .sum();
+        let s = area.signum();
+        let a = [s * grad[0], s * grad[1]];
+        periods.push([s * phi - a[0] * start[0] - a[1] * start[1], a[0], a[1]]);
+    }
+    periods
+}
+
+/// The hole coefficients are the jumps of the Airy function around each hole, whichever way
+/// the solver cut the domain: checked against the jumps integrated from the force densities
+/// alone, on a disk with three anchored-rim holes in a row (the middle hole's cut ends on a
+/// neighbouring hole), with constant and affine jumps, and on the cheese model (39 holes).
+#[test]
+fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
+    let holes = [-0.5, 0.0, 0.5].map(|x| generate::circle([x, 0.0], 0.12, 12));
+    let domain = generate::Domain {
+        outer: generate::circle([0.0, 0.0], 1.0, 48),
+        holes: holes.to_vec(),
+    };
+    let (p, t) = generate::triangulate(&domain, 0.004).unwrap();
+    let row = generate::lift(
+        &p,
+        &t,
+        |u| generate::spherical_cap(1.0, 0.7, u[0].hypot(u[1])),
+        |u, outer| outer || (u[1] > 0.05 && u[0].abs() < 0.7 && u[0].hypot(u[1]) < 0.9),
+    )
+    .unwrap();
+    let cuts = voussoir::stress::holes::cut_holes(&row).unwrap();
+    assert!(
+        cuts.iter().any(|c| c.ends_at_hole.is_some()),
+        "a cut ends on another hole"
+    );
+    let mut cases = vec![
+        ("three holes, constant", row.clone(), HoleMode::Constant),
+        ("three holes, affine", row, HoleMode::Affine),
+        ("ringed hole, affine", ringed_hole(), HoleMode::Affine),
+    ];
+    if let Some(cheese) = load_model("cheese") {
+        cases.push(("cheese, constant", cheese.clone(), HoleMode::Constant));
+        cases.push(("cheese, affine", cheese, HoleMode::Affine));
+    }
+    for (label, mesh, holes) in cases {
+        let problem = Problem::new(mesh);
+        let settings = StressSettings {
+            holes,
+            ..Default::default()
+        };
+        let r = analyse(&problem, &settings).unwrap();
+        assert!(r.status.is_solved(), "{label}: {:?}", r.status);
+        let expected = airy_periods(&problem.mesh, &r.force_densities);
+        assert_eq!(expected.len(), r.hole_coefficients.len(), "{label}");
+        // q = S y holds exactly, so the integrated jumps equal the returned ones to rounding:
+        // c scales as q L², a as q L (L the mesh's plan diameter).
+        let q_max = r.force_densities.iter().fold(0.0f64, |m, q| m.max(q.abs()));
+        let (lo, hi) = problem.mesh.positions.iter().fold(
+            ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+            |(lo, hi), p| {
+                (
+                    [lo[0].min(p[0]), lo[1].min(p[1])],
+                    [hi[0].max(p[0]), hi[1].max(p[1])],
+                )
+            },
+        );
+        let diam = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+        let tol = 1e-9 * q_max * diam;
+        let mut largest = 0.0f64;
+        for (h, (got, want)) in r.hole_coefficients.iter().zip(&expected).enumerate() {
+            largest = largest.max(want[0].abs());
+            assert!(
+                (got[0] - want[0]).abs() <= tol * diam
+                    && (got[1] - want[1]).abs() <= tol
+                    && (got[2] - want[2]).abs() <= tol,
+                "{label}, hole {h}: returned {got:?}, integrated {want:?}"
+            );
+        }
+        eprintln!(
+            "{label}: {:?} {:?} qmax {q_max} diam {diam}",
+            r.hole_coefficients, expected
+        );
+        assert!(
+            largest > 1e-5 * q_max * diam * diam,
+            "{label}: the holes carry stress"
+        );
+    }
+}
+
+/// A hole ringed by other holes, with no interior vertex between them, so that no path of
+/// interior vertices leads from it to the outer loop: an 8 × 8 grid of vertices whose central
+/// cell and seven cells around it are holes; the outer loop and the ring holes are anchored.
+fn ringed_hole() -> Mesh {
+    let holes = [
+        [3, 3],
+        [2, 1],
+        [4, 1],
+        [5, 3],
+        [5, 5],
+        [3, 5],
+        [1, 5],
+        [1, 3],
+    ];
+    let id = |x: u32, y: u32| y * 8 + x;
+    let mut faces = Vec::new();
+    for y in 0..7 {
+        for x in 0..7 {
+            if holes.contains(&[x, y]) {
+                continue;
+            }
+            let [a, b, c, d] = [id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)];
+            faces.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    let positions: Vec<[f64; 3]> = (0..64)
+        .map(|v| {
+            let u = [(v % 8) as f64 / 3.5 - 1.0, (v / 8) as f64 / 3.5 - 1.0];
+            [u[0], u[1], 1.0 - 0.3 * (u[0] * u[0] + u[1] * u[1])]
+        })
+        .collect();
+    let ring_hole_corner = |x: u32, y: u32| {
+        holes[1..]
+            .iter()
+            .any(|h| (h[0]..=h[0] + 1).contains(&x) && (h[1]..=h[1] + 1).contains(&y))
+    };
+    let anchored: Vec<u32> = (0..64)
+        .filter(|&v| {
+            let (x, y) = (v % 8, v / 8);
+            x == 0 || y == 0 || x == 7 || y == 7 || ring_hole_corner(x, y)
+        })
+        .collect();
+    Mesh::new(positions, faces, &anchored).unwrap()
+}
+
+/// The ringed hole is cut through the ring (its cut ends on a ring hole), and the reduced
+/// optimum with affine jumps is the edge-based one.
+#[test]
+fn a_hole_ringed_by_holes_is_cut_through_the_ring() {
+    let mesh = ringed_hole();
+    assert_eq!(mesh.loops.iter().filter(|l| !l.is_outer).count(), 8);
+    let centre_loop = mesh
+        .loops
+        .iter()
+        .position(|l| l.vertices.contains(&(3 * 8 + 3)))
+        .unwrap();
+    // No interior vertex next to the central hole: a cut to the outer loop alone would fail.
+    for &v in &mesh.loops[centre_loop].vertices {
+        assert!(mesh.neighbours(v).all(|w| mesh.on_boundary[w as usize]));
+    }
+    let cuts = voussoir::stress::holes::cut_holes(&mesh).unwrap();
+    let centre = cuts
+        .iter()
+        .find(|c| c.loop_index == centre_loop)
+        .expect("the central hole's cut");
+    assert_eq!(centre.path.len(), 2, "one edge to a ring hole");
+    assert!(centre.ends_at_hole.is_some());
+    let settings = StressSettings {
+        holes: HoleMode::Affine,
+        ..Default::default()
+    };
+    assert_same_optimum("ringed hole", &Problem::new(mesh), &settings);
+}

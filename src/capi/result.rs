@@ -388,8 +388,9 @@ pub unsafe extern "C" fn vsr_result_horizontal_imbalance(
     })
 }
 
-/// Airy jump across each hole M_h(x, y) = c + a_x x + a_y y, #H by 3 doubles (c in force ×
-/// length; a_x, a_y in force), row-major, holes in the order of the mesh's boundary loops.
+/// Airy jump around each hole M_h(x, y) = c + a_x x + a_y y (the change of the Airy function
+/// continued once counter-clockwise around the hole), #H by 3 doubles (c in force × length;
+/// a_x, a_y in force), row-major, holes in the order of the mesh's boundary loops.
 /// With `VSR_HOLE_MODE_CONSTANT` a_x = a_y = 0. Empty (0 entries) for the edge-based
 /// formulation, which has no hole unknowns.
 ///

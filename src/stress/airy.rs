@@ -163,11 +163,28 @@ impl AiryOperator {
             .collect()
     }
 
-    /// Hole jump coefficients (c, a_x, a_y) of hole h in frame coordinates (zeros past `width`).
+    /// Jump coefficients (c, a_x, a_y) across the cut of hole h in frame coordinates (zeros past
+    /// `width`).
     pub fn hole_jump(&self, y: &[f64], h: usize) -> [f64; 3] {
         let mut m = [0.0; 3];
         for (d, md) in m.iter_mut().enumerate().take(self.hole_width) {
             *md = y[self.hole_start + h * self.hole_width + d];
+        }
+        m
+    }
+
+    /// The jump of the Airy function around hole h, c_h + a_h·u (frame coordinates), as a cut
+    /// from hole h straight to the outer loop would carry it: the jump across hole h's own cut
+    /// less those across the cuts that end on its loop (crossed the other way by a small loop
+    /// around the hole). Unlike the jumps across the cuts, it does not depend on where the cuts
+    /// run.
+    pub fn hole_period(&self, y: &[f64], h: usize) -> [f64; 3] {
+        let mut m = self.hole_jump(y, h);
+        for (c, cut) in self.cuts.iter().enumerate() {
+            if cut.ends_at_hole == Some(h) {
+                let j = self.hole_jump(y, c);
+                (0..3).for_each(|d| m[d] -= j[d]);
+            }
         }
         m
     }

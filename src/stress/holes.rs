@@ -16,6 +16,8 @@ use std::collections::VecDeque;
 pub struct HoleCut {
     /// Index into `mesh.loops` of the hole.
     pub loop_index: usize,
+    /// The hole whose loop the path ends on (None: the outer loop).
+    pub ends_at_hole: Option<usize>,
     pub path: Vec<u32>,
     pub cut_edges: Vec<u32>,
     /// Sorted face ids of R_h.
@@ -43,7 +45,11 @@ pub fn face_of_directed(mesh: &Mesh, a: u32, b: u32) -> Option<(u32, u32)> {
     side.map(|s| (s.face, s.opposite))
 }
 
-/// Builds the cut of every hole of `mesh`.
+/// Builds the cut of every hole of `mesh`, in the order of its holes. The cuts form a tree
+/// per component, grown from the outer loop: each round joins the hole nearest to the loops
+/// already joined by a shortest path through interior vertices (Prim's order). Any cut system
+/// that leaves the domain simply connected spans the same multivalued Airy functions; short
+/// cuts keep each hole's unknowns coupled to few others in the normal equations.
 pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
     let n = mesh.positions.len();
     let mut loop_of = vec![usize::MAX; n];
@@ -52,12 +58,28 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
             loop_of[v as usize] = l;
         }
     }
-    let mut cuts = Vec::new();
-    for (h, lp) in mesh.loops.iter().enumerate().filter(|(_, l)| !l.is_outer) {
-        let path = shortest_path(mesh, h, &loop_of).ok_or(Error::HoleNotCuttable {
-            hole: cuts.len(),
-            vertex: lp.vertices[0] as usize,
-        })?;
+    let holes: Vec<usize> = (0..mesh.loops.len())
+        .filter(|&l| !mesh.loops[l].is_outer)
+        .collect();
+    let mut hole_of_loop = vec![usize::MAX; mesh.loops.len()];
+    for (h, &l) in holes.iter().enumerate() {
+        hole_of_loop[l] = h;
+    }
+    let mut joined: Vec<bool> = mesh.loops.iter().map(|l| l.is_outer).collect();
+    let mut cuts: Vec<Option<HoleCut>> = vec![None; holes.len()];
+    for _ in 0..holes.len() {
+        let Some(path) = nearest_path(mesh, &joined, &loop_of) else {
+            let h = (0..holes.len())
+                .find(|&h| cuts[h].is_none())
+                .expect("a hole left");
+            return Err(Error::HoleNotCuttable {
+                hole: h,
+                vertex: mesh.loops[holes[h]].vertices[0] as usize,
+            });
+        };
+        let from = loop_of[path[0] as usize];
+        let to = loop_of[*path.last().expect("path") as usize];
+        joined[from] = true;
         let cut_edges: Vec<u32> = path
             .windows(2)
             .map(|w| mesh.edge_between(w[0], w[1]).expect("path edge") as u32)
@@ -68,25 +90,34 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
         }
         right_faces.sort_unstable();
         right_faces.dedup();
-        cuts.push(HoleCut {
-            loop_index: h,
+        let h = hole_of_loop[from];
+        cuts[h] = Some(HoleCut {
+            loop_index: from,
+            ends_at_hole: (!mesh.loops[to].is_outer).then(|| hole_of_loop[to]),
             path,
             cut_edges,
             right_faces,
         });
     }
-    Ok(cuts)
+    Ok(cuts
+        .into_iter()
+        .map(|c| c.expect("every hole cut"))
+        .collect())
 }
 
-/// Breadth-first search from every vertex of loop `h` through interior vertices to the outer
-/// loop of the same component.
-fn shortest_path(mesh: &Mesh, h: usize, loop_of: &[usize]) -> Option<Vec<u32>> {
+/// Breadth-first search from every vertex of the joined loops through interior vertices to the
+/// nearest loop not yet joined; the path runs from that loop to a joined one.
+fn nearest_path(mesh: &Mesh, joined: &[bool], loop_of: &[usize]) -> Option<Vec<u32>> {
     let n = mesh.positions.len();
     let mut parent = vec![u32::MAX; n];
     let mut queue = VecDeque::new();
-    for &v in &mesh.loops[h].vertices {
-        parent[v as usize] = v;
-        queue.push_back(v);
+    for (l, lp) in mesh.loops.iter().enumerate() {
+        if joined[l] {
+            for &v in &lp.vertices {
+                parent[v as usize] = v;
+                queue.push_back(v);
+            }
+        }
     }
     while let Some(v) = queue.pop_front() {
         for w in mesh.neighbours(v) {
@@ -94,14 +125,13 @@ fn shortest_path(mesh: &Mesh, h: usize, loop_of: &[usize]) -> Option<Vec<u32>> {
                 continue;
             }
             let l = loop_of[w as usize];
-            if l != usize::MAX && mesh.loops[l].is_outer {
+            if l != usize::MAX && !joined[l] {
                 let mut path = vec![w, v];
                 let mut x = v;
                 while parent[x as usize] != x {
                     x = parent[x as usize];
                     path.push(x);
                 }
-                path.reverse();
                 return Some(path);
             }
             if !mesh.on_boundary[w as usize] {

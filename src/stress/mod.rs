@@ -81,7 +81,9 @@ pub struct StressResult {
     /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram, except
     /// along the cut of a hole whose jump is non-zero (φ is multivalued there).
     pub weights: Vec<f64>,
-    /// Hole jump M_h(u) = c + a·u per hole as (c, a_x, a_y), in the order of the mesh's holes.
+    /// Hole jump M_h(u) = c + a·u per hole as (c, a_x, a_y), in the order of the mesh's holes:
+    /// the change of the Airy function continued once counter-clockwise around the hole
+    /// (independent of where the solver cut the domain).
     pub hole_coefficients: Vec<[f64; 3]>,
     /// Inward normal push τ per vertex (non-zero only at free boundary vertices).
     pub tau: Vec<f64>,
@@ -444,7 +446,7 @@ pub fn analyse_cached(
     let (airy_frame, hole_frame, centres_frame) = match &airy_op {
         Some(op) => {
             let phi = op.airy_values(&y);
-            let holes = (0..op.cuts.len()).map(|h| op.hole_jump(&y, h)).collect();
+            let holes = (0..op.cuts.len()).map(|h| op.hole_period(&y, h)).collect();
             let centres = dual::centres_from_airy(mesh, &plan, op, &phi, &y);
             (phi, holes, centres)
         }
