@@ -8,7 +8,8 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
-use std::collections::VecDeque;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// The cut of one hole: path vertices (hole loop first, outer loop last), cut edges and the
 /// faces on the right of the path.
@@ -65,10 +66,13 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
     for (h, &l) in holes.iter().enumerate() {
         hole_of_loop[l] = h;
     }
-    let mut joined: Vec<bool> = mesh.loops.iter().map(|l| l.is_outer).collect();
+    let mut search = Search::new(mesh, loop_of);
+    for l in (0..mesh.loops.len()).filter(|&l| mesh.loops[l].is_outer) {
+        search.join(l);
+    }
     let mut cuts: Vec<Option<HoleCut>> = vec![None; holes.len()];
     for _ in 0..holes.len() {
-        let Some(path) = nearest_path(mesh, &joined, &loop_of) else {
+        let Some(path) = search.nearest_path() else {
             let h = (0..holes.len())
                 .find(|&h| cuts[h].is_none())
                 .expect("a hole left");
@@ -77,9 +81,9 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
                 vertex: mesh.loops[holes[h]].vertices[0] as usize,
             });
         };
-        let from = loop_of[path[0] as usize];
-        let to = loop_of[*path.last().expect("path") as usize];
-        joined[from] = true;
+        let from = search.loop_of[path[0] as usize];
+        let to = search.loop_of[*path.last().expect("path") as usize];
+        search.join(from);
         let cut_edges: Vec<u32> = path
             .windows(2)
             .map(|w| mesh.edge_between(w[0], w[1]).expect("path edge") as u32)
@@ -90,8 +94,7 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
         }
         right_faces.sort_unstable();
         right_faces.dedup();
-        let h = hole_of_loop[from];
-        cuts[h] = Some(HoleCut {
+        cuts[hole_of_loop[from]] = Some(HoleCut {
             loop_index: from,
             ends_at_hole: (!mesh.loops[to].is_outer).then(|| hole_of_loop[to]),
             path,
@@ -105,42 +108,80 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
         .collect())
 }
 
-/// Breadth-first search from every vertex of the joined loops through interior vertices to the
-/// nearest loop not yet joined; the path runs from that loop to a joined one.
-fn nearest_path(mesh: &Mesh, joined: &[bool], loop_of: &[usize]) -> Option<Vec<u32>> {
-    let n = mesh.positions.len();
-    let mut parent = vec![u32::MAX; n];
-    let mut queue = VecDeque::new();
-    for (l, lp) in mesh.loops.iter().enumerate() {
-        if joined[l] {
-            for &v in &lp.vertices {
-                parent[v as usize] = v;
-                queue.push_back(v);
-            }
+/// Shortest paths through interior vertices from the joined loops, kept up to date as loops
+/// join (each join only revisits the vertices it brings nearer), and the steps from them onto
+/// loops not yet joined.
+struct Search<'a> {
+    mesh: &'a Mesh,
+    loop_of: Vec<usize>,
+    joined: Vec<bool>,
+    /// Edges from the nearest joined loop, and the previous vertex on that path (a joined
+    /// loop's vertices are their own).
+    distance: Vec<u32>,
+    parent: Vec<u32>,
+    queue: BinaryHeap<Reverse<(u32, u32)>>,
+    /// (path length, vertex of a loop not yet joined, the vertex it steps from).
+    steps: BinaryHeap<Reverse<(u32, u32, u32)>>,
+}
+
+impl<'a> Search<'a> {
+    fn new(mesh: &'a Mesh, loop_of: Vec<usize>) -> Search<'a> {
+        let n = mesh.positions.len();
+        Search {
+            mesh,
+            loop_of,
+            joined: vec![false; mesh.loops.len()],
+            distance: vec![u32::MAX; n],
+            parent: vec![u32::MAX; n],
+            queue: BinaryHeap::new(),
+            steps: BinaryHeap::new(),
         }
     }
-    while let Some(v) = queue.pop_front() {
-        for w in mesh.neighbours(v) {
-            if parent[w as usize] != u32::MAX {
+
+    /// Joins loop l and brings the distances up to date (Dijkstra with unit lengths).
+    fn join(&mut self, l: usize) {
+        self.joined[l] = true;
+        for &v in &self.mesh.loops[l].vertices {
+            self.distance[v as usize] = 0;
+            self.parent[v as usize] = v;
+            self.queue.push(Reverse((0, v)));
+        }
+        while let Some(Reverse((d, v))) = self.queue.pop() {
+            if d > self.distance[v as usize] {
                 continue;
             }
-            let l = loop_of[w as usize];
-            if l != usize::MAX && !joined[l] {
-                let mut path = vec![w, v];
-                let mut x = v;
-                while parent[x as usize] != x {
-                    x = parent[x as usize];
-                    path.push(x);
+            for w in self.mesh.neighbours(v) {
+                let lw = self.loop_of[w as usize];
+                if lw != usize::MAX && !self.joined[lw] {
+                    self.steps.push(Reverse((d + 1, w, v)));
+                } else if !self.mesh.on_boundary[w as usize] && d + 1 < self.distance[w as usize] {
+                    self.distance[w as usize] = d + 1;
+                    self.parent[w as usize] = v;
+                    self.queue.push(Reverse((d + 1, w)));
                 }
-                return Some(path);
-            }
-            if !mesh.on_boundary[w as usize] {
-                parent[w as usize] = v;
-                queue.push_back(w);
             }
         }
     }
-    None
+
+    /// The shortest path from a loop not yet joined to a joined one, loop vertices at both
+    /// ends and interior vertices between; None when no loop can be reached.
+    fn nearest_path(&mut self) -> Option<Vec<u32>> {
+        while let Some(Reverse((d, w, v))) = self.steps.pop() {
+            // Skip steps onto loops joined since, and those from vertices brought nearer
+            // since (their shorter step was queued then).
+            if self.joined[self.loop_of[w as usize]] || d != self.distance[v as usize] + 1 {
+                continue;
+            }
+            let mut path = vec![w, v];
+            let mut x = v;
+            while self.parent[x as usize] != x {
+                x = self.parent[x as usize];
+                path.push(x);
+            }
+            return Some(path);
+        }
+        None
+    }
 }
 
 /// Adds the faces of path vertex k's fan that lie on the right of the path: counter-clockwise
