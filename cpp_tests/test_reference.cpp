@@ -8,8 +8,8 @@
 // (a) is checked on every interior edge and (b) applies. Where they are not (annular_vault,
 // free_vault, four_holes, hex, three_pillar, cheese: holes with anchored vertices) the Airy
 // function is multivalued: (a) is checked directly on the edges whose two faces are away
-// from the hole cuts (the faces along the cuts must be explained by the returned jump c_h,
-// see support.cpp), and (b) is not applied. Each test prints which.
+// from the hole cuts (with one hole, the faces along its cut must be explained by the
+// returned jump c_h, see support.cpp), and (b) is not applied. Each test prints which.
 #include "support.hpp"
 
 #include <gtest/gtest.h>

@@ -682,8 +682,8 @@ VsrStatus vsr_result_airy(const struct VsrResult *result, double *out, size_t le
 
 /**
  * Vertex weights w = x² + y² − 2 φ, #V doubles (the power diagram of the plan points with
- * these weights is the force diagram, except along the cuts of holes whose jump is non-zero,
- * where φ is multivalued; units as in the paper, length² and force × length mixed, so
+ * these weights is the force diagram, except along the holes' cuts where φ jumps (it is
+ * multivalued there; see `vsr_result_hole_coefficients`); units as in the paper, length² and force × length mixed, so
  * meaningful for unit loads). Like φ, defined up to an affine function (see
  * `vsr_result_airy`).
  *
@@ -743,7 +743,10 @@ VsrStatus vsr_result_horizontal_imbalance(const struct VsrResult *result, double
 /**
  * Airy jump around each hole M_h(x, y) = c + a_x x + a_y y (the change of the Airy function
  * continued once counter-clockwise around the hole), #H by 3 doubles (c in force × length;
- * a_x, a_y in force), row-major, holes in the order of the mesh's boundary loops.
+ * a_x, a_y in force), row-major, holes in the order of the mesh's boundary loops. The solver
+ * cuts the domain along a tree of shortest paths, each from a hole to the outer loop or to a
+ * hole cut before it; across hole h's cut φ jumps by the sum of the coefficients of h and of
+ * every hole cut through h.
  * With `VSR_HOLE_MODE_CONSTANT` a_x = a_y = 0. Empty (0 entries) for the edge-based
  * formulation, which has no hole unknowns.
  *
@@ -755,8 +758,8 @@ VsrStatus vsr_result_hole_coefficients(const struct VsrResult *result, double *o
 /**
  * Force diagram points: one per face, the gradient of the Airy function on it, #F by 2
  * doubles (force), row-major, in face order. This is the power centre of the face's weighted
- * vertices except on the faces along a hole's cut when that hole's jump is non-zero (the Airy
- * function is multivalued there; see `vsr_result_hole_coefficients`). Defined up to a
+ * vertices except on the faces along a hole's cut where the Airy function jumps (it is
+ * multivalued there; see `vsr_result_hole_coefficients`). Defined up to a
  * translation, as φ is up to an affine function (`vsr_result_airy`).
  *
  * # Safety
@@ -767,7 +770,7 @@ VsrStatus vsr_result_force_diagram_centres(const struct VsrResult *result, doubl
 /**
  * Force diagram segments: one per interior edge, in increasing edge id, #S by 4 doubles
  * (x0, y0, x1, y1; force), row-major: the points of the edge's left and right face (across
- * a hole's cut the right point is shifted by the hole's jump). Its length over the edge's
+ * a hole's cut the right point is shifted by the gradient of the jump there). Its length over the edge's
  * plan length is the edge's force density. The edge ids are given, in the same order, by
  * `vsr_result_force_diagram_segment_edges`.
  *

@@ -46,7 +46,8 @@ pub enum Error {
     },
     /// No vertex is anchored at all.
     NoSupports,
-    /// A hole could not be joined to its component's outer boundary through interior vertices.
+    /// A hole could not be joined to its component's outer boundary or to another hole through
+    /// interior vertices.
     HoleNotCuttable { hole: usize, vertex: usize },
     /// A numerical failure inside a solver (not a property of the input).
     Numerical { what: String },
@@ -126,7 +127,7 @@ impl fmt::Display for Error {
             NoSupports => write!(f, "no vertex is anchored: a vault needs supports"),
             HoleNotCuttable { hole, vertex } => write!(
                 f,
-                "hole {hole} (at vertex {vertex}) cannot be joined to the outer boundary through interior vertices"
+                "hole {hole} (at vertex {vertex}) cannot be joined to the outer boundary or another hole through interior vertices"
             ),
             Numerical { what } => write!(f, "numerical failure: {what}"),
             Io { path, reason } => write!(f, "{path}: {reason}"),

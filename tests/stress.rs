@@ -736,10 +736,14 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
         |u, outer| outer || (u[1] > 0.05 && u[0].abs() < 0.7 && u[0].hypot(u[1]) < 0.9),
     )
     .unwrap();
+    // The side holes are nearer the rim than the middle one, and nearer the middle one than
+    // the rim: the cuts chain rim ← side ← middle ← other side.
     let cuts = voussoir::stress::holes::cut_holes(&row).unwrap();
     assert!(
-        cuts.iter().any(|c| c.ends_at_hole.is_some()),
-        "a cut ends on another hole"
+        cuts.iter().any(|c| c
+            .ends_at_hole
+            .is_some_and(|h| cuts[h].ends_at_hole.is_some())),
+        "a cut ends on a hole whose cut ends on a hole"
     );
     let mut cases = vec![
         ("three holes, constant", row.clone(), HoleMode::Constant),
@@ -784,13 +788,41 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
                 "{label}, hole {h}: returned {got:?}, integrated {want:?}"
             );
         }
-        eprintln!(
-            "{label}: {:?} {:?} qmax {q_max} diam {diam}",
-            r.hole_coefficients, expected
-        );
         assert!(
             largest > 1e-5 * q_max * diam * diam,
             "{label}: the holes carry stress"
+        );
+        if holes == HoleMode::Affine {
+            let a = expected.iter().fold(0.0f64, |m, p| m.max(p[1].hypot(p[2])));
+            assert!(
+                a > 1e-5 * q_max * diam,
+                "{label}: a net force through a hole"
+            );
+        }
+        // The jump across each cut is that around its hole plus those across the cuts ending
+        // on its loop: where the cuts nest, it differs from the returned coefficients.
+        let cuts = voussoir::stress::holes::cut_holes(&problem.mesh).unwrap();
+        let mut across = expected.clone();
+        for _ in 0..cuts.len() {
+            across = (0..cuts.len())
+                .map(|h| {
+                    cuts.iter()
+                        .enumerate()
+                        .fold(expected[h], |mut j, (c, cut)| {
+                            if cut.ends_at_hole == Some(h) {
+                                (0..3).for_each(|d| j[d] += across[c][d]);
+                            }
+                            j
+                        })
+                })
+                .collect();
+        }
+        let nested = (0..cuts.len())
+            .map(|h| (across[h][0] - expected[h][0]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            nested > 1e-5 * q_max * diam * diam,
+            "{label}: the cuts' jumps differ from the holes'"
         );
     }
 }

@@ -610,8 +610,10 @@ CheckReport reference_check(const MeshData &mesh, const Solution &sol,
 
     // --- (a) Power centres of the weighted plan points (CGAL) give q = d*/l on interior edges.
     //
-    // With non-zero hole coefficients the Airy function is multivalued: it jumps by c_h across
-    // a cut from hole h to another boundary loop, and the returned single-valued weights
+    // With non-zero hole coefficients the Airy function is multivalued: it jumps by c_h around
+    // hole h. The library cuts the domain along a tree of paths (each from a hole to the outer
+    // loop or to another hole), across which it jumps by the sum of the c_h of the holes cut
+    // through that path, and the returned single-valued weights
     // cannot hold it on the faces along the cut (their power centres are off). (a) is then
     // checked directly only on the edges whose two faces are away from the cuts:
     //  - the cut faces are located with the library's force diagram centres (the gradient of
@@ -621,8 +623,8 @@ CheckReport reference_check(const MeshData &mesh, const Solution &sol,
     //  - on a cut face, the library's centre must be the CGAL power centre of the weights with
     //    a non-empty proper subset of the face's vertices shifted by ∓2 c_h for one hole h
     //    (φ ± c_h). With one hole this is required of every cut face (it checks the returned
-    //    c_h); with several, cuts share vertices and their jumps add up, so the faces
-    //    explained by one hole's jump are only counted;
+    //    c_h); with several, a cut carries the sum of several holes' jumps and cuts share
+    //    vertices, so the faces explained by one hole's jump are only counted;
     //  - on edges with a cut face, d*/l from the library's centres must equal q;
     //  - the cut faces are at most a quarter of the faces;
     //  - independently of the weights, the force diagram integrated from q alone across

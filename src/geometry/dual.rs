@@ -14,7 +14,7 @@ pub struct ForceDiagram {
     /// One point per face.
     pub centres: Vec<[f64; 2]>,
     /// Per edge: (left face point, right face point) for interior edges, None on the boundary.
-    /// Across a hole's cut the right-hand point is shifted by the hole's jump gradient.
+    /// Across a hole's cut the right-hand point is shifted by the gradient of the jump there.
     pub segments: Vec<Option<[[f64; 2]; 2]>>,
 }
 

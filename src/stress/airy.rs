@@ -173,20 +173,21 @@ impl AiryOperator {
         m
     }
 
-    /// The jump of the Airy function around hole h, c_h + a_h·u (frame coordinates), as a cut
-    /// from hole h straight to the outer loop would carry it: the jump across hole h's own cut
-    /// less those across the cuts that end on its loop (crossed the other way by a small loop
-    /// around the hole). Unlike the jumps across the cuts, it does not depend on where the cuts
-    /// run.
-    pub fn hole_period(&self, y: &[f64], h: usize) -> [f64; 3] {
-        let mut m = self.hole_jump(y, h);
+    /// The jump of the Airy function once counter-clockwise around each hole, c_h + a_h·u
+    /// (frame coordinates), as a cut from the hole straight to the outer loop would carry it:
+    /// the jump across the hole's own cut less those across the cuts that end on its loop
+    /// (crossed the other way by a small loop around the hole). Unlike the jumps across the
+    /// cuts, it does not depend on where the cuts run.
+    pub fn hole_periods(&self, y: &[f64]) -> Vec<[f64; 3]> {
+        let mut periods: Vec<[f64; 3]> =
+            (0..self.cuts.len()).map(|h| self.hole_jump(y, h)).collect();
         for (c, cut) in self.cuts.iter().enumerate() {
-            if cut.ends_at_hole == Some(h) {
+            if let Some(h) = cut.ends_at_hole {
                 let j = self.hole_jump(y, c);
-                (0..3).for_each(|d| m[d] -= j[d]);
+                (0..3).for_each(|d| periods[h][d] -= j[d]);
             }
         }
-        m
+        periods
     }
 
     /// The Airy value that face t sees at its vertex v: φ_v plus the jump of every hole whose

@@ -1,18 +1,20 @@
 //! Cuts for the multivalued Airy function on domains with holes (MATH §6).
 //!
-//! Each hole gets a shortest edge path from its loop to its component's outer loop through
-//! interior vertices, and the set R_h of faces that touch the path on its right. The faces of
-//! R_h see φ + M_h on the path's vertices, which lets the stress carry a net torque (constant
-//! part c_h) and a net force (affine part a_h) around the hole while keeping every interior
-//! vertex in exact horizontal balance.
+//! Each hole gets a shortest edge path through interior vertices from its loop to the outer
+//! loop or to a hole cut before it (the cuts form a tree per component), and the set R_h of
+//! faces that touch the path on its right. The faces of R_h see φ + J_h on the path's
+//! vertices, which lets the stress carry a net torque (constant part) and a net force (affine
+//! part) around the hole while keeping every interior vertex in exact horizontal balance. The
+//! jump J_h across a cut is the sum of the jumps around its hole and around every hole cut
+//! through it (`AiryOperator::hole_periods`).
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
-/// The cut of one hole: path vertices (hole loop first, outer loop last), cut edges and the
-/// faces on the right of the path.
+/// The cut of one hole: path vertices (hole loop first, the outer loop or an earlier hole's
+/// loop last), cut edges and the faces on the right of the path.
 #[derive(Debug, Clone)]
 pub struct HoleCut {
     /// Index into `mesh.loops` of the hole.
@@ -72,6 +74,8 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
     }
     let mut cuts: Vec<Option<HoleCut>> = vec![None; holes.len()];
     for _ in 0..holes.len() {
+        // Not expected on a validated mesh (the first boundary vertex on any edge path out of
+        // the joined loops is on a loop not yet joined); kept as an error, not a panic.
         let Some(path) = search.nearest_path() else {
             let h = (0..holes.len())
                 .find(|&h| cuts[h].is_none())

@@ -79,11 +79,13 @@ pub struct StressResult {
     /// apart per component, the edge-based one integrates it from the first face.
     pub airy: Vec<f64>,
     /// Vertex weights w = |u|² − 2φ: the power diagram of (u, w) is the force diagram, except
-    /// along the cut of a hole whose jump is non-zero (φ is multivalued there).
+    /// along the holes' cuts where φ jumps (φ is multivalued there; see `hole_coefficients`).
     pub weights: Vec<f64>,
     /// Hole jump M_h(u) = c + a·u per hole as (c, a_x, a_y), in the order of the mesh's holes:
     /// the change of the Airy function continued once counter-clockwise around the hole
-    /// (independent of where the solver cut the domain).
+    /// (independent of where the solver cut the domain). The cuts form a tree: each runs from
+    /// its hole to the outer loop or to a hole cut before it, and across hole h's cut φ jumps
+    /// by the sum of the coefficients of h and of every hole cut through h.
     pub hole_coefficients: Vec<[f64; 3]>,
     /// Inward normal push τ per vertex (non-zero only at free boundary vertices).
     pub tau: Vec<f64>,
@@ -446,7 +448,7 @@ pub fn analyse_cached(
     let (airy_frame, hole_frame, centres_frame) = match &airy_op {
         Some(op) => {
             let phi = op.airy_values(&y);
-            let holes = (0..op.cuts.len()).map(|h| op.hole_period(&y, h)).collect();
+            let holes = op.hole_periods(&y);
             let centres = dual::centres_from_airy(mesh, &plan, op, &phi, &y);
             (phi, holes, centres)
         }
