@@ -162,9 +162,22 @@ pub fn diagram(
         .map(|(e, edge)| {
             let (l, r) = (edge.left?, edge.right?);
             let mut ends = [centres[l.face as usize], centres[r.face as usize]];
-            for (h, cut) in op.map_or(&[][..], |op| &op.cuts[..]).iter().enumerate() {
+            let Some(op) = op else {
+                return Some(ends.map(scaled));
+            };
+            // A cut edge has its right face in the cut's R_h: only the cuts beside its two
+            // faces can cut it (in increasing order, each once).
+            let (at_l, at_r) = (op.cuts_at_face(l.face), op.cuts_at_face(r.face));
+            if at_l.is_empty() && at_r.is_empty() {
+                return Some(ends.map(scaled));
+            }
+            let mut beside = [at_l, at_r].concat();
+            beside.sort_unstable();
+            beside.dedup();
+            for h in beside.into_iter().map(|h| h as usize) {
+                let cut = &op.cuts[h];
                 if cut.is_cut_edge(e as u32) {
-                    let m = op.unwrap().hole_jump(y, h);
+                    let m = op.hole_jump(y, h);
                     for (k, side) in [l, r].iter().enumerate() {
                         if cut.is_right_face(side.face) {
                             ends[k] = [ends[k][0] - m[1], ends[k][1] - m[2]];
