@@ -174,7 +174,7 @@ pub fn diagram(
             let mut beside = [at_l, at_r].concat();
             beside.sort_unstable();
             beside.dedup();
-            for h in beside.into_iter().map(|h| h as usize) {
+            for h in beside {
                 let cut = &op.cuts[h];
                 if cut.is_cut_edge(e as u32) {
                     let m = op.hole_jump(y, h);

@@ -3,7 +3,7 @@
 
 use super::gauge;
 use super::holes::{cut_holes, HoleCut};
-use super::sparse::Csr;
+use super::sparse::{bucketed, Csr};
 use crate::error::Result;
 use crate::geometry::Plan;
 use crate::mesh::{Mesh, Side};
@@ -44,7 +44,7 @@ pub struct AiryOperator {
     /// The cuts whose right faces contain face t, in increasing order:
     /// `face_cuts[face_cut_start[t]..face_cut_start[t + 1]]` (see `cuts_at_face`).
     face_cut_start: Vec<usize>,
-    face_cuts: Vec<u32>,
+    face_cuts: Vec<usize>,
     /// Column of the crease unknown of each boundary edge that has a non-anchored end.
     pub crease_col: Vec<Option<usize>>,
 }
@@ -98,23 +98,11 @@ impl AiryOperator {
         }
         // Each face asks only the cuts it lies beside: scanning every cut per face took
         // seconds per stress step with a thousand holes.
-        let mut face_cut_start = vec![0; mesh.faces.len() + 1];
-        for cut in &cuts {
-            cut.right_faces
-                .iter()
-                .for_each(|&t| face_cut_start[t as usize + 1] += 1);
-        }
-        for t in 0..mesh.faces.len() {
-            face_cut_start[t + 1] += face_cut_start[t];
-        }
-        let mut next = face_cut_start.clone();
-        let mut face_cuts = vec![0; face_cut_start[mesh.faces.len()]];
-        for (h, cut) in cuts.iter().enumerate() {
-            for &t in &cut.right_faces {
-                face_cuts[next[t as usize]] = h as u32;
-                next[t as usize] += 1;
-            }
-        }
+        let beside = cuts.iter().map(|c| c.right_faces.len()).sum();
+        let (face_cut_start, face_cuts) = bucketed(mesh.faces.len(), beside, || {
+            (cuts.iter().enumerate())
+                .flat_map(|(h, c)| c.right_faces.iter().map(move |&t| (t as usize, h)))
+        });
         let mut op = AiryOperator {
             s: Csr::new(cols),
             phi_col,
@@ -137,7 +125,7 @@ impl AiryOperator {
     }
 
     /// The cuts whose right faces R_h contain face t, in increasing order.
-    pub fn cuts_at_face(&self, t: u32) -> &[u32] {
+    pub fn cuts_at_face(&self, t: u32) -> &[usize] {
         &self.face_cuts[self.face_cut_start[t as usize]..self.face_cut_start[t as usize + 1]]
     }
 
@@ -160,7 +148,7 @@ impl AiryOperator {
                 }
             }
             for &h in self.cuts_at_face(side.face) {
-                let (h, cut) = (h as usize, &self.cuts[h as usize]);
+                let cut = &self.cuts[h];
                 // On the cut, compare with the right face shifted back by M_h, which agrees with
                 // the left face along the edge: only the off-path vertex moves, by −M_h.
                 let terms: Vec<(u32, f64)> = if cut.is_cut_edge(e as u32) {
@@ -223,8 +211,7 @@ impl AiryOperator {
     pub fn face_local_airy(&self, plan: &Plan, phi: &[f64], y: &[f64], t: u32, v: u32) -> f64 {
         let mut value = phi[v as usize];
         for &h in self.cuts_at_face(t) {
-            let (h, cut) = (h as usize, &self.cuts[h as usize]);
-            if cut.on_path(v) {
+            if self.cuts[h].on_path(v) {
                 let m = self.hole_jump(y, h);
                 let b = hole_basis(plan.u[v as usize]);
                 value += m[0] * b[0] + m[1] * b[1] + m[2] * b[2];

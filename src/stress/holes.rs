@@ -61,9 +61,7 @@ pub fn cut_holes(mesh: &Mesh) -> Result<Vec<HoleCut>> {
             loop_of[v as usize] = l;
         }
     }
-    let holes: Vec<usize> = (0..mesh.loops.len())
-        .filter(|&l| !mesh.loops[l].is_outer)
-        .collect();
+    let holes: Vec<usize> = mesh.holes().collect();
     let mut hole_of_loop = vec![usize::MAX; mesh.loops.len()];
     for (h, &l) in holes.iter().enumerate() {
         hole_of_loop[l] = h;

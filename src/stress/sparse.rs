@@ -1,5 +1,6 @@
 //! A minimal compressed-row matrix: the force map q = S y is built row by row (one row per
-//! edge) and consumed row by row when the QP is assembled.
+//! edge) and consumed row by row when the QP is assembled; and compressed patterns built from
+//! their entries (`bucketed`).
 
 /// Compressed sparse rows; duplicate entries within a row are summed on construction.
 #[derive(Debug, Clone, Default)]
@@ -74,6 +75,29 @@ impl Csr {
             })
             .collect()
     }
+}
+
+/// A compressed-column pattern of n columns from `nnz` (column, row) entries, rows in the
+/// order the entries come (`entries` is called twice: to count, then to fill).
+pub(crate) fn bucketed<I: Iterator<Item = (usize, usize)>>(
+    n: usize,
+    nnz: usize,
+    entries: impl Fn() -> I,
+) -> (Vec<usize>, Vec<usize>) {
+    let mut ptr = vec![0; n + 1];
+    for (col, _) in entries() {
+        ptr[col + 1] += 1;
+    }
+    for c in 0..n {
+        ptr[c + 1] += ptr[c];
+    }
+    let mut next = ptr.clone();
+    let mut idx = vec![0; nnz];
+    for (col, row) in entries() {
+        idx[next[col]] = row;
+        next[col] += 1;
+    }
+    (ptr, idx)
 }
 
 #[cfg(test)]

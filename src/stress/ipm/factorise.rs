@@ -10,8 +10,8 @@
 //! factorisation); on two, 164 ms with AMD's order and 121–126 ms with the nested
 //! dissection's (`ordering`). Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
 
-use super::pattern::bucketed;
 use super::supernodal::{both, owners, Split};
+use crate::stress::sparse::bucketed;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::ldlt::factor::{cholesky_in_place, cholesky_in_place_scratch};

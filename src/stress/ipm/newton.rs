@@ -15,7 +15,6 @@ use faer::{Conj, MatMut, Par};
 /// 100k-vertex dome stalled at a dual residual near 1e-8 (and fell back to clarabel); 1e-10
 /// failed already at 6k.
 pub(super) const DELTA: f64 = 1e-7;
-
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.

@@ -13,7 +13,8 @@
 //! separator, ordered after both sides. Parts of up to `LEAF` unknowns are ordered by minimum
 //! degree, counting their couplings to the separators around them.
 
-use super::pattern::{amd_labels, bucketed, entries};
+use super::pattern::{amd_labels, entries};
+use crate::stress::sparse::bucketed;
 
 /// Parts of up to this many unknowns are ordered by minimum degree (`order_leaf`; with AMD
 /// on the 100k dome, 256 gave the least work of 16, 64, 256, 1000, 5000 and 30000).

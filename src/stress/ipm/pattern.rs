@@ -6,6 +6,7 @@ use super::factorise::Plan;
 use super::ordering::nested_dissection_labels;
 use super::supernodal::Split;
 use super::*;
+use crate::stress::sparse::bucketed;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
@@ -251,29 +252,6 @@ pub(super) fn entries<'a>(
             .iter()
             .map(move |&r| (r, c))
     })
-}
-
-/// A compressed-column pattern of n columns from `nnz` (column, row) entries, rows in the
-/// order the entries come (`entries` is called twice: to count, then to fill).
-pub(super) fn bucketed<I: Iterator<Item = (usize, usize)>>(
-    n: usize,
-    nnz: usize,
-    entries: impl Fn() -> I,
-) -> (Vec<usize>, Vec<usize>) {
-    let mut ptr = vec![0; n + 1];
-    for (col, _) in entries() {
-        ptr[col + 1] += 1;
-    }
-    for c in 0..n {
-        ptr[c + 1] += ptr[c];
-    }
-    let mut next = ptr.clone();
-    let mut idx = vec![0; nnz];
-    for (col, row) in entries() {
-        idx[next[col]] = row;
-        next[col] += 1;
-    }
-    (ptr, idx)
 }
 
 /// The symbolic factorisation of a pattern already in its elimination order (given as an
