@@ -5,9 +5,11 @@
 //!     cargo bench --bench stress -- --large   # also 100k vertices
 //!     cargo bench --bench stress -- --large --large-ff   # and the whole form finding at 100k
 //!
-//! Every stress step is timed four ways: reduced (de Goes) and edge-based (VHWP12) unknowns,
-//! each with the native structured interior-point solver and with clarabel (the reference);
-//! steps under a second are timed as the median of five runs.
+//! Every paper row's stress step is timed four ways: reduced (de Goes) and edge-based (VHWP12)
+//! unknowns, each with the native structured interior-point solver and with clarabel (the
+//! reference); every shared model and every scaling dome in both formulations with the native
+//! solver. Steps under a second are timed as the median of five runs; a step that did not end
+//! `Solved` shows its status and gets no ratio.
 //! Rows without a shared model use generated stand-ins of the paper's size and kind.
 
 use std::path::{Path, PathBuf};
@@ -15,6 +17,7 @@ use std::time::Instant;
 use voussoir::generate::{self, Domain};
 use voussoir::{
     analyse, form_find, FormFindSettings, Formulation, Mesh, Problem, QpSolver, StressSettings,
+    StressStatus,
 };
 
 /// Peak resident memory of this process so far, in MiB.
@@ -123,9 +126,17 @@ fn shared_model(dir: &Path, name: &str) -> Option<Problem> {
 /// runs of a 10–200 ms step spread by ±30% on the 2-core machine).
 const RUNS: usize = 5;
 
-/// One stress step: the median seconds over `RUNS` runs (one run when it takes a second or
-/// more), QP iterations, and the solver that answered.
-fn step(problem: &Problem, formulation: Formulation, solver: QpSolver) -> (f64, u32, QpSolver) {
+/// One stress step as timed: the median seconds over `RUNS` runs (one run when it takes a
+/// second or more), and the last run's QP iterations, solver and status.
+#[derive(Clone, Copy)]
+struct Step {
+    seconds: f64,
+    iterations: u32,
+    solver: QpSolver,
+    status: StressStatus,
+}
+
+fn step(problem: &Problem, formulation: Formulation, solver: QpSolver) -> Step {
     let settings = StressSettings {
         formulation,
         solver,
@@ -138,19 +149,40 @@ fn step(problem: &Problem, formulation: Formulation, solver: QpSolver) -> (f64, 
         seconds.push(t.elapsed().as_secs_f64());
         if seconds.len() == RUNS || seconds[0] >= 1.0 {
             seconds.sort_by(f64::total_cmp);
-            return (seconds[seconds.len() / 2], r.iterations, r.solver);
+            return Step {
+                seconds: seconds[seconds.len() / 2],
+                iterations: r.iterations,
+                solver: r.solver,
+                status: r.status,
+            };
         }
     }
 }
 
-fn cell((s, it, solver): (f64, u32, QpSolver), native: bool) -> String {
-    // A native step that fell back to clarabel is marked with *.
-    let mark = if native && solver != QpSolver::Native {
+/// "seconds (iterations)"; a native step that fell back to clarabel is marked with *, and a
+/// step that did not end `Solved` names its status, so that its time is not read as a
+/// solve's.
+fn cell(step: Step, native: bool) -> String {
+    let mark = if native && step.solver != QpSolver::Native {
         "*"
     } else {
         ""
     };
-    format!("{s:.3}{mark} ({it})")
+    let status = if step.status == StressStatus::Solved {
+        String::new()
+    } else {
+        format!(", {:?}", step.status)
+    };
+    format!("{:.3}{mark} ({}{status})", step.seconds, step.iterations)
+}
+
+/// Edge-based seconds over reduced seconds, or "—" when either step was not solved.
+fn ratio(edge: Step, reduced: Step) -> String {
+    if edge.status == StressStatus::Solved && reduced.status == StressStatus::Solved {
+        format!("{:.1}", edge.seconds / reduced.seconds)
+    } else {
+        "—".to_string()
+    }
 }
 
 /// A row of the paper's table: (name, V;E;F, VHWP12 s, de Goes s).
@@ -274,20 +306,63 @@ fn paper_table(dir: Option<&Path>) {
         let ff = form_find(&problem, &FormFindSettings::default(), None).expect("valid problem");
         let ff_s = t.elapsed().as_secs_f64();
         println!(
-            "| {} | {} | {ours} | {size} | {} | {} | {} | {} | {:.1} | {:.1} | {} / {} | {:.0} | {} ({:?}), {ff_s:.2} |",
+            "| {} | {} | {ours} | {size} | {} | {} | {} | {} | {} | {} | {} / {} | {:.0} | {} ({:?}), {ff_s:.2} |",
             row.name,
             row.size,
             cell(rn, true),
             cell(rc, false),
             cell(en, true),
             cell(ec, false),
-            en.0 / rn.0,
-            ec.0 / rc.0,
+            ratio(en, rn),
+            ratio(ec, rc),
             row.de_goes,
             row.vhwp12,
-            row.de_goes / rn.0,
+            row.de_goes / rn.seconds,
             ff.iterations,
             ff.termination,
+        );
+    }
+}
+
+/// Every shared model, reduced and edge-based side by side (native solver, default settings).
+fn shared_models_table(dir: &Path) {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| {
+                    let path = e.ok()?.path();
+                    let name = path.file_stem()?.to_str()?.to_string();
+                    (path.extension()? == "obj" && dir.join(format!("{name}.json")).is_file())
+                        .then_some(name)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    println!();
+    println!(
+        "Stress step on every shared model, native solver (seconds, QP iterations in brackets)"
+    );
+    println!();
+    println!("| model | V;E;F | holes | reduced | edge-based | edge/reduced |");
+    println!("|---|---|---|---|---|---|");
+    for name in names {
+        let Some(problem) = shared_model(dir, &name) else {
+            println!("| {name} | could not be read | | | | |");
+            continue;
+        };
+        let m = &problem.mesh;
+        let rn = step(&problem, Formulation::Reduced, QpSolver::Native);
+        let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
+        println!(
+            "| {name} | {};{};{} | {} | {} | {} | {} |",
+            m.positions.len(),
+            m.edges.len(),
+            m.faces.len(),
+            m.holes().count(),
+            cell(rn, true),
+            cell(en, true),
+            ratio(en, rn),
         );
     }
 }
@@ -317,12 +392,14 @@ fn scaling(large: bool, large_ff: bool) {
     println!("| V | E | stress step s (QP its) | solver | peak RSS after step MiB | form finding its, s |");
     println!("|---|---|---|---|---|---|");
     let mut points = Vec::new();
+    let mut reduced = Vec::new();
     for &n in sizes {
         let problem = Problem::new(dome_with_hole(n));
         let v = problem.mesh.positions.len();
-        let (s, it, solver) = step(&problem, Formulation::Reduced, QpSolver::Native);
+        let rn = step(&problem, Formulation::Reduced, QpSolver::Native);
         let rss = peak_rss_mib();
-        points.push((v as f64, s));
+        points.push((v as f64, rn.seconds));
+        reduced.push(rn);
         // The whole loop only where asked for: it dominates the run at 100k.
         let ff = if large_ff && n == *sizes.last().expect("sizes") {
             let t = Instant::now();
@@ -337,8 +414,11 @@ fn scaling(large: bool, large_ff: bool) {
             "—".to_string()
         };
         println!(
-            "| {v} | {} | {s:.2} ({it}) | {solver:?} | {rss:.0} | {ff} |",
-            problem.mesh.edges.len()
+            "| {v} | {} | {:.2} ({}) | {:?} | {rss:.0} | {ff} |",
+            problem.mesh.edges.len(),
+            rn.seconds,
+            rn.iterations,
+            rn.solver,
         );
     }
     println!();
@@ -346,6 +426,25 @@ fn scaling(large: bool, large_ff: bool) {
         "fitted growth exponent of the stress step: t ∝ V^{:.2}",
         exponent(&points)
     );
+
+    // After the reduced rows, so that their peak memory is their own.
+    println!();
+    println!("The same domes, reduced and edge-based side by side (native solver; the edge-based steps run after all reduced ones, so their memory is the process's peak so far)");
+    println!();
+    println!("| V | reduced s (QP its) | edge-based s (QP its) | edge/reduced | peak RSS after edge-based step MiB |");
+    println!("|---|---|---|---|---|");
+    for (&n, &rn) in sizes.iter().zip(&reduced) {
+        let problem = Problem::new(dome_with_hole(n));
+        let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
+        println!(
+            "| {} | {} | {} | {} | {:.0} |",
+            problem.mesh.positions.len(),
+            cell(rn, true),
+            cell(en, true),
+            ratio(en, rn),
+            peak_rss_mib(),
+        );
+    }
 }
 
 fn main() {
@@ -357,6 +456,9 @@ fn main() {
         println!("shared models skipped: ../shared/data/models not found (generated rows only)");
     }
     paper_table(dir.as_deref());
+    if let Some(dir) = dir.as_deref() {
+        shared_models_table(dir);
+    }
     scaling(large, large_ff);
     println!();
     println!(
