@@ -417,6 +417,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             h: &h,
             groups: &groups,
             positions: Some(&positions),
+            slack_unit: Some(slack_unit(inp)),
         },
         &if coarse {
             ipm::Tolerances::for_form_finding(n)
@@ -440,6 +441,32 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         },
         iterations: out.iterations,
     }
+}
+
+/// The interior-point start's slack unit, in multiples of the median ℓ_e² over the edges with
+/// a bound (`slack_unit`): the start's constraint term then weighs Σ (ℓ² (q − bound))² alike in
+/// both formulations, which bound the same force densities.
+///
+/// With the median row scale as the unit (`ipm::caller_units`'s default) the start depended on
+/// the unknowns: the reduced rows' median scale is 0.001–0.11 (0.5–1.9 times this unit) on the
+/// nine shared models and the benchmark's domes, the edge-based unit rows' 1.24–1.30 whatever
+/// the mesh, so the edge-based start pulled every force density 10²–10⁶ times harder towards
+/// its bound, and its iterations crawled. Measured with this unit (QP iterations reduced /
+/// edge-based, before → after): the Cas-size dome 14/41 → 14/17, the dome with a hole 12/26 →
+/// 12/15, lilium 13/19 → 14/15, four_holes 20/21 → 15/18, free_vault 10/11 → 10/14; the nine
+/// models' reduced steps 138 iterations in all → 135, their edge-based ones 155 → 148. With 5
+/// and 20 instead of 10: reduced 147 and 142, edge-based 140 and 142.
+const START_UNIT: f64 = 10.0;
+
+/// The QP's slack unit for the interior-point start: `START_UNIT` times the median ℓ_e² of
+/// the edges with a bound, the same in both formulations.
+fn slack_unit(inp: &QpInput) -> f64 {
+    let mut l2: Vec<f64> = (0..inp.edges.len())
+        .filter(|&e| inp.bounds[e].is_some())
+        .map(|e| inp.length[e] * inp.length[e])
+        .collect();
+    l2.sort_by(f64::total_cmp);
+    START_UNIT * l2.get(l2.len() / 2).copied().unwrap_or(1.0)
 }
 
 /// The plan position of each unknown of `solve_native`: for y, the mean of the midpoints of

@@ -59,6 +59,9 @@ pub struct Qp<'a> {
     /// Plan position of each unknown, for the nested-dissection ordering of large QPs
     /// (`ordering`); None: AMD's order at every size.
     pub positions: Option<&'a [[f64; 2]]>,
+    /// The caller's natural unit of the inequality rows' slacks, in which the starting point
+    /// is built (see `caller_units`); None: the median row scale.
+    pub slack_unit: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -258,7 +261,7 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
 }
 
 /// Per inequality row, the factor that turns its scaled slack back into the caller's units,
-/// up to one common factor (the median row scale). The starting point is built in those units:
+/// times `unit` (by default the median row scale). The starting point is built in those units:
 /// the stress QPs' rows bound force densities (and τ), commensurate as the caller states them,
 /// while the unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
 /// times larger than an interior edge's (a combination of Airy values). Mehrotra's uniform
@@ -266,13 +269,20 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
 /// their optimum (Cas-size dome: 65 against 3600; 50k: against 55 000), and the iterations
 /// spent 15 steps of 0.2–0.7 letting them grow. The iterates are otherwise invariant to the
 /// row scaling, which stays for the linear algebra.
-fn caller_units(row_scale: &[f64]) -> Vec<f64> {
-    let mut sorted = row_scale.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let Some(&median) = sorted.get(sorted.len() / 2) else {
+///
+/// `unit` sets the weight of the starting point's constraint term (`START_PENALTY`) in the
+/// caller's units. The median row scale depends on the unknowns: the stress QPs pass their
+/// own unit instead, the same for both formulations (`qp::START_UNIT`).
+fn caller_units(row_scale: &[f64], unit: Option<f64>) -> Vec<f64> {
+    let unit = unit.or_else(|| {
+        let mut sorted = row_scale.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        sorted.get(sorted.len() / 2).copied()
+    });
+    let Some(unit) = unit else {
         return Vec::new();
     };
-    row_scale.iter().map(|r| median / r).collect()
+    row_scale.iter().map(|r| unit / r).collect()
 }
 
 /// Solves the QP after equilibration: variables scaled so that the normal matrix at W = I has
@@ -300,7 +310,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
     let ones_q = vec![1.0; qp.quad.nrows()];
     let re = unit_rows(qp.eq, &d);
     let ri = unit_rows(qp.ineq, &d);
-    let start_units = caller_units(&ri);
+    let start_units = caller_units(&ri, qp.slack_unit);
     let skip_last = cache.far_from_balance && fallback_is_costly(n);
     let warm = cache.last.take().filter(|_| !skip_last).map(|(x, active)| {
         let x: Vec<f64> = x.iter().zip(&d).map(|(x, d)| x / d).collect();
@@ -325,6 +335,7 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
             h: &h,
             groups: &groups,
             positions: qp.positions,
+            slack_unit: qp.slack_unit,
         },
         &start_units,
         tol,

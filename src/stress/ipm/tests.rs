@@ -111,6 +111,7 @@ fn small_qp_with_active_bound_and_equality() {
             h: &[1.8],
             groups: &RowGroups::default(),
             positions: None,
+            slack_unit: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -176,6 +177,7 @@ fn polishing_corrects_a_wrongly_dropped_row() {
         h: &[0.0],
         groups: &RowGroups::default(),
         positions: None,
+        slack_unit: None,
     };
     let x = polish_at(&qp, &[2.0, 1e-3], &[1e-3], &[1e-7], &Tolerances::default())
         .expect("the corrected guess is optimal");
@@ -199,6 +201,7 @@ fn active_bounds<R>(k: usize, run: impl FnOnce(&Qp) -> R) -> R {
         h: &vec![0.0; k],
         groups: &RowGroups::default(),
         positions: None,
+        slack_unit: None,
     })
 }
 
@@ -334,6 +337,7 @@ fn polished_active_rows_count_on_their_bounds_in_the_gap() {
         h: &vec![bound; n - 1],
         groups: &RowGroups::default(),
         positions: None,
+        slack_unit: None,
     };
     let active = |i: usize| target[i] < bound;
     let mut optimum = vec![1e7];
@@ -400,6 +404,7 @@ fn large_unknowns_with_small_differences_converge_at_the_rounding_floor() {
             h: &vec![0.0; n - 1],
             groups: &RowGroups::default(),
             positions: None,
+            slack_unit: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -452,6 +457,7 @@ fn bound_constrained_least_squares_finds_the_active_set() {
             h: &vec![0.0; n],
             groups: &RowGroups::default(),
             positions: None,
+            slack_unit: None,
         },
         &Tolerances::default(),
         &mut PatternCache::default(),
@@ -491,6 +497,7 @@ fn far_from_balance_skips_the_last_active_set_only_beyond_20k_unknowns() {
             h: &vec![0.0; n],
             groups: &RowGroups::default(),
             positions: None,
+            slack_unit: None,
         };
         let tol = Tolerances::for_size(n);
         let mut cache = PatternCache::default();
@@ -674,6 +681,7 @@ fn dissection_order_solves_a_large_qp_as_amds_does() {
         h: &h,
         groups: &groups,
         positions,
+        slack_unit: None,
     };
     let (mut dissected, mut amd) = (PatternCache::default(), PatternCache::default());
     let tol = Tolerances::for_size(n);
