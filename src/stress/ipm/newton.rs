@@ -17,6 +17,16 @@ use faer::{Conj, MatMut, Par};
 pub(super) const DELTA: f64 = 1e-7;
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
+/// δ_eq beyond 20k unknowns (`fallback_is_costly`). There the factor's rounding, amplified by
+/// equality weights of 1e6, set a floor on the dual residual above its tolerance wherever
+/// equality rows are many: the edge-based steps on the benchmark's domes with a hole (two
+/// rows per free vertex) stopped at `MaxIterations` at 10k, 50k and 100k vertices (46, 28 and
+/// 29 iterations, the dual residual stuck at 30× its tolerance at 10k), and are `Solved` with
+/// 1e-4 (18, 25 and 31; 1e-5 solved 10k but not 50k). The reduced steps there, with equality
+/// rows only on the hole's rim, take the same 20 iterations at 50k. Below 20k unknowns 1e-5
+/// and 1e-4 gave the nine shared models' reduced steps 1 and 4 more iterations in all.
+pub(super) const DELTA_EQ_LARGE: f64 = 1e-4;
+
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
 pub(super) const REGULARISATION: [f64; 3] = [1e-12, 1e-9, 1e-6];
 
@@ -72,10 +82,15 @@ impl<'a> Newton<'a> {
     ) -> Option<Newton<'a>> {
         let pattern = normal.pattern;
         let n = pattern.n;
+        let delta_eq = if fallback_is_costly(n) {
+            DELTA_EQ_LARGE
+        } else {
+            DELTA_EQ
+        };
         let w_reg: Vec<f64> = d
             .iter()
             .enumerate()
-            .map(|(r, d)| 1.0 / (d + if r < pattern.m_eq { DELTA_EQ } else { DELTA }))
+            .map(|(r, d)| 1.0 / (d + if r < pattern.m_eq { delta_eq } else { DELTA }))
             .collect();
         let values = &mut space.values;
         values.copy_from_slice(&normal.p_values);
