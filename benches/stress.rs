@@ -35,23 +35,7 @@ fn max_area(area: f64, n: usize) -> f64 {
 
 /// A spherical dome over the unit disk with an off-centre free hole; rim anchored.
 fn dome_with_hole(n: usize) -> Mesh {
-    let domain = Domain {
-        outer: generate::circle([0.0, 0.0], 1.0, ((n as f64).sqrt() * 3.5) as usize),
-        holes: vec![generate::circle(
-            [0.35, 0.1],
-            0.2,
-            ((n as f64).sqrt() * 0.8) as usize,
-        )],
-    };
-    let area = std::f64::consts::PI * (1.0 - 0.04);
-    let (p, t) = generate::triangulate(&domain, max_area(area, n)).expect("domain");
-    generate::lift(
-        &p,
-        &t,
-        |u| generate::spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
-        |_, outer| outer,
-    )
-    .expect("dome")
+    generate::dome_with_hole(n).expect("dome")
 }
 
 /// A barrel vault over 2 × 3 whose crown is shifted off the centre line, anchored along its

@@ -150,6 +150,24 @@ pub fn cap_dome(angle: f64, n: usize) -> Result<Mesh> {
     )
 }
 
+/// The benchmark's dome with a hole, about `n` vertices: a spherical cap of rim angle 0.9 rad
+/// over the unit disk (rim anchored) with a free off-centre hole of radius 0.2 at (0.35, 0.1).
+pub fn dome_with_hole(n: usize) -> Result<Mesh> {
+    let k = (n as f64).sqrt();
+    let domain = Domain {
+        outer: circle([0.0, 0.0], 1.0, (k * 3.5) as usize),
+        holes: vec![circle([0.35, 0.1], 0.2, (k * 0.8) as usize)],
+    };
+    let area = std::f64::consts::PI * (1.0 - 0.04);
+    let (p, t) = triangulate(&domain, 1.6 * area / (2.0 * n as f64))?;
+    lift(
+        &p,
+        &t,
+        |u| spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
+        |_, outer| outer,
+    )
+}
+
 /// A structured disk of radius 1: a centre vertex and `rings` concentric rings, ring k with
 /// 6k vertices, consecutive rings zipped together by angle. Edges follow the radial and hoop
 /// directions, the principal stress directions of a dome of revolution.

@@ -520,14 +520,7 @@ fn native_qp_is_not_slowed_by_a_free_hole_rim() {
 #[test]
 fn both_formulations_start_alike_and_take_about_as_many_iterations() {
     let problem = Problem::new(holed_disk(3, 0.004, |_, outer| outer));
-    let settings = StressSettings {
-        holes: HoleMode::Affine,
-        ..Default::default()
-    };
-    let (red, edge) = assert_same_optimum("holed disk", &problem, &settings);
-    for r in [&red, &edge] {
-        assert_eq!(r.solver, QpSolver::Native);
-    }
+    let (red, edge) = assert_same_native_optimum("holed disk", &problem);
     assert!(
         edge.iterations <= red.iterations + 5,
         "reduced {} against edge-based {} QP iterations",
@@ -543,34 +536,23 @@ fn both_formulations_start_alike_and_take_about_as_many_iterations() {
 /// reduced one at this size (nor at the benchmark's 10k, 50k and 100k).
 #[test]
 fn the_edge_based_step_solves_a_seven_thousand_vertex_dome() {
-    let n = 7200.0f64;
-    let domain = generate::Domain {
-        outer: generate::circle([0.0, 0.0], 1.0, (n.sqrt() * 3.5) as usize),
-        holes: vec![generate::circle(
-            [0.35, 0.1],
-            0.2,
-            (n.sqrt() * 0.8) as usize,
-        )],
-    };
-    let (p, t) =
-        generate::triangulate(&domain, 1.6 * std::f64::consts::PI * 0.96 / (2.0 * n)).unwrap();
-    let mesh = generate::lift(
-        &p,
-        &t,
-        |u| generate::spherical_cap(1.0, 0.9, u[0].hypot(u[1])),
-        |_, outer| outer,
-    )
-    .unwrap();
+    let mesh = generate::dome_with_hole(7200).unwrap();
     assert!(mesh.edges.len() > 20_000, "{} edges", mesh.edges.len());
-    let problem = Problem::new(mesh);
+    assert_same_native_optimum("7k dome with a hole", &Problem::new(mesh));
+}
+
+/// [`assert_same_optimum`] with affine hole jumps (so that both formulations have the same
+/// feasible forces), each answered by the native solver.
+fn assert_same_native_optimum(label: &str, problem: &Problem) -> (StressResult, StressResult) {
     let settings = StressSettings {
         holes: HoleMode::Affine,
         ..Default::default()
     };
-    let (red, edge) = assert_same_optimum("7k dome with a hole", &problem, &settings);
+    let (red, edge) = assert_same_optimum(label, problem, &settings);
     for r in [&red, &edge] {
-        assert_eq!(r.solver, QpSolver::Native);
+        assert_eq!(r.solver, QpSolver::Native, "{label}");
     }
+    (red, edge)
 }
 
 /// The mesh's positions with every height multiplied by `factor`.
