@@ -1,7 +1,7 @@
-//! The paper's timing table (de Goes et al. 2013, Figure 7.7) with our figures beside it, then
-//! scaling to 100k vertices. Prints tables; asserts nothing.
+//! The paper's timing table (de Goes et al. 2013, Figure 7.7) with our figures beside it, every
+//! shared model, then scaling to 100k vertices. Prints tables; asserts nothing.
 //!
-//!     cargo bench --bench stress              # the paper's rows + scaling to 50k vertices
+//!     cargo bench --bench stress              # the paper's rows, the shared models, scaling to 50k
 //!     cargo bench --bench stress -- --large   # also 100k vertices
 //!     cargo bench --bench stress -- --large --large-ff   # and the whole form finding at 100k
 //!
@@ -165,6 +165,15 @@ fn cell(step: Step, native: bool) -> String {
     format!("{:.3}{mark} ({}{status})", step.seconds, step.iterations)
 }
 
+/// The paper's seconds over ours, or "—" when our step was not solved.
+fn speedup(paper: f64, ours: Step) -> String {
+    if ours.status == StressStatus::Solved {
+        format!("{:.0}", paper / ours.seconds)
+    } else {
+        "—".to_string()
+    }
+}
+
 /// Edge-based seconds over reduced seconds, or "—" when either step was not solved.
 fn ratio(edge: Step, reduced: Step) -> String {
     if edge.status == StressStatus::Solved && reduced.status == StressStatus::Solved {
@@ -295,7 +304,7 @@ fn paper_table(dir: Option<&Path>) {
         let ff = form_find(&problem, &FormFindSettings::default(), None).expect("valid problem");
         let ff_s = t.elapsed().as_secs_f64();
         println!(
-            "| {} | {} | {ours} | {size} | {} | {} | {} | {} | {} | {} | {} / {} | {:.0} | {} ({:?}), {ff_s:.2} |",
+            "| {} | {} | {ours} | {size} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} ({:?}), {ff_s:.2} |",
             row.name,
             row.size,
             cell(rn, true),
@@ -306,7 +315,7 @@ fn paper_table(dir: Option<&Path>) {
             ratio(ec, rc),
             row.de_goes,
             row.vhwp12,
-            row.de_goes / rn.seconds,
+            speedup(row.de_goes, rn),
             ff.iterations,
             ff.termination,
         );
@@ -403,10 +412,9 @@ fn scaling(large: bool, large_ff: bool) {
             "—".to_string()
         };
         println!(
-            "| {v} | {} | {:.2} ({}) | {:?} | {rss:.0} | {ff} |",
+            "| {v} | {} | {} | {:?} | {rss:.0} | {ff} |",
             problem.mesh.edges.len(),
-            rn.seconds,
-            rn.iterations,
+            cell(rn, true),
             rn.solver,
         );
     }

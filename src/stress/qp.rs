@@ -444,8 +444,9 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
 }
 
 /// The interior-point start's slack unit, in multiples of the median ℓ_e² over the edges with
-/// a bound (`slack_unit`): the start's constraint term then weighs Σ (ℓ² (q − bound))² alike in
-/// both formulations, which bound the same force densities.
+/// a bound (`slack_unit`): the start's constraint term is then (START_UNIT × median ℓ²)² Σ
+/// (q − bound)² / `START_PENALTY`, one common factor, alike in both formulations, which bound
+/// the same force densities.
 ///
 /// With the median row scale as the unit (`ipm::caller_units`'s default) the start depended on
 /// the unknowns: the reduced rows' median scale is 0.001–0.11 (0.5–1.9 times this unit) on the

@@ -17,7 +17,8 @@ use faer::{Conj, MatMut, Par};
 pub(super) const DELTA: f64 = 1e-7;
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
-/// δ_eq beyond 20k unknowns (`fallback_is_costly`). There the factor's rounding, amplified by
+/// δ_eq beyond 20k unknowns (`fallback_is_costly`), in every Newton system of such a QP (the
+/// start, the iterations, polishing). There the factor's rounding, amplified by
 /// equality weights of 1e6, set a floor on the dual residual above its tolerance wherever
 /// equality rows are many: the edge-based steps on the benchmark's domes with a hole (two
 /// rows per free vertex) stopped at `MaxIterations` at 10k, 50k and 100k vertices (46, 28 and
