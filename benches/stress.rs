@@ -165,19 +165,11 @@ fn cell(step: Step, native: bool) -> String {
     format!("{:.3}{mark} ({}{status})", step.seconds, step.iterations)
 }
 
-/// The paper's seconds over ours, or "—" when our step was not solved.
-fn speedup(paper: f64, ours: Step) -> String {
-    if ours.status == StressStatus::Solved {
-        format!("{:.0}", paper / ours.seconds)
-    } else {
-        "—".to_string()
-    }
-}
-
-/// Edge-based seconds over reduced seconds, or "—" when either step was not solved.
-fn ratio(edge: Step, reduced: Step) -> String {
-    if edge.status == StressStatus::Solved && reduced.status == StressStatus::Solved {
-        format!("{:.1}", edge.seconds / reduced.seconds)
+/// `value` with `decimals` decimals, or "—" when any of `steps` did not end `Solved` (a time
+/// that is not a solve's makes no ratio).
+fn if_solved(value: f64, decimals: usize, steps: &[Step]) -> String {
+    if steps.iter().all(|s| s.status == StressStatus::Solved) {
+        format!("{value:.decimals$}")
     } else {
         "—".to_string()
     }
@@ -311,11 +303,11 @@ fn paper_table(dir: Option<&Path>) {
             cell(rc, false),
             cell(en, true),
             cell(ec, false),
-            ratio(en, rn),
-            ratio(ec, rc),
+            if_solved(en.seconds / rn.seconds, 1, &[en, rn]),
+            if_solved(ec.seconds / rc.seconds, 1, &[ec, rc]),
             row.de_goes,
             row.vhwp12,
-            speedup(row.de_goes, rn),
+            if_solved(row.de_goes / rn.seconds, 0, &[rn]),
             ff.iterations,
             ff.termination,
         );
@@ -360,7 +352,7 @@ fn shared_models_table(dir: &Path) {
             m.holes().count(),
             cell(rn, true),
             cell(en, true),
-            ratio(en, rn),
+            if_solved(en.seconds / rn.seconds, 1, &[en, rn]),
         );
     }
 }
@@ -438,7 +430,7 @@ fn scaling(large: bool, large_ff: bool) {
             problem.mesh.positions.len(),
             cell(rn, true),
             cell(en, true),
-            ratio(en, rn),
+            if_solved(en.seconds / rn.seconds, 1, &[en, rn]),
             peak_rss_mib(),
         );
     }

@@ -639,6 +639,12 @@ fn loads_at(
     (load, free, if mean_load > 0.0 { mean_load } else { 1.0 })
 }
 
+/// The upper median (element len/2 in increasing order), found in linear time.
+pub(crate) fn upper_median(mut values: Vec<f64>) -> Option<f64> {
+    let k = values.len() / 2;
+    (!values.is_empty()).then(|| *values.select_nth_unstable_by(k, f64::total_cmp).1)
+}
+
 fn mean_over(x: &[f64], ids: &[u32]) -> f64 {
     if ids.is_empty() {
         return 0.0;

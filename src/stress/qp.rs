@@ -462,12 +462,11 @@ const START_UNIT: f64 = 10.0;
 /// The QP's slack unit for the interior-point start: `START_UNIT` times the median ℓ_e² of
 /// the edges with a bound, the same in both formulations.
 fn slack_unit(inp: &QpInput) -> f64 {
-    let mut l2: Vec<f64> = (0..inp.edges.len())
+    let l2: Vec<f64> = (0..inp.edges.len())
         .filter(|&e| inp.bounds[e].is_some())
         .map(|e| inp.length[e] * inp.length[e])
         .collect();
-    l2.sort_by(f64::total_cmp);
-    START_UNIT * l2.get(l2.len() / 2).copied().unwrap_or(1.0)
+    START_UNIT * super::upper_median(l2).unwrap_or(1.0)
 }
 
 /// The plan position of each unknown of `solve_native`: for y, the mean of the midpoints of

@@ -274,12 +274,7 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
 /// caller's units. The median row scale depends on the unknowns: the stress QPs pass their
 /// own unit instead, the same for both formulations (`qp::START_UNIT`).
 fn caller_units(row_scale: &[f64], unit: Option<f64>) -> Vec<f64> {
-    let unit = unit.or_else(|| {
-        let mut sorted = row_scale.to_vec();
-        sorted.sort_by(f64::total_cmp);
-        sorted.get(sorted.len() / 2).copied()
-    });
-    let Some(unit) = unit else {
+    let Some(unit) = unit.or_else(|| crate::stress::upper_median(row_scale.to_vec())) else {
         return Vec::new();
     };
     row_scale.iter().map(|r| unit / r).collect()
