@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::problem::Problem;
 use crate::shape::{Schedule, ShapeStep};
 use crate::stress::{
-    analyse_cached, EdgeScope, Prior, QBound, StressCache, StressResult, StressSettings,
+    analyse_cached, EdgeScope, Prior, QBound, QpSolver, StressCache, StressResult, StressSettings,
     StressStatus,
 };
 use std::time::Instant;
@@ -109,6 +109,9 @@ pub struct FormFindResult {
     pub history: Vec<f64>,
     /// Stress steps taken.
     pub iterations: usize,
+    /// The solver that answered each stress step: the native one, or clarabel where the
+    /// native method did not converge (see `QpSolver::Native`).
+    pub solvers: Vec<QpSolver>,
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
@@ -159,6 +162,7 @@ pub fn form_find(
     // residuals, not by the QPs' optimality (see `StressCache::for_form_finding`).
     let mut cache = StressCache::for_form_finding();
     let mut stress_steps = 0;
+    let mut solvers = Vec::new();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
             let t = Instant::now();
@@ -191,6 +195,7 @@ pub fn form_find(
         };
         cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
+        solvers.push(stress.solver);
         // A step that stopped short of its optimum may balance the shape worse than the forces
         // at hand (the previous ones, certified at these heights): those are kept instead,
         // unless ODT has just moved the plan under them.
@@ -272,6 +277,7 @@ pub fn form_find(
     Ok(FormFindResult {
         termination,
         iterations: stress_steps,
+        solvers,
         positions,
         stress,
         history,

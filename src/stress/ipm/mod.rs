@@ -27,6 +27,7 @@
 use super::sparse::Csr;
 
 mod factorise;
+mod gmres;
 mod kkt;
 mod newton;
 mod ordering;
@@ -184,6 +185,14 @@ impl Default for Tolerances {
 /// gains a tenth of that.
 const CORRECTOR_STRETCH: f64 = 1.5;
 const CORRECTOR_ADD: f64 = 0.1;
+
+/// An iteration's direction gets Krylov cycles (`Newton::refine`) when refinement leaves
+/// its x rows an error above this fraction of the dual residual it is to remove (or of the
+/// dual tolerance, once the residual is below it): the step would leave that residual where it
+/// is. On four_holes' late form-finding QPs, refinement stalled with the x rows' error as large
+/// as the residual itself, the dual residual stayed at 10–100 times its tolerance for 60
+/// iterations, and the QPs ran to the iteration limit and clarabel.
+const KRYLOV_GOAL: f64 = 0.1;
 
 /// Fraction of the way to the boundary of the positive orthant taken by each step (0.995
 /// lost the last digits the 50k-vertex dome needs and fell back to clarabel).
@@ -598,6 +607,7 @@ fn iterate(
                 }
             }
         }
+        let dual_tolerance = (tol.dual_feas * kkt.dual_scale).max(kkt.dual_floor);
         let Kkt {
             r_d,
             r_e,
@@ -641,6 +651,8 @@ fn iterate(
         let d: Vec<f64> = (0..m).map(|i| s[i] / z[i]).collect();
         // The corrector needs an accuracy just ahead of the iterate's own.
         let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
+        // The direction's own error in the dual residual worth Krylov cycles to remove.
+        let krylov_goal = (KRYLOV_GOAL * inf_norm(&r_d)).max(dual_tolerance);
         let mut step = |reg: f64| {
             let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg, &mut space)?;
             let sol = newton.approximate(&minus_rd, &rhs(&r_aff));
@@ -690,7 +702,7 @@ fn iterate(
                 (alpha, r_c, b2, sol, dir) = (a, r_try, b_try, sol_try, dir_try);
             }
             drop(dir);
-            let sol = newton.refine(sol, &minus_rd, &b2, precision, false)?;
+            let sol = newton.refine(sol, &minus_rd, &b2, precision, false, Some(krylov_goal))?;
             Some(split(sol, &r_c))
         };
         let Some((dx, dl, ds, dz)) = REGULARISATION.iter().find_map(|&reg| step(reg)) else {

@@ -31,6 +31,11 @@ pub(super) const DELTA_EQ_LARGE: f64 = 1e-4;
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
 pub(super) const REGULARISATION: [f64; 3] = [1e-12, 1e-9, 1e-6];
 
+/// GMRES cycles, and basis vectors per cycle, tried where refinement stalls short of its
+/// target (`Newton::krylov`).
+const KRYLOV_CYCLES: usize = 3;
+const KRYLOV_BASIS: usize = 30;
+
 /// The Newton system in augmented form, for unknowns (dx, w):
 ///
 ///   P dx + Cᵀ w = b1,   C dx − D w = b2      (C = [E; G], D = 0 on E, s / z on G)
@@ -200,7 +205,7 @@ impl<'a> Newton<'a> {
         x_rows: bool,
     ) -> Option<[Vec<f64>; 2]> {
         let sol = self.approximate(b1, b2);
-        self.refine(sol, b1, b2, tol, x_rows)
+        self.refine(sol, b1, b2, tol, x_rows, None)
     }
 
     /// Iterative refinement of an approximate solution `sol` against the exact augmented
@@ -214,8 +219,8 @@ impl<'a> Newton<'a> {
         b2: &[f64],
         tol: f64,
         x_rows: bool,
+        krylov_goal: Option<f64>,
     ) -> Option<[Vec<f64>; 2]> {
-        let n = self.normal.pattern.n;
         // Equality rows count as they are (their violation is what matters), inequality rows
         // as they enter dx (times their weight): inactive ones carry huge right-hand sides
         // whose rounding does not matter.
@@ -231,21 +236,15 @@ impl<'a> Newton<'a> {
         };
         let b_norm = weighted(b1, b2);
         let (mut last, mut last_x) = (f64::INFINITY, f64::INFINITY);
-        let (mut e_x, mut terms) = (0.0, 0.0);
+        let (mut e_norm, mut e_x, mut terms) = (0.0, 0.0, 0.0);
+        // The error of `sol` where refinement stopped short of its round limit.
+        let mut error = None;
         for _ in 0..10 {
-            let [dx, w] = &sol;
-            let px = self.normal.mul_p(dx);
-            let ct_w = mul_t(self.cons, w, n);
-            let e1: Vec<f64> = (0..n).map(|i| b1[i] - px[i] - ct_w[i]).collect();
-            let cdx = self.cons.mul(dx);
-            let e2: Vec<f64> = (0..b2.len())
-                .map(|i| b2[i] - cdx[i] + self.d[i] * w[i])
-                .collect();
-            let e_norm = weighted(&e1, &e2);
-            e_x = inf_norm(&e1);
-            terms = inf_norm(&px).max(inf_norm(&ct_w));
+            let (e1, e2, t) = self.error(&sol, b1, b2);
+            (e_norm, e_x, terms) = (weighted(&e1, &e2), inf_norm(&e1), t);
             let x_progress = x_rows && e_norm <= last && e_x <= 0.75 * last_x;
             if e_norm <= tol * b_norm || (e_norm > 0.5 * last && !x_progress) {
+                error = Some([e1, e2]);
                 break;
             }
             (last, last_x) = (e_norm, e_x);
@@ -258,6 +257,109 @@ impl<'a> Newton<'a> {
         // side, and beyond rounding of the terms that make it up: a lost pivot. Constraint rows
         // converge at a rate set by δ / (s/z + δ), slowly where constraints are strongly
         // active, whatever the factor: an inexact direction there is still a good one.
-        (e_x <= 0.5 * b_norm || e_x <= 1e-10 * terms).then_some(sol)
+        if !(e_x <= 0.5 * b_norm || e_x <= 1e-10 * terms) {
+            return None;
+        }
+        // The x rows' error that remains is what the step leaves of the dual residual.
+        if let Some(goal) = krylov_goal.filter(|&g| e_x > g && e_norm > tol * b_norm) {
+            let error = error.unwrap_or_else(|| {
+                let (e1, e2, _) = self.error(&sol, b1, b2);
+                [e1, e2]
+            });
+            self.krylov(&mut sol, error, b1, b2, (tol * b_norm, goal), &weighted);
+        }
+        Some(sol)
+    }
+
+    /// The error b − K sol of the exact augmented system, by block, and the size of the x
+    /// rows' terms.
+    fn error(&self, [dx, w]: &[Vec<f64>; 2], b1: &[f64], b2: &[f64]) -> (Vec<f64>, Vec<f64>, f64) {
+        let n = self.normal.pattern.n;
+        let px = self.normal.mul_p(dx);
+        let ct_w = mul_t(self.cons, w, n);
+        let e1: Vec<f64> = (0..n).map(|i| b1[i] - px[i] - ct_w[i]).collect();
+        let cdx = self.cons.mul(dx);
+        let e2: Vec<f64> = (0..b2.len())
+            .map(|i| b2[i] - cdx[i] + self.d[i] * w[i])
+            .collect();
+        (e1, e2, inf_norm(&px).max(inf_norm(&ct_w)))
+    }
+
+    /// K sol = (P dx + Cᵀ w, C dx − D w).
+    fn product(&self, [dx, w]: &[Vec<f64>; 2]) -> [Vec<f64>; 2] {
+        let n = self.normal.pattern.n;
+        let px = self.normal.mul_p(dx);
+        let ct_w = mul_t(self.cons, w, n);
+        let k1 = px.iter().zip(&ct_w).map(|(a, b)| a + b).collect();
+        let cdx = self.cons.mul(dx);
+        let k2 = cdx
+            .iter()
+            .zip(&self.d)
+            .zip(w)
+            .map(|((c, d), w)| c - d * w)
+            .collect();
+        [k1, k2]
+    }
+
+    /// GMRES cycles on the exact augmented system, right-preconditioned by the regularised
+    /// solve, rows scaled as refinement weighs them; from `sol`, whose error is `error`. Kept
+    /// only while they reduce the weighted error.
+    fn krylov(
+        &mut self,
+        sol: &mut [Vec<f64>; 2],
+        mut error: [Vec<f64>; 2],
+        b1: &[f64],
+        b2: &[f64],
+        (target, goal): (f64, f64),
+        weighted: &dyn Fn(&[f64], &[f64]) -> f64,
+    ) {
+        let n = self.normal.pattern.n;
+        let m_eq = self.normal.pattern.m_eq;
+        let scale: Vec<f64> = self
+            .w_reg
+            .iter()
+            .enumerate()
+            .map(|(r, w)| if r < m_eq { 1.0 } else { *w })
+            .collect();
+        let flatten = |[e1, e2]: &[Vec<f64>; 2]| -> Vec<f64> {
+            e1.iter()
+                .copied()
+                .chain(e2.iter().zip(&scale).map(|(e, s)| e * s))
+                .collect()
+        };
+        // A scaled residual back in the system's rows.
+        let unscale = |v: &[f64]| -> (Vec<f64>, Vec<f64>) {
+            (
+                v[..n].to_vec(),
+                v[n..].iter().zip(&scale).map(|(v, s)| v / s).collect(),
+            )
+        };
+        let mut e_norm = weighted(&error[0], &error[1]);
+        for _ in 0..KRYLOV_CYCLES {
+            let r0 = flatten(&error);
+            let mut op = |v: &[f64]| -> Vec<f64> {
+                let (v1, v2) = unscale(v);
+                let u = self.approximate(&v1, &v2);
+                flatten(&self.product(&u))
+            };
+            let Some((y, _)) = gmres::cycle(&mut op, &r0, KRYLOV_BASIS, target.max(goal)) else {
+                return;
+            };
+            let (y1, y2) = unscale(&y);
+            let corr = self.approximate(&y1, &y2);
+            let trial: [Vec<f64>; 2] =
+                [0, 1].map(|k| sol[k].iter().zip(&corr[k]).map(|(s, c)| s + c).collect());
+            let (e1, e2, _) = self.error(&trial, b1, b2);
+            let trial_norm = weighted(&e1, &e2);
+            // (NaN included.)
+            if trial_norm.partial_cmp(&e_norm) != Some(std::cmp::Ordering::Less) {
+                return;
+            }
+            let e_x = inf_norm(&e1);
+            (*sol, error, e_norm) = (trial, [e1, e2], trial_norm);
+            if e_norm <= target || e_x <= goal {
+                return;
+            }
+        }
     }
 }

@@ -287,7 +287,7 @@ pub(super) fn polish_step(
             if hopeless(&step_of(&rough)) {
                 return Some(Err(PolishFailure::EarlyGuess));
             }
-            let sol = newton.refine(rough, &b1, b2, 1e-2 * tol.feas, true)?;
+            let sol = newton.refine(rough, &b1, b2, 1e-2 * tol.feas, true, None)?;
             Some(Ok(step_of(&sol)))
         })
         .unwrap_or(Err(PolishFailure::Inexact))
