@@ -309,6 +309,7 @@ fn not_converged_writes_outputs_and_exits_3() {
     let r = read_json(&dir.path("formfind-out/report.json"));
     assert_eq!(r["termination"], "max_iterations");
     assert_eq!(r["iterations"], 2);
+    assert_eq!(r["step_solvers"], serde_json::json!(["native", "native"]));
     assert!(dir.path("formfind-out/vault-formfound.obj").is_file());
     check_pictures(&dir.path("formfind-out/pictures"));
 }
@@ -362,6 +363,7 @@ fn qp_solver_option_is_honoured_and_reported() {
         let r = read_json(&dir.path("formfind-out/report.json"));
         assert_eq!(r["settings"]["qp_solver"], qp);
         assert_eq!(r["qp_solver_used"], qp);
+        assert_eq!(r["step_solvers"], serde_json::json!([qp]));
         objective.push(r["objective"].as_f64().unwrap());
     }
     let (a, b) = (objective[0], objective[1]);

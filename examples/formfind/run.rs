@@ -5,7 +5,7 @@ use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use voussoir::geometry::Frame;
-use voussoir::{analyse, form_find, Problem, StressResult, Termination};
+use voussoir::{analyse, form_find, Problem, QpSolver, StressResult, Termination};
 
 use crate::args::Options;
 use crate::model::Model;
@@ -24,6 +24,8 @@ pub struct Outcome {
     pub history: Vec<f64>,
     /// Stress steps taken.
     pub iterations: usize,
+    /// The QP solver that answered each stress step (see `FormFindResult::solvers`).
+    pub solvers: Vec<QpSolver>,
     pub hausdorff: f64,
     pub l2: f64,
     pub stress_seconds: f64,
@@ -88,6 +90,7 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
             stress: before.clone(),
             history: vec![before.eps_inf],
             iterations: 1,
+            solvers: vec![before.solver],
             hausdorff: 0.0,
             l2: 0.0,
             stress_seconds: before.seconds,
@@ -120,6 +123,7 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
             before,
             history: r.history,
             iterations: r.iterations,
+            solvers: r.solvers,
             hausdorff: r.hausdorff,
             l2: r.l2,
             stress_seconds: r.stress_seconds,
