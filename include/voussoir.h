@@ -172,6 +172,35 @@ typedef uint32_t VsrResultKind;
 #endif // __cplusplus
 
 /**
+ * Solver of the stress QP (`vsr_settings_set_qp_solver`, `vsr_result_qp_solver`).
+ */
+enum VsrQpSolver
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Default: the structured interior-point method; falls back to clarabel when it does not
+   * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
+   * with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
+   * limit, or after 10 iterations without progress, with status
+   * VSR_STRESS_STATUS_MAX_ITERATIONS).
+   */
+  VSR_QP_SOLVER_NATIVE = 0,
+  /**
+   * clarabel's generic conic solver only: the reference.
+   */
+  VSR_QP_SOLVER_CLARABEL = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VsrQpSolver VsrQpSolver;
+#else
+typedef uint32_t VsrQpSolver;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * How the (last) stress QP ended (`vsr_result_stress_status`).
  */
 enum VsrStressStatus
@@ -204,35 +233,6 @@ enum VsrStressStatus
 typedef enum VsrStressStatus VsrStressStatus;
 #else
 typedef uint32_t VsrStressStatus;
-#endif // __STDC_VERSION__ >= 202311L
-#endif // __cplusplus
-
-/**
- * Solver of the stress QP (`vsr_settings_set_qp_solver`, `vsr_result_qp_solver`).
- */
-enum VsrQpSolver
-#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
-  : uint32_t
-#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
- {
-  /**
-   * Default: the structured interior-point method; falls back to clarabel when it does not
-   * converge (beyond 20k unknowns an answer at tenfold relaxed tolerances is kept instead,
-   * with status VSR_STRESS_STATUS_ALMOST_SOLVED, and the last iterate at the iteration
-   * limit, or after 10 iterations without progress, with status
-   * VSR_STRESS_STATUS_MAX_ITERATIONS).
-   */
-  VSR_QP_SOLVER_NATIVE = 0,
-  /**
-   * clarabel's generic conic solver only: the reference.
-   */
-  VSR_QP_SOLVER_CLARABEL = 1,
-};
-#ifndef __cplusplus
-#if __STDC_VERSION__ >= 202311L
-typedef enum VsrQpSolver VsrQpSolver;
-#else
-typedef uint32_t VsrQpSolver;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -800,6 +800,17 @@ VsrStatus vsr_result_force_diagram_segment_edges(const struct VsrResult *result,
  * `result`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or writable.
  */
 VsrStatus vsr_result_eps_history(const struct VsrResult *result, double *out, size_t len, size_t *needed);
+
+/**
+ * The solver that answered each form-finding stress step, one `VsrQpSolver` per step (as
+ * many as `vsr_result_termination`'s iterations): `VSR_QP_SOLVER_CLARABEL` where the native
+ * one was asked for but did not converge, which is much slower. For an analysis result:
+ * `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_qp_solver`).
+ *
+ * # Safety
+ * `result`: a valid handle; `out`: NULL or `len` writable values; `needed`: NULL or writable.
+ */
+VsrStatus vsr_result_step_solvers(const struct VsrResult *result, VsrQpSolver *out, size_t len, size_t *needed);
 
 /**
  * Summary of the result's forces: `status` (a `VsrStressStatus`) and `qp_iterations` of the

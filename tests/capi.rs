@@ -746,6 +746,10 @@ fn result_getters_check_pointers_buffers_and_kind() {
     assert_failed(st, S::NotAvailable, "result");
     assert_eq!(needed, 5);
     assert!(h.iter().all(|&x| x == -1.0));
+    let mut solvers = [VsrQpSolver::Clarabel; 3];
+    let st = unsafe { vsr_result_step_solvers(analysis, solvers.as_mut_ptr(), 3, &mut needed) };
+    assert_failed(st, S::NotAvailable, "result");
+    assert_eq!((needed, solvers), (5, [VsrQpSolver::Clarabel; 3]));
     let (mut t, mut it) = (VsrTermination::Cancelled, 77usize);
     assert_failed(
         unsafe { vsr_result_termination(analysis, &mut t, &mut it) },
@@ -807,6 +811,16 @@ fn result_getters_check_pointers_buffers_and_kind() {
     assert!(eps < 1e-6, "eps_inf {eps}");
     let history = doubles(form, vsr_result_eps_history);
     assert!(!history.is_empty() && history.len() <= it + 1);
+    // One solver per stress step, all native on this small cap.
+    let mut steps = usize::MAX;
+    assert_ok(unsafe { vsr_result_step_solvers(form, null_mut(), 0, &mut steps) });
+    assert_eq!(steps, it);
+    let mut solvers = vec![VsrQpSolver::Clarabel; steps];
+    assert_ok(unsafe { vsr_result_step_solvers(form, solvers.as_mut_ptr(), steps, null_mut()) });
+    assert!(
+        solvers.iter().all(|&s| s == VsrQpSolver::Native),
+        "{solvers:?}"
+    );
 
     let (mut x, mut y, mut z) = (-1.0, -1.0, -1.0);
     assert_failed(

@@ -532,6 +532,31 @@ pub unsafe extern "C" fn vsr_result_eps_history(
     })
 }
 
+/// The solver that answered each form-finding stress step, one `VsrQpSolver` per step (as
+/// many as `vsr_result_termination`'s iterations): `VSR_QP_SOLVER_CLARABEL` where the native
+/// one was asked for but did not converge, which is much slower. For an analysis result:
+/// `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_qp_solver`).
+///
+/// # Safety
+/// `result`: a valid handle; `out`: NULL or `len` writable values; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_step_solvers(
+    result: *const VsrResult,
+    out: *mut VsrQpSolver,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(result, out, len, needed, |r| {
+                let steps = &r.form("the step solvers")?.solvers;
+                Ok(steps.iter().map(|&s| VsrQpSolver::of(s)).collect())
+            })
+        }
+    })
+}
+
 /// Summary of the result's forces: `status` (a `VsrStressStatus`) and `qp_iterations` of the
 /// interior-point solver of the stress step that produced them (0 when a form-finding step
 /// was solved from the previous step's active set alone), `eps_inf` = max |r_i| / mean p_i

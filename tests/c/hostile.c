@@ -160,6 +160,12 @@ int main(void) {
     EXPECT(vsr_result_eps_history(result, buffer, 64, &needed), VSR_STATUS_NOT_AVAILABLE,
            "result");
     for (i = 0; i < 64; ++i) TRUE(buffer[i] == -7.0);
+    {
+        VsrQpSolver solvers[2] = {VSR_QP_SOLVER_CLARABEL, VSR_QP_SOLVER_CLARABEL};
+        EXPECT(vsr_result_step_solvers(result, solvers, 2, &needed), VSR_STATUS_NOT_AVAILABLE,
+               "result");
+        TRUE(solvers[0] == VSR_QP_SOLVER_CLARABEL && solvers[1] == VSR_QP_SOLVER_CLARABEL);
+    }
     EXPECT(vsr_result_positions(result, buffer, 64, &needed), VSR_STATUS_OK, "");
     TRUE(needed == 15 && buffer[14] == 0.3 && buffer[15] == -7.0);
     {
