@@ -190,10 +190,10 @@ const CORRECTOR_ADD: f64 = 0.1;
 /// its x rows an error above this fraction of the dual residual it is to remove (or of the
 /// dual tolerance, once the residual is below it): the step would leave that residual where it
 /// is. On four_holes' late form-finding QPs, refinement stalled with the x rows' error as large
-/// as the residual itself, the dual residual stayed at 10–100 times its tolerance for 60
+/// as the residual itself, the dual residual stayed at 8–130 times its tolerance for 60
 /// iterations, and the QPs ran to the iteration limit and clarabel. Not beyond 20k unknowns
 /// (`fallback_is_costly`): there a cycle costs about a second, and on the 100k dome's
-/// edge-based step the errors that called for one were at the solves' rounding: 11 of 13
+/// edge-based step the errors that called for one were at the solves' rounding: 9 of 13
 /// cycles raised the error, and the step took 39 iterations and 33 s instead of 31 and 22 s.
 const KRYLOV_GOAL: f64 = 0.1;
 
