@@ -200,7 +200,12 @@ pub fn form_find(
         // at hand (the previous ones, certified at these heights): those are kept instead,
         // unless ODT has just moved the plan under them.
         let stress = match last.take() {
-            Some(held) if k >= settings.odt_iterations && falls_short(&stress, &held) => held,
+            Some(held)
+                if k >= settings.odt_iterations
+                    && falls_short(&stress, cache.last_was_coarse(), &held) =>
+            {
+                held
+            }
             _ => stress,
         };
         stress_s += t.elapsed().as_secs_f64();
@@ -289,16 +294,23 @@ pub fn form_find(
     })
 }
 
-/// Whether a stress step's answer `new`, which stopped short of its optimum, balances the
-/// shape worse than `held`, the forces already at hand at the same heights. Such a step (at
-/// 100k vertices, one at its iteration budget took ε∞ from 1.3e-5 to 3.9e-4) would undo the
-/// loop's progress, while `held` is still a compressive stress in horizontal balance there:
-/// only the heights have changed since (a relative q_min moves with the loads they change).
-fn falls_short(new: &StressResult, held: &StressResult) -> bool {
-    matches!(
-        new.status,
-        StressStatus::AlmostSolved | StressStatus::MaxIterations
-    ) && held.eps_inf < new.eps_inf
+/// Whether a stress step's answer `new`, which stopped short of its optimum (at the
+/// iteration limit, at reduced accuracy, or solved to coarse optimality: `coarse`), balances
+/// the shape worse than `held`, the forces already at hand at the same heights. Such a step
+/// (at 100k vertices, one at its iteration budget took ε∞ from 1.3e-5 to 3.9e-4) would undo
+/// the loop's progress, while `held` is still a compressive stress in horizontal balance
+/// there: only the heights have changed since (a relative q_min moves with the loads they
+/// change). Near the end of the 100k dome's loop coarse steps, the previous active set
+/// polished at coarse tolerances, balanced the shape up to 20 times worse than the held
+/// forces, and whether the loop converged (23 steps) or stalled (32) came down to rounding;
+/// with the held forces kept it converged in 25 and 26 steps with the same two roundings.
+fn falls_short(new: &StressResult, coarse: bool, held: &StressResult) -> bool {
+    let short = coarse
+        || matches!(
+            new.status,
+            StressStatus::AlmostSolved | StressStatus::MaxIterations
+        );
+    short && held.eps_inf < new.eps_inf
 }
 
 fn infeasibility_hint(s: &StressSettings) -> String {
@@ -362,11 +374,27 @@ mod tests {
         };
         let worse = 2.0 * held.eps_inf + 1e-3;
         for status in [StressStatus::AlmostSolved, StressStatus::MaxIterations] {
-            assert!(falls_short(&with(status, worse), &held));
-            assert!(!falls_short(&with(status, 0.5 * held.eps_inf), &held));
+            assert!(falls_short(&with(status, worse), false, &held));
+            assert!(!falls_short(
+                &with(status, 0.5 * held.eps_inf),
+                false,
+                &held
+            ));
         }
         // A solved step is the optimum of the current QP: it is taken even when it balances
-        // worse (early steps trade residual for a smoother force diagram).
-        assert!(!falls_short(&with(StressStatus::Solved, worse), &held));
+        // worse (early steps trade residual for a smoother force diagram)...
+        assert!(!falls_short(
+            &with(StressStatus::Solved, worse),
+            false,
+            &held
+        ));
+        // ... unless it was solved to coarse optimality only (form finding beyond 20k
+        // unknowns), short of that optimum by design.
+        assert!(falls_short(&with(StressStatus::Solved, worse), true, &held));
+        assert!(!falls_short(
+            &with(StressStatus::Solved, 0.5 * held.eps_inf),
+            true,
+            &held
+        ));
     }
 }

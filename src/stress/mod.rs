@@ -202,6 +202,8 @@ pub struct StressCache {
     normal: ipm::PatternCache,
     /// Solve native QPs to `ipm::Tolerances::for_form_finding` (coarse when large).
     coarse: bool,
+    /// Whether the last step's answer was solved to coarse optimality.
+    last_coarse: bool,
 }
 
 impl StressCache {
@@ -230,6 +232,12 @@ impl StressCache {
     /// balance 42 times in 61.
     pub fn far_from_balance(&mut self, far: bool) {
         self.normal.far_from_balance(far);
+    }
+
+    /// Whether the last step's answer is a native QP's solved to coarse optimality: short of
+    /// its optimum by design, as one at the iteration limit is by necessity.
+    pub fn last_was_coarse(&self) -> bool {
+        self.last_coarse
     }
 }
 
@@ -415,6 +423,7 @@ pub fn analyse_cached(
         out,
         regularisation,
     } = best.expect("at least one attempt");
+    cache.last_coarse = out.coarse;
     let (airy_op, s, _) = models[slot(formulation_used)]
         .take()
         .expect("model of the attempt");

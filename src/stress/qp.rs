@@ -54,6 +54,8 @@ pub struct QpOutput {
     pub tau: Vec<f64>,
     pub status: StressStatus,
     pub iterations: u32,
+    /// Solved to coarse optimality (`ipm::Tolerances::for_form_finding` beyond 20k unknowns).
+    pub coarse: bool,
 }
 
 struct Triplets {
@@ -278,6 +280,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
                 tau: vec![0.0; n_vertices],
                 status: StressStatus::NumericalError,
                 iterations: 0,
+                coarse: false,
             }
         }
     };
@@ -289,6 +292,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
         tau,
         status: StressStatus::from_clarabel(solver.solution.status),
         iterations: solver.solution.iterations,
+        coarse: false,
     }
 }
 
@@ -440,6 +444,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             ipm::IpmStatus::NumericalError => StressStatus::NumericalError,
         },
         iterations: out.iterations,
+        coarse: coarse && ipm::fallback_is_costly(n),
     }
 }
 
