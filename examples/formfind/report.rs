@@ -109,7 +109,7 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         // The QP solver that produced the final forces (clarabel after a fallback).
         "qp_solver_used": name_of(&QP_SOLVERS, s.solver),
         "iterations": outcome.iterations,
-        // Per stress step: clarabel where the native method did not converge.
+        // Per stress step: clarabel where asked for or where the native method did not converge.
         "step_solvers": outcome.solvers.iter().map(|&q| name_of(&QP_SOLVERS, q)).collect::<Vec<_>>(),
         "eps_inf": s.eps_inf,
         "history": outcome.history,

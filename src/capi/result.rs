@@ -533,8 +533,9 @@ pub unsafe extern "C" fn vsr_result_eps_history(
 }
 
 /// The solver that answered each form-finding stress step, one `VsrQpSolver` per step (as
-/// many as `vsr_result_termination`'s iterations): `VSR_QP_SOLVER_CLARABEL` where the native
-/// one was asked for but did not converge, which is much slower. For an analysis result:
+/// many as `vsr_result_termination`'s iterations, a step whose answer gave way to the forces
+/// at hand included): `VSR_QP_SOLVER_CLARABEL` where clarabel was asked for, or where the
+/// native one was but did not converge (much slower). For an analysis result:
 /// `VSR_STATUS_NOT_AVAILABLE` (use `vsr_result_qp_solver`).
 ///
 /// # Safety

@@ -109,8 +109,9 @@ pub struct FormFindResult {
     pub history: Vec<f64>,
     /// Stress steps taken.
     pub iterations: usize,
-    /// The solver that answered each stress step: the native one, or clarabel where the
-    /// native method did not converge (see `QpSolver::Native`).
+    /// The solver that answered each stress step: clarabel where it was asked for, or where the
+    /// native method did not converge (see `QpSolver::Native`); also for a step whose answer
+    /// gave way to the forces at hand (see `history`).
     pub solvers: Vec<QpSolver>,
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
@@ -200,9 +201,15 @@ pub fn form_find(
         // at hand (the previous ones, certified at these heights): those are kept instead,
         // unless ODT has just moved the plan under them.
         let stress = match last.take() {
+            // A smoothed step trades residual for smoothness on purpose: only once the
+            // smoothing has faded is a coarse one judged by its residual.
             Some(held)
                 if k >= settings.odt_iterations
-                    && falls_short(&stress, cache.last_was_coarse(), &held) =>
+                    && falls_short(
+                        &stress,
+                        cache.last_was_coarse() && stress_settings.dual_length_smoothing == 0.0,
+                        &held,
+                    ) =>
             {
                 held
             }

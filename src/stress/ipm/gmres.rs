@@ -7,7 +7,7 @@
 /// Runs up to `k` Arnoldi steps of the operator `op` from the residual `r0`, stopping early once
 /// the least-squares residual (2-norm) is at most `target`. Returns Σ y_j v_j, the combination
 /// of the basis vectors that minimises ‖r0 − op(Σ y_j v_j)‖₂, and that minimum; None if `r0` is
-/// zero or not finite.
+/// zero or not finite, or if the first step already breaks down (op(r0) zero or not finite).
 pub(super) fn cycle(
     op: &mut dyn FnMut(&[f64]) -> Vec<f64>,
     r0: &[f64],
@@ -26,7 +26,7 @@ pub(super) fn cycle(
     let mut residual = beta;
     for j in 0..k {
         let mut w = op(&basis[j]);
-        let mut col = Vec::with_capacity(j + 2);
+        let w_norm = norm(&w);
         // Modified Gram–Schmidt, twice: the basis must stay orthogonal to the last digits
         // for the least-squares residual to be the true one.
         let mut coef = vec![0.0; j + 1];
@@ -37,7 +37,7 @@ pub(super) fn cycle(
                 w.iter_mut().zip(v).for_each(|(a, b)| *a -= c * b);
             }
         }
-        col.extend_from_slice(&coef);
+        let mut col = coef;
         let h_next = norm(&w);
         col.push(h_next);
         for i in 0..j {
@@ -47,7 +47,7 @@ pub(super) fn cycle(
         }
         let (a, b) = (col[j], col[j + 1]);
         let r = a.hypot(b);
-        if !(r.is_finite() && r > 0.0) {
+        if !(r.is_finite() && r > f64::MIN_POSITIVE) {
             break;
         }
         cs.push(a / r);
@@ -58,7 +58,8 @@ pub(super) fn cycle(
         g[j] *= cs[j];
         h.push(col);
         residual = g[j + 1].abs();
-        if residual <= target || h_next <= f64::EPSILON * beta || j + 1 == k {
+        // Breakdown: what op adds to the basis is rounding (the solution lies in it).
+        if residual <= target || h_next <= f64::EPSILON * w_norm || j + 1 == k {
             break;
         }
         basis.push(w.iter().map(|v| v / h_next).collect());
@@ -121,5 +122,23 @@ mod tests {
         assert!((norm(&r2) - res2).abs() < 1e-12 * norm(&b));
         assert!(res2 < norm(&b) && res2 > 1e-6 * norm(&b));
         assert!(cycle(&mut |v| mul(v), &vec![0.0; n], n, 0.0).is_none());
+        // A target stops the cycle as soon as the least-squares residual meets it.
+        let mut calls = 0;
+        let target = 0.5 * norm(&b);
+        let (x3, res3) = cycle(
+            &mut |v| {
+                calls += 1;
+                mul(v)
+            },
+            &b,
+            n,
+            target,
+        )
+        .unwrap();
+        let r3: Vec<f64> = mul(&x3).iter().zip(&b).map(|(ax, b)| b - ax).collect();
+        assert!(res3 <= target && (norm(&r3) - res3).abs() < 1e-12 * norm(&b));
+        assert!(calls < n, "{calls} operator calls");
+        // An operator that returns NaN ends the cycle without an answer.
+        assert!(cycle(&mut |v| vec![f64::NAN; v.len()], &b, n, 0.0).is_none());
     }
 }

@@ -187,9 +187,9 @@ const CORRECTOR_STRETCH: f64 = 1.5;
 const CORRECTOR_ADD: f64 = 0.1;
 
 /// An iteration's direction gets Krylov cycles (`Newton::refine`) when refinement leaves
-/// its x rows an error above this fraction of the dual residual it is to remove (or of the
-/// dual tolerance, once the residual is below it): the step would leave that residual where it
-/// is. On four_holes' late form-finding QPs, refinement stalled with the x rows' error as large
+/// its x rows an error above this fraction of the dual residual it is to remove, or above
+/// the dual tolerance, whichever is larger: the step would leave that residual where it is.
+/// On four_holes' late form-finding QPs, refinement stalled with the x rows' error as large
 /// as the residual itself, the dual residual stayed at 8–130 times its tolerance for 60
 /// iterations, and the QPs ran to the iteration limit and clarabel. Not beyond 20k unknowns
 /// (`fallback_is_costly`): there a cycle costs about a second, and on the 100k dome's
