@@ -4,6 +4,8 @@
 //! the rate reg / (reg + λ) ≈ 1 along them and stalls; a Krylov method preconditioned with the
 //! same factor resolves a few such directions in as many iterations.
 
+use super::dot;
+
 /// Runs up to `k` Arnoldi steps of the operator `op` from the residual `r0`, stopping early once
 /// the least-squares residual (2-norm) is at most `target`. Returns Σ y_j v_j, the combination
 /// of the basis vectors that minimises ‖r0 − op(Σ y_j v_j)‖₂, and that minimum; None if `r0` is
@@ -79,10 +81,6 @@ pub(super) fn cycle(
         out.iter_mut().zip(v).for_each(|(o, v)| *o += c * v);
     }
     Some((out, residual))
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(a: &[f64]) -> f64 {
