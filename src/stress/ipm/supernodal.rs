@@ -265,9 +265,12 @@ pub(super) fn owners(begin: &[usize], end: &[usize], n: usize) -> Vec<usize> {
     owner
 }
 
-/// Whether the machine runs two threads at once.
+/// Whether the machine runs two threads at once. Asked once per process: the answer reads the
+/// cgroup files, which cost 1% of a small stress step when asked for every QP (the barrel row,
+/// 336 vertices, profiled).
 fn two_threads() -> bool {
-    std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+    static TWO: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *TWO.get_or_init(|| std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2))
 }
 
 /// The multiply-adds of factoring a supernode of `ncols` columns and `nrows` rows (its
