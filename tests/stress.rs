@@ -578,11 +578,19 @@ fn heights_scaled(mesh: &Mesh, factor: f64) -> Vec<[f64; 3]> {
 /// One cache across stress steps gives the answers of fresh ones: reused for a moved shape of
 /// the same mesh (the solve then starts from the previous step's active set), replaced when
 /// the structure changes (an upper bound adds rows, another mesh), and reused after that.
+/// The reduced operator it keeps is rebuilt whenever the plan, the supports or the hole mode
+/// change, though the structure stays.
 #[test]
 fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     let dome = Problem::new(polar_cap(10, 1.3));
     let lowered = heights_scaled(&dome.mesh, 0.8);
+    let stretched: Vec<[f64; 3]> = (dome.mesh.positions.iter())
+        .map(|p| [1.3 * p[0], p[1] - 0.2 * p[0] * p[0], p[2]])
+        .collect();
     let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
+    let other_arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[0] < 0.3));
+    assert_eq!(arc.mesh.faces, other_arc.mesh.faces);
+    assert_ne!(arc.mesh.anchored, other_arc.mesh.anchored);
     let plain = StressSettings {
         solver: QpSolver::Native,
         q_min: QBound::Relative(0.05),
@@ -592,6 +600,10 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
         q_max: Some(QBound::Relative(1.0)),
         ..plain.clone()
     };
+    let affine = StressSettings {
+        holes: HoleMode::Affine,
+        ..plain.clone()
+    };
     let steps = [
         (&dome, &dome.mesh.positions, &plain),
         (&dome, &lowered, &plain),
@@ -599,6 +611,10 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
         (&arc, &arc.mesh.positions, &plain),
         (&dome, &dome.mesh.positions, &plain),
         (&dome, &lowered, &plain),
+        (&dome, &stretched, &plain),
+        (&arc, &arc.mesh.positions, &plain),
+        (&other_arc, &other_arc.mesh.positions, &plain),
+        (&other_arc, &other_arc.mesh.positions, &affine),
     ];
     let mut cache = stress::StressCache::default();
     for (k, &(problem, positions, settings)) in steps.iter().enumerate() {
