@@ -192,12 +192,14 @@ pub fn analyse_near(
     )
 }
 
-/// What a stress step leaves for the next one on the same mesh: the structure of the native
-/// solver's normal matrix (its fill-reducing ordering and symbolic factorisation), which
-/// depends on the mesh's connectivity and the settings but not on the positions, and the last
-/// answer with its active bounds, and the reduced operator q = S y of the last plan (see
-/// `ReducedOperator`). Opaque; `Default` is empty, and a step of another structure replaces
-/// what it holds.
+/// What a stress step leaves for the next one on the same mesh:
+/// - the structure of the native solver's normal matrix (its fill-reducing ordering and
+///   symbolic factorisation), which depends on the mesh's connectivity and the settings but
+///   not on the positions;
+/// - the last answer with its active bounds;
+/// - the reduced operator q = S y of the last plan (see `ReducedOperator`).
+///
+/// Opaque; `Default` is empty, and a step of another structure replaces what it holds.
 #[derive(Default)]
 pub struct StressCache {
     normal: ipm::PatternCache,
