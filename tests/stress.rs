@@ -579,7 +579,7 @@ fn heights_scaled(mesh: &Mesh, factor: f64) -> Vec<[f64; 3]> {
 /// the same mesh (the solve then starts from the previous step's active set), replaced when
 /// the structure changes (an upper bound adds rows, another mesh), and reused after that.
 /// The reduced operator it keeps is rebuilt whenever the plan, the supports or the hole mode
-/// change, though the structure stays.
+/// change (a moved plan keeps the normal matrix's structure).
 #[test]
 fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     let dome = Problem::new(polar_cap(10, 1.3));

@@ -199,7 +199,8 @@ pub fn analyse_near(
 /// - the last answer with its active bounds;
 /// - the reduced operator q = S y of the last plan (see `ReducedOperator`).
 ///
-/// Opaque; `Default` is empty, and a step of another structure replaces what it holds.
+/// Opaque; `Default` is empty. A step of another structure replaces what it holds, and a step
+/// with another plan, other supports or another hole mode replaces the reduced operator.
 #[derive(Default)]
 pub struct StressCache {
     normal: ipm::PatternCache,
@@ -246,22 +247,45 @@ impl StressCache {
 }
 
 /// The reduced operator of a plan, kept for the next step: it depends on the plan positions,
-/// the connectivity, the supports and the hole mode, not on the heights, so a form finding
-/// without ODT (the default) builds it once. At 100k vertices building it (the hole cuts
-/// included) took 0.11 s a step.
+/// the connectivity, which boundary loops are holes, the supports and the hole mode, not on
+/// the heights, so a form finding without ODT (the default) builds it once. At 100k vertices
+/// building it (the hole cuts included) took 0.11 s a step.
 struct ReducedOperator {
-    u: Vec<[f64; 2]>,
+    u: Vec<[u64; 2]>,
     faces: Vec<[u32; 3]>,
+    outer: Vec<bool>,
     anchored: Vec<bool>,
     holes: airy::HoleMode,
     op: AiryOperator,
 }
 
+/// Plan positions compared bit for bit: the operator is a function of the bits, and
+/// unreferenced vertices may be NaN (never equal to itself).
+fn plan_bits(plan: &Plan) -> Vec<[u64; 2]> {
+    plan.u.iter().map(|u| u.map(f64::to_bits)).collect()
+}
+
+fn outer_loops(mesh: &Mesh) -> Vec<bool> {
+    mesh.loops.iter().map(|l| l.is_outer).collect()
+}
+
 impl ReducedOperator {
+    fn new(mesh: &Mesh, plan: &Plan, holes: airy::HoleMode, op: AiryOperator) -> Self {
+        ReducedOperator {
+            u: plan_bits(plan),
+            faces: mesh.faces.clone(),
+            outer: outer_loops(mesh),
+            anchored: mesh.anchored.clone(),
+            holes,
+            op,
+        }
+    }
+
     fn fits(&self, mesh: &Mesh, plan: &Plan, holes: airy::HoleMode) -> bool {
         self.holes == holes
-            && self.u == plan.u
+            && self.u == plan_bits(plan)
             && self.faces == mesh.faces
+            && self.outer == outer_loops(mesh)
             && self.anchored == mesh.anchored
     }
 }
@@ -521,13 +545,7 @@ pub fn analyse_cached(
         .collect();
     let force_diagram = dual::diagram(mesh, &centres_frame, airy_op.as_ref(), &y, p_bar);
     let reduced_op = airy_op.or_else(|| models[slot(Reduced)].take().and_then(|m| m.0));
-    cache.reduced = reduced_op.map(|op| ReducedOperator {
-        u: plan.u.clone(),
-        faces: mesh.faces.clone(),
-        anchored: mesh.anchored.clone(),
-        holes: settings.holes,
-        op,
-    });
+    cache.reduced = reduced_op.map(|op| ReducedOperator::new(mesh, &plan, settings.holes, op));
 
     let (residuals, horizontal_imbalance) = equilibrium(
         mesh,
@@ -779,5 +797,61 @@ mod tests {
         assert!(!attempt_is_final(Native, NumericalError, large, 0));
         assert!(attempt_is_final(Native, Solved, small, 0));
         assert!(attempt_is_final(Clarabel, Infeasible, large, 1));
+    }
+
+    fn plan_at(mesh: &Mesh, positions: &[[f64; 3]]) -> Plan {
+        Plan::new(mesh, positions, &Frame::of(mesh, positions))
+    }
+
+    /// The kept reduced operator serves steps at other heights, also on meshes with a NaN
+    /// unreferenced vertex, and no other plan, supports or hole mode.
+    #[test]
+    fn the_reduced_operator_is_kept_for_the_same_plan_only() {
+        let dome = crate::generate::dome_with_hole(300).unwrap();
+        let mut positions = dome.positions.clone();
+        positions.push([f64::NAN; 3]);
+        let anchored: Vec<u32> = (0..dome.anchored.len() as u32)
+            .filter(|&v| dome.anchored[v as usize])
+            .collect();
+        let mesh = Mesh::new(positions, dome.faces.clone(), &anchored).unwrap();
+        let problem = Problem::new(mesh);
+        let mesh = &problem.mesh;
+        let settings = StressSettings {
+            solver: QpSolver::Native,
+            ..StressSettings::default()
+        };
+        let mut cache = StressCache::default();
+        analyse_cached(&problem, &mesh.positions, &settings, None, &mut cache).unwrap();
+        let lowered: Vec<[f64; 3]> = (mesh.positions.iter())
+            .map(|p| [p[0], p[1], 0.8 * p[2]])
+            .collect();
+        assert!(plan_at(mesh, &lowered)
+            .u
+            .iter()
+            .flatten()
+            .any(|x| x.is_nan()));
+        let kept = cache.reduced.as_ref().expect("kept after a reduced step");
+        let constant = settings.holes;
+        assert!(kept.fits(mesh, &plan_at(mesh, &lowered), constant));
+        let moved: Vec<[f64; 3]> = (mesh.positions.iter())
+            .map(|p| [p[0] * 1.1, p[1], p[2]])
+            .collect();
+        assert!(!kept.fits(mesh, &plan_at(mesh, &moved), constant));
+        let same = plan_at(mesh, &mesh.positions);
+        assert!(!kept.fits(mesh, &same, airy::HoleMode::Affine));
+        let mut other = mesh.clone();
+        let free = (0..other.anchored.len())
+            .find(|&v| !other.anchored[v])
+            .unwrap();
+        other.anchored[free] = true;
+        assert!(!kept.fits(&other, &same, constant));
+        let mut flipped = mesh.clone();
+        flipped
+            .loops
+            .iter_mut()
+            .for_each(|l| l.is_outer = !l.is_outer);
+        assert!(!kept.fits(&flipped, &same, constant));
+        analyse_cached(&problem, &lowered, &settings, None, &mut cache).unwrap();
+        assert!(cache.reduced.is_some());
     }
 }
