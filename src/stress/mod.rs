@@ -197,14 +197,15 @@ pub fn analyse_near(
 ///   symbolic factorisation), which depends on the mesh's connectivity and the settings but
 ///   not on the positions;
 /// - the last answer with its active bounds;
-/// - the reduced operator q = S y of the last plan (see `ReducedOperator`).
+/// - the reduced operator q = S y of the last plan, with the inputs it was built from (see
+///   `PlanKey`).
 ///
 /// Opaque; `Default` is empty. A step of another structure replaces what it holds, and a step
 /// with another plan, other supports or another hole mode replaces the reduced operator.
 #[derive(Default)]
 pub struct StressCache {
     normal: ipm::PatternCache,
-    reduced: Option<ReducedOperator>,
+    reduced: Option<(PlanKey, AiryOperator)>,
     /// Solve native QPs to `ipm::Tolerances::for_form_finding` (coarse when large).
     coarse: bool,
     /// Whether the last step's answer was solved to coarse optimality.
@@ -246,46 +247,40 @@ impl StressCache {
     }
 }
 
-/// The reduced operator of a plan, kept for the next step: it depends on the plan positions,
-/// the connectivity, which boundary loops are holes, the supports and the hole mode, not on
-/// the heights, so a form finding without ODT (the default) builds it once. At 100k vertices
-/// building it (the hole cuts included) took 0.11 s a step.
-struct ReducedOperator {
+/// What the reduced operator of a step was built from: the plan positions, the connectivity,
+/// which boundary loops are holes, the supports and the hole mode, not the heights. A form
+/// finding without ODT (the default) keeps them, and so builds the operator once (at 100k
+/// vertices it took 0.11 s a step, the hole cuts included). Plan positions are compared bit
+/// for bit: the operator is a function of the bits, and unreferenced vertices may be NaN
+/// (never equal to itself).
+struct PlanKey {
     u: Vec<[u64; 2]>,
     faces: Vec<[u32; 3]>,
     outer: Vec<bool>,
     anchored: Vec<bool>,
     holes: airy::HoleMode,
-    op: AiryOperator,
 }
 
-/// Plan positions compared bit for bit: the operator is a function of the bits, and
-/// unreferenced vertices may be NaN (never equal to itself).
-fn plan_bits(plan: &Plan) -> Vec<[u64; 2]> {
-    plan.u.iter().map(|u| u.map(f64::to_bits)).collect()
-}
-
-fn outer_loops(mesh: &Mesh) -> Vec<bool> {
-    mesh.loops.iter().map(|l| l.is_outer).collect()
-}
-
-impl ReducedOperator {
-    fn new(mesh: &Mesh, plan: &Plan, holes: airy::HoleMode, op: AiryOperator) -> Self {
-        ReducedOperator {
-            u: plan_bits(plan),
+impl PlanKey {
+    fn of(mesh: &Mesh, plan: &Plan, holes: airy::HoleMode) -> PlanKey {
+        PlanKey {
+            u: plan.u.iter().map(|u| u.map(f64::to_bits)).collect(),
             faces: mesh.faces.clone(),
-            outer: outer_loops(mesh),
+            outer: mesh.loops.iter().map(|l| l.is_outer).collect(),
             anchored: mesh.anchored.clone(),
             holes,
-            op,
         }
     }
 
     fn fits(&self, mesh: &Mesh, plan: &Plan, holes: airy::HoleMode) -> bool {
         self.holes == holes
-            && self.u == plan_bits(plan)
+            && self
+                .u
+                .iter()
+                .copied()
+                .eq(plan.u.iter().map(|u| u.map(f64::to_bits)))
             && self.faces == mesh.faces
-            && self.outer == outer_loops(mesh)
+            && self.outer.iter().eq(mesh.loops.iter().map(|l| &l.is_outer))
             && self.anchored == mesh.anchored
     }
 }
@@ -409,12 +404,16 @@ pub fn analyse_cached(
     let slot = |f: Formulation| (f == EdgeBased) as usize;
     let mut best: Option<Attempt> = None;
     let mut clarabel_tries = 0;
+    // The key of a kept reduced operator, stored back with it after the step.
+    let mut kept_key = None;
     for &(solver, formulation, lift_forces, factor) in &attempts {
         if models[slot(formulation)].is_none() {
-            let kept = cache
-                .reduced
-                .take()
-                .filter(|r| formulation == Reduced && r.fits(mesh, &plan, settings.holes));
+            let kept = (cache.reduced.take())
+                .filter(|(key, _)| formulation == Reduced && key.fits(mesh, &plan, settings.holes))
+                .map(|(key, op)| {
+                    kept_key = Some(key);
+                    op
+                });
             models[slot(formulation)] = Some(force_model(
                 mesh,
                 &plan,
@@ -422,10 +421,11 @@ pub fn analyse_cached(
                 formulation,
                 &bounds,
                 &free,
-                kept.map(|r| r.op),
+                kept,
             )?);
         }
-        let (_, s, balance) = models[slot(formulation)].as_ref().expect("built above");
+        let (map, balance) = models[slot(formulation)].as_ref().expect("built above");
+        let s = map.s();
         let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
         let input = qp::QpInput {
             s,
@@ -478,13 +478,18 @@ pub fn analyse_cached(
         regularisation,
     } = best.expect("at least one attempt");
     cache.last_coarse = out.coarse;
-    let (airy_op, s, _) = models[slot(formulation_used)]
+    let (map, _) = models[slot(formulation_used)]
         .take()
         .expect("model of the attempt");
     let status = out.status;
     let usable = status.is_solved() || status == StressStatus::MaxIterations;
-    let y = if usable { out.y } else { vec![0.0; s.ncols] };
-    let q_frame = s.mul(&y);
+    let y = if usable {
+        out.y
+    } else {
+        vec![0.0; map.s().ncols]
+    };
+    let q_frame = map.s().mul(&y);
+    let airy_op = map.airy();
     let tau_frame = if usable { out.tau } else { vec![0.0; n] };
 
     // Back to physical units.
@@ -544,8 +549,11 @@ pub fn analyse_cached(
         })
         .collect();
     let force_diagram = dual::diagram(mesh, &centres_frame, airy_op.as_ref(), &y, p_bar);
-    let reduced_op = airy_op.or_else(|| models[slot(Reduced)].take().and_then(|m| m.0));
-    cache.reduced = reduced_op.map(|op| ReducedOperator::new(mesh, &plan, settings.holes, op));
+    let reduced_op = airy_op.or_else(|| models[slot(Reduced)].take().and_then(|m| m.0.airy()));
+    cache.reduced = reduced_op.map(|op| {
+        let key = kept_key.unwrap_or_else(|| PlanKey::of(mesh, &plan, settings.holes));
+        (key, op)
+    });
 
     let (residuals, horizontal_imbalance) = equilibrium(
         mesh,
@@ -640,9 +648,31 @@ struct Attempt {
     regularisation: f64,
 }
 
-/// The force map q = S y of a formulation and the vertices that need explicit horizontal
-/// balance rows.
-type ForceModel = (Option<AiryOperator>, Csr, Vec<u32>);
+/// The force map q = S y of a formulation: the reduced operator, whose S it is, or the
+/// edge-based selection of the edges that carry force.
+enum ForceMap {
+    Airy(AiryOperator),
+    Selection(Csr),
+}
+
+impl ForceMap {
+    fn s(&self) -> &Csr {
+        match self {
+            ForceMap::Airy(op) => &op.s,
+            ForceMap::Selection(s) => s,
+        }
+    }
+
+    fn airy(self) -> Option<AiryOperator> {
+        match self {
+            ForceMap::Airy(op) => Some(op),
+            ForceMap::Selection(_) => None,
+        }
+    }
+}
+
+/// A formulation's force map and the vertices that need explicit horizontal balance rows.
+type ForceModel = (ForceMap, Vec<u32>);
 
 fn force_model(
     mesh: &Mesh,
@@ -659,13 +689,12 @@ fn force_model(
                 Some(op) => op,
                 None => AiryOperator::new(mesh, plan, holes)?,
             };
-            let s = op.s.clone();
             let balance = free
                 .iter()
                 .copied()
                 .filter(|&v| mesh.on_boundary[v as usize])
                 .collect();
-            (Some(op), s, balance)
+            (ForceMap::Airy(op), balance)
         }
         Formulation::EdgeBased => {
             let mut s = Csr::new(bounds.iter().flatten().count());
@@ -683,7 +712,7 @@ fn force_model(
                 .filter(|&v| mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v]))
                 .map(|v| v as u32)
                 .collect();
-            (None, s, balance)
+            (ForceMap::Selection(s), balance)
         }
     })
 }
@@ -830,7 +859,7 @@ mod tests {
             .iter()
             .flatten()
             .any(|x| x.is_nan()));
-        let kept = cache.reduced.as_ref().expect("kept after a reduced step");
+        let (kept, _) = cache.reduced.as_ref().expect("kept after a reduced step");
         let constant = settings.holes;
         assert!(kept.fits(mesh, &plan_at(mesh, &lowered), constant));
         let moved: Vec<[f64; 3]> = (mesh.positions.iter())
