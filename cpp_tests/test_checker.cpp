@@ -28,8 +28,8 @@ bool mentions(const CheckReport &rep, const std::string &check, const std::strin
 }
 
 // ---------------------------------------------------------------------------------------------
-// Known answers: formula (W) of MATH.md §4, written here in plain C++ (no CGAL), gives q from
-// the weights; the checker's CGAL power centres must agree, and on a convex Airy function
+// Known answers: formula (W) of docs/method.md §5, written here in plain C++ (no CGAL), gives q
+// from the weights; the checker's CGAL power centres must agree, and on a convex Airy function
 // over a convex domain the mesh must be the regular triangulation.
 
 // q on every interior edge from weights w by the closed form (W); 0 on boundary edges.

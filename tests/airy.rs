@@ -1,5 +1,6 @@
-//! MATH §13 items 1 and 2: the closed forms of the reduced operator against force diagrams
-//! built explicitly from power centres, and exact horizontal balance at interior vertices.
+//! docs/method.md §14 items 1 and 2: the closed forms of the reduced operator against force
+//! diagrams built explicitly from power centres, and exact horizontal balance at interior
+//! vertices.
 
 mod common;
 use common::{holed_disk, jiggle, Rng};

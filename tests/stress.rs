@@ -1,6 +1,6 @@
-//! MATH §13 items 3, 4 and 5: the reduced optimum equals the edge-based (VHWP12) optimum, a
-//! 45° cap stands from the stress step alone while a hemisphere does not, and the answer is
-//! invariant under rigid motions and scales with uniform scaling.
+//! docs/method.md §14 items 3, 4 and 5: the reduced optimum equals the edge-based (VHWP12)
+//! optimum, a 45° cap stands from the stress step alone while a hemisphere does not, and the
+//! answer is invariant under rigid motions and scales with uniform scaling.
 
 mod common;
 use common::{holed_disk, load_model, polar_cap, MODELS};

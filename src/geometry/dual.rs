@@ -1,5 +1,5 @@
 //! The force diagram (Maxwell–Cremona dual): one point per face, the gradient of the Airy
-//! function there, which is the power centre of the face's weighted vertices (MATH §4).
+//! function there, which is the power centre of the face's weighted vertices (docs/method.md §5).
 //! An interior edge's dual segment joins its two faces' points; its signed length over the
 //! plan length is the edge's force density.
 

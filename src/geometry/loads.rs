@@ -1,4 +1,4 @@
-//! Vertical loads per vertex (MATH §7): a share of each face's weight plus point loads.
+//! Vertical loads per vertex (docs/method.md §2): a share of each face's weight plus point loads.
 
 use crate::mesh::Mesh;
 

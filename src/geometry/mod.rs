@@ -1,7 +1,8 @@
 //! Plan geometry (cotangents, areas, lengths) in a nondimensional frame, and vertical loads.
 //!
 //! Everything the solvers see is expressed in the frame u' = (u − centre)/L₀, z' = z/L₀ with
-//! L₀ half the plan bounding-box diagonal (MATH §8), so conditioning does not depend on units.
+//! L₀ half the plan bounding-box diagonal (docs/method.md §1), so conditioning does not depend
+//! on units.
 
 pub mod distance;
 pub mod dual;

@@ -1,4 +1,4 @@
-//! Optimal Delaunay Triangulation smoothing of the plan on the 3-D surface (MATH §10).
+//! Optimal Delaunay Triangulation smoothing of the plan on the 3-D surface (docs/method.md §12).
 //!
 //! Each movable vertex goes towards x* = Σ_t |t| c_t / Σ_t |t| (c_t the circumcentre and |t|
 //! the area of the 3-D triangle), one vertex at a time; its height is resampled from the

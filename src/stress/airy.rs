@@ -1,5 +1,5 @@
 //! The reduced operator of de Goes et al.: force densities as a linear map of the Airy values
-//! φ (vertex weights), the hole jumps and the boundary creases, q = S y (MATH §3–6).
+//! φ (vertex weights), the hole jumps and the boundary creases, q = S y (docs/method.md §4–7).
 
 use super::gauge;
 use super::holes::{cut_holes, HoleCut};

@@ -1,4 +1,4 @@
-//! Cuts for the multivalued Airy function on domains with holes (MATH §6).
+//! Cuts for the multivalued Airy function on domains with holes (docs/method.md §7).
 //!
 //! Each hole gets a shortest edge path through interior vertices from its loop to the outer
 //! loop or to a hole cut before it (the cuts form a tree per component), and the set R_h of

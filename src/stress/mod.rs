@@ -1,4 +1,5 @@
-//! Stress optimisation: the best compressive force densities for a fixed shape (MATH §3–8).
+//! Stress optimisation: the best compressive force densities for a fixed shape
+//! (docs/method.md §4–10).
 //!
 //! Both formulations build q = S y for their own unknowns and share one QP (`qp.rs`); the
 //! result is recomputed in physical units from the returned force densities, so every figure
@@ -707,7 +708,7 @@ fn force_model(
                 });
                 col += b.is_some() as usize;
             }
-            // Interior point supports take vertical reactions only (MATH §5).
+            // Interior point supports take vertical reactions only (docs/method.md §6).
             let balance = (0..mesh.positions.len())
                 .filter(|&v| mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v]))
                 .map(|v| v as u32)

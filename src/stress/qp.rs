@@ -1,6 +1,6 @@
-//! The stress QP of MATH §8, shared by the reduced and the edge-based formulations: both give
-//! q = S y for their own unknowns y, and differ only in S and in which vertices need explicit
-//! horizontal balance rows.
+//! The stress QP of docs/method.md §8, shared by the reduced and the edge-based formulations
+//! (§9): both give q = S y for their own unknowns y, and differ only in S and in which vertices
+//! need explicit horizontal balance rows.
 //!
 //!   minimise    ‖r‖² + ε Σ_e (l_e q_e)² + μ Σ_(a,b) (l_a q_a − l_b q_b)²
 //!   subject to  r = G S y − p             (vertical residuals, lifted: keeps the KKT sparse)

@@ -14,7 +14,7 @@ pub enum EdgeScope {
     All,
 }
 
-/// Normal stress at free boundary vertices (MATH §5).
+/// Normal stress at free boundary vertices (docs/method.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum TauMode {
     /// An optimised inward push τ ≥ 0 per free vertex, as the paper does. Non-zero τ means the

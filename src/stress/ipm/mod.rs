@@ -11,7 +11,7 @@
 //! the small curvatures) and iterative refinement against the exact augmented system removes
 //! its effect. In weight space every row a_k and c_i touches a vertex's one-ring, so the
 //! matrix has the two-ring pattern of the mesh: much smaller than a generic conic solver's
-//! KKT system (MATH §8).
+//! KKT system (docs/method.md §8).
 //!
 //! The unknowns are relabelled once in a fill-reducing order (AMD's, or beyond 40k unknowns a
 //! nested dissection by their plan positions: `ordering`), so that no factorisation permutes
