@@ -107,9 +107,8 @@ fn shared_model(dir: &Path, name: &str) -> Option<Problem> {
 }
 
 /// Runs of a stress step timed for its median when one run takes less than a second: at least
-/// `MIN_RUNS`, then more until the runs add up to a second or number `MAX_RUNS` (single runs of
-/// a 10–200 ms step spread by ±30% on the 2-core machine; with five runs, lilium's reduced step
-/// once came out at 0.040 s in one table and 0.028 s in the next, in the same run).
+/// `MIN_RUNS`, then more until the runs add up to a second or number `MAX_RUNS`, because single
+/// runs of a short step spread widely on a shared machine.
 const MIN_RUNS: usize = 5;
 const MAX_RUNS: usize = 21;
 

@@ -105,8 +105,7 @@ fn every_shared_model_converges_with_default_settings() {
         let r = run(name, &Problem::new(mesh));
         certified_after_shape += usize::from(r.history.len() > r.iterations);
         // Every step is the native solver's own answer (four_holes' late, nearly degenerate
-        // QPs ran to the iteration limit and clarabel, 4 of 11 steps, until the directions
-        // that refinement cannot resolve got Krylov cycles).
+        // QPs need the Krylov cycles where refinement cannot resolve a direction).
         assert_eq!(r.solvers.len(), r.iterations, "{name}");
         assert!(
             r.solvers.iter().all(|&s| s == QpSolver::Native),

@@ -210,7 +210,7 @@ fn reduced_equals_edge_based_on_every_real_model() {
 /// The structured interior-point solver reaches the optimum of clarabel (the reference) on
 /// every real model, in both formulations, with plain compression and with the form-finding
 /// bound q_min, and answers itself (four_holes' reduced QPs, with free holes of 4–6
-/// vertices, fell back to clarabel until the Airy gauge was spread over the mesh).
+/// vertices, depend on the Airy gauge being spread over the mesh).
 #[test]
 fn native_solver_equals_clarabel_on_every_real_model() {
     let plain = StressSettings::default();
@@ -498,10 +498,9 @@ fn invalid_settings_are_rejected_by_name() {
 }
 
 /// The native QP's starting point measures every inequality row's slack in the caller's units
-/// (all force densities). Started in the unit-norm scaling instead, a free hole's rim edges,
-/// whose force densities are their own unknowns, began ~1/ℓ² below their optimum and the
-/// iterations spent a dozen short steps letting them grow: this 3.9k-vertex disk took 25
-/// iterations that way, 16 now.
+/// (all force densities): in the unit-norm scaling a free hole's rim edges, whose force
+/// densities are their own unknowns, would start ~1/ℓ² below their optimum and cost a dozen
+/// short steps on this 3.9k-vertex disk.
 #[test]
 fn native_qp_is_not_slowed_by_a_free_hole_rim() {
     let problem = Problem::new(holed_disk(7, 0.0006, |_, outer| outer));
@@ -512,11 +511,8 @@ fn native_qp_is_not_slowed_by_a_free_hole_rim() {
 
 /// Both formulations bound the same force densities, so the native QP starts them from the
 /// same point, built in one unit of force density (`qp::START_UNIT`): they then follow the
-/// same central path and take about as many iterations. With the median row scale as the
-/// unit, the edge-based start (unit rows) pulled every force density 10²–10⁶ times harder
-/// towards its bound than the reduced one, and its iterations crawled: on this disk 13
-/// reduced against 24 edge-based iterations (15 now); on the benchmark's Cas-size dome 14
-/// against 41 (17 now).
+/// same central path and take about as many iterations (with the median row scale as the
+/// unit, the edge-based start would pull every force density far harder towards its bound).
 #[test]
 fn both_formulations_start_alike_and_take_about_as_many_iterations() {
     let problem = Problem::new(holed_disk(3, 0.004, |_, outer| outer));
@@ -529,11 +525,9 @@ fn both_formulations_start_alike_and_take_about_as_many_iterations() {
     );
 }
 
-/// Beyond 20k unknowns the equality rows weigh less (`DELTA_EQ_LARGE`): with weights of 1e6
-/// the edge-based step on this 7k-vertex dome (21k unknowns, two equality rows per free
-/// vertex) stopped at `MaxIterations` (31 iterations), its dual residual held above its
-/// tolerance by the factor's rounding, and the reference formulation could not check the
-/// reduced one at this size (nor at the benchmark's 10k, 50k and 100k).
+/// Beyond 20k unknowns the equality rows weigh less (`DELTA_EQ_LARGE`), so that the factor's
+/// rounding does not hold the dual residual of the edge-based step on this 7k-vertex dome
+/// (21k unknowns, two equality rows per free vertex) above its tolerance.
 #[test]
 fn the_edge_based_step_solves_a_seven_thousand_vertex_dome() {
     let mesh = generate::dome_with_hole(7200).unwrap();

@@ -96,8 +96,8 @@ impl AiryOperator {
                 cols += 1;
             }
         }
-        // Each face asks only the cuts it lies beside: scanning every cut per face took
-        // seconds per stress step with a thousand holes.
+        // Each face asks only the cuts it lies beside, so that a mesh with many holes does
+        // not scan every cut per face.
         let beside = cuts.iter().map(|c| c.right_faces.len()).sum();
         let (face_cut_start, face_cuts) = bucketed(mesh.faces.len(), beside, || {
             (cuts.iter().enumerate())

@@ -1,13 +1,7 @@
 //! The gauge of the Airy function. Affine φ gives q = 0, so φ is pinned to 0 at three
-//! vertices of every component (MATH §3). Any three non-collinear vertices remove that null
-//! space exactly, but not equally well: pinned at one small face, an Airy function that is
-//! affine except at that face, of size L (the mesh's extent) away from it, changes the
-//! force densities only by about h/L of its size (h the edge length), so the normal matrix
-//! has a direction whose curvature is about (h/L)², 1/n, below the rest. Pinned at three
-//! vertices far apart, the same direction must bend by its full size. On the benchmark's
-//! 100k-vertex dome the factor's last pivot, an Airy value, rounded away and derailed the
-//! interior-point iterations, most likely along that direction: with the spread gauge the
-//! same steps converge (docs/performance.md, twentieth session).
+//! vertices of every component (docs/method.md §4). They are spread far apart because pinning
+//! one small face leaves a nearly affine φ whose curvature lies about 1/n below the rest, a
+//! direction the factorisation of a large normal matrix cannot resolve.
 
 use crate::geometry::Plan;
 use crate::mesh::Mesh;

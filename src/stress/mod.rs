@@ -216,13 +216,10 @@ pub struct StressCache {
 impl StressCache {
     /// The cache of a form finding: its QPs beyond 20k unknowns are solved to coarse
     /// optimality (relative gap 1e-3, dual residual 1e-4 of its scale; bounds and equality
-    /// rows held as tightly as ever). The loop stops on residuals recomputed from forces and
-    /// heights, which an inexact optimum does not falsify; exact QPs were most of a large
-    /// loop's time, and their dual residual is what stalled (100k-vertex dome: 30 steps and
-    /// 507 s exact, 23 steps and 215 s coarse, the same Hausdorff distance 0.0019). Below 20k
-    /// unknowns nothing changes: there coarse steps moved cheese's loop to 20–22 steps and a
-    /// farther shape, and on four_holes (degenerate QPs) a coarse native answer stalled the
-    /// loop where clarabel's exact one converges.
+    /// rows held as tightly as ever), because the loop stops on residuals recomputed from
+    /// forces and heights, which an inexact optimum does not falsify, while exact QPs are most
+    /// of a large loop's time. Below 20k unknowns QPs stay exact, since there coarse answers
+    /// lengthen the loop or stall it on degenerate QPs.
     pub fn for_form_finding() -> StressCache {
         StressCache {
             coarse: true,
@@ -232,11 +229,8 @@ impl StressCache {
 
     /// Tells the next step whether its shape is far from balance (form finding: ε∞ > 0.1
     /// with the last forces at the new heights). Beyond 20k unknowns such a step does not try
-    /// the last answer's active set: a height step there moves much of the shape, the set is
-    /// wrong in hundreds of rows and the failed attempt costs several factorisations. Counted
-    /// over form findings of the nine shared models and generated 20k and 50k domes, such
-    /// attempts succeeded 3 times in 60 (50k: none of 10, 0.3–0.6 s each), those nearer
-    /// balance 42 times in 61.
+    /// the last answer's active set, because a height step there moves much of the shape, the
+    /// set is wrong in hundreds of rows and the failed attempt costs several factorisations.
     pub fn far_from_balance(&mut self, far: bool) {
         self.normal.far_from_balance(far);
     }
@@ -250,10 +244,9 @@ impl StressCache {
 
 /// What the reduced operator of a step was built from: the plan positions, the connectivity,
 /// which boundary loops are holes, the supports and the hole mode, not the heights. A form
-/// finding without ODT (the default) keeps them, and so builds the operator once (at 100k
-/// vertices it took 0.11 s a step, the hole cuts included). Plan positions are compared bit
-/// for bit: the operator is a function of the bits, and unreferenced vertices may be NaN
-/// (never equal to itself).
+/// finding without ODT (the default) keeps them, and so builds the operator once. Plan
+/// positions are compared bit for bit: the operator is a function of the bits, and
+/// unreferenced vertices may be NaN (never equal to itself).
 struct PlanKey {
     u: Vec<[u64; 2]>,
     faces: Vec<[u32; 3]>,
@@ -784,10 +777,9 @@ pub fn equilibrium(
 
 /// Whether an attempt's answer ends the list of attempts in `analyse_cached`.
 /// - Native: only a converged answer stands (at reduced accuracy it can sit at a point that
-///   is not optimal: four_holes), except on large problems, where the fallback would take
-///   many minutes: there an answer at reduced accuracy, at the iteration limit or where the
-///   iterations stalled is kept and reported as such (at 100k vertices a form-finding step
-///   whose native iterations stalled at the limit then ran in clarabel for over 20 minutes).
+///   is not optimal), except on large problems, where the fallback would take many minutes:
+///   there an answer at reduced accuracy, at the iteration limit or where the iterations
+///   stalled is kept and reported as such.
 /// - Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other form
 ///   of the same problem, then keep the better. Numerical failure: go down the list.
 fn attempt_is_final(

@@ -451,17 +451,9 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
 /// The interior-point start's slack unit, in multiples of the median ℓ_e² over the edges with
 /// a bound (`slack_unit`): the start's constraint term is then (START_UNIT × median ℓ²)² Σ
 /// (q − bound)² / `START_PENALTY`, one common factor, alike in both formulations, which bound
-/// the same force densities.
-///
-/// With the median row scale as the unit (`ipm::caller_units`'s default) the start depended on
-/// the unknowns: the reduced rows' median scale is 0.001–0.11 (0.5–1.9 times this unit) on the
-/// nine shared models and the benchmark's domes, the edge-based unit rows' 1.24–1.30 whatever
-/// the mesh, so the edge-based start pulled every force density 10²–10⁶ times harder towards
-/// its bound, and its iterations crawled. Measured with this unit (QP iterations reduced /
-/// edge-based, before → after): the Cas-size dome 14/41 → 14/17, the dome with a hole 12/26 →
-/// 12/15, lilium 13/19 → 14/15, four_holes 20/21 → 15/18, free_vault 10/11 → 10/14; the nine
-/// models' reduced steps 138 iterations in all → 135, their edge-based ones 155 → 148. With 5
-/// and 20 instead of 10: reduced 147 and 142, edge-based 140 and 142.
+/// the same force densities. The median row scale (`ipm::caller_units`'s default) would make
+/// the start depend on the unknowns, and start the edge-based formulation's force densities
+/// far nearer their bounds than the reduced one's.
 const START_UNIT: f64 = 10.0;
 
 /// The QP's slack unit for the interior-point start: `START_UNIT` times the median ℓ_e² of

@@ -5,10 +5,7 @@
 //! inside each, which on these factors was slower than one thread. The dense kernels here
 //! are faer's: the LDLᵀ of each supernode's diagonal block (with faer's dynamic
 //! regularisation), the triangular solve below it and the products of the updates.
-//!
-//! On one thread this code takes faer's time (the 100k dome: 255 against 260 ms a
-//! factorisation); on two, 164 ms with AMD's order and 121–126 ms with the nested
-//! dissection's (`ordering`). Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
+//! Smaller factors (`FACTOR_SPLIT_FROM`) keep faer's factorisation.
 
 use super::supernodal::{both, owners, Split};
 use crate::stress::sparse::bucketed;
@@ -28,8 +25,7 @@ pub(super) const TINY_PIVOT: f64 = 1e-14;
 pub(super) const HUGE_PIVOT: f64 = 1e20;
 
 /// Updates with fewer multiply-adds than this are done by plain loops: faer's matrix product
-/// costs more to dispatch than the arithmetic of the many small supernodes (chosen, not
-/// tuned: 0 gave the same time a factorisation at 100k).
+/// costs more to dispatch than the arithmetic of the many small supernodes.
 const LOOPS_BELOW: usize = 4096;
 
 /// The supernodal structure the factorisation reads, and for every supernode the earlier

@@ -97,15 +97,10 @@ impl Kkt {
 }
 
 /// The dual residual is accepted within this many ulps of the largest sum of absolute terms
-/// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding. Weights and Airy values can be
-/// 10⁶–10⁷ in the scaled unknowns while P x is O(1) (100k-vertex form finding: Σ|P||x| 1.75e7
-/// against |P x| 2.7), and the residual then hovered at 0.5–1.5 ulps of those terms, 2–4×
-/// above the relative tolerance, for 50 iterations. Where the optimum is flat along some
-/// unknowns the iterates drift along them with the solves' rounding: free_vault's QP with
-/// q_min, solved with the supernodal solve's rounding instead of faer's (equal backward
-/// errors), drifted one Airy value from 8e3 to 7e4 and stalled at 35–40 ulps: with 10 it took
-/// 80 iterations and clarabel, with 100 it takes 11 (12 with faer's rounding and 10). 100
-/// ulps is still a backward error of 2e-14.
+/// in a row of P x + c − Eᵀλ − Gᵀz: below that it is rounding, because weights and Airy values
+/// can be 10⁶–10⁷ in the scaled unknowns while P x is O(1), and where the optimum is flat the
+/// iterates drift along it with the solves' rounding (100 ulps is still a backward error of
+/// about 2e-14).
 pub(super) const DUAL_ROUNDING: f64 = 100.0;
 
 /// Iterations without progress after which `Progress` declares a stall.
@@ -114,12 +109,8 @@ pub(super) const STALL_WINDOW: u32 = 10;
 /// Whether the iterations still make progress: the residuals halving or the gap falling
 /// tenfold (against where they stood at the last such progress) within `STALL_WINDOW`
 /// iterations. Only beyond 20k unknowns is a stall an exit (`fallback_is_costly`: the caller
-/// then keeps the answer at hand): there form-finding steps whose directions had gone inexact
-/// kept the dual residual near 1e-4, 2700× its tolerance, from their 12th iteration to the
-/// 150-iteration limit, with no tenfold fall of the gap in the 60 iterations after the 36th.
-/// Stopped by a stall at 19 iterations, the 100k dome's 13th step balanced the shape as well
-/// as at 150 (ε∞ 0.1612 against 0.1614) in 11 s instead of 71 s; a window of 20 stopped it at
-/// 55 (28 s), and the whole 100k form finding took 785 s with it against 508 s with 10.
+/// then keeps the answer at hand), because there iterations whose directions have gone
+/// inexact can crawl to the iteration limit without improving the answer.
 pub(super) struct Progress {
     pub(super) reference: [f64; 2],
     pub(super) since: u32,

@@ -107,17 +107,11 @@ pub struct Tolerances {
 impl Tolerances {
     /// The defaults adapted to `n` unknowns.
     /// - The dual tolerance grows as √(n / 10⁴) from 10⁴ unknowns on, besides its rounding
-    ///   floor (`DUAL_ROUNDING`): at 100k unknowns form-finding steps whose residual hovered
-    ///   1–3× above 1e-10 of its scale stayed above the floor as well, and without the growth
-    ///   they fell back to clarabel. A flat 1e-9 let four_holes stop 0.2% above its optimum.
-    /// - The iteration budget: the fallback (clarabel) costs about what 100 native iterations
-    ///   do at a thousand unknowns but thousands at 20k and more (a 20k-vertex QP: 2 s
-    ///   native, 120 s clarabel), so large problems get more (see `fallback_is_costly`).
-    /// - Beyond 20k unknowns one centrality corrector per iteration instead of three: each
-    ///   costs a solve with a large factor. The benchmark's 100k dome: 23 iterations and
-    ///   13.0 s instead of 26 and 17.1 s; 50k: 21 and 5.44 s instead of 20 and 5.58 s. At
-    ///   the paper's sizes one corrector was neither faster nor slower (±3%: barrel, lilium,
-    ///   cheese, dome with doors, free_vault, the Cas-size dome), so they keep three.
+    ///   floor (`DUAL_ROUNDING`), because the rounding of larger factors grows too.
+    /// - The iteration budget is larger beyond 20k unknowns, where the fallback (clarabel)
+    ///   costs thousands of native iterations (see `fallback_is_costly`).
+    /// - Beyond 20k unknowns one centrality corrector per iteration instead of three, because
+    ///   each costs a solve with a large factor.
     pub fn for_size(n: usize) -> Tolerances {
         let base = Tolerances::default();
         let large = fallback_is_costly(n);
@@ -136,11 +130,6 @@ impl Tolerances {
     /// horizontally as an exact one. A relative gap g leaves the residual vector within √(2g)
     /// (4.5%) of the optimum's in norm. There exact QPs are most of the loop's cost and their
     /// dual residual is what stalls.
-    ///
-    /// With `for_size`'s one centrality corrector: measured on the generated domes' whole
-    /// form findings (one run each), 50k with 0, 1, 2 and 3 correctors 58.0, 51.7–53.4, 58.5
-    /// and 61.5–62.9 s (17 steps each); 100k with 1 and 3, 164.9 s (24 steps) and 187.7 s
-    /// (23 steps).
     pub fn for_form_finding(n: usize) -> Tolerances {
         let exact = Tolerances::for_size(n);
         if !fallback_is_costly(n) {
@@ -155,8 +144,8 @@ impl Tolerances {
 }
 
 /// Whether clarabel, the fallback, costs thousands of native iterations on a QP with `n`
-/// unknowns (a 20k-vertex QP: 2 s native, 120 s clarabel; at 100k a form-finding step ran
-/// for more than 10 minutes in clarabel where the native method had taken 20–75 s).
+/// unknowns: its generic KKT factorisation grows much faster with size than the two-ring
+/// normal matrix does.
 pub fn fallback_is_costly(n: usize) -> bool {
     n > 20_000
 }
@@ -171,9 +160,8 @@ impl Default for Tolerances {
             feas: 1e-10,
             dual_feas: 1e-10,
             almost: 10.0,
-            // Well-posed problems converge in 11–40 iterations (form-finding steps at 100k
-            // unknowns took up to 130); beyond, the caller's fallback is cheaper than crawling
-            // on: see `for_size`.
+            // Well-posed problems converge well within this; beyond, the caller's fallback is
+            // cheaper than crawling on (see `for_size`).
             max_iter: 80,
             correctors: 3,
         }
@@ -189,16 +177,12 @@ const CORRECTOR_ADD: f64 = 0.1;
 /// An iteration's direction gets Krylov cycles (`Newton::refine`) when refinement leaves
 /// its x rows an error above this fraction of the dual residual it is to remove, or above
 /// the dual tolerance, whichever is larger: the step would leave that residual where it is.
-/// On four_holes' late form-finding QPs, refinement stalled with the x rows' error as large
-/// as the residual itself, the dual residual stayed at 8–130 times its tolerance for 60
-/// iterations, and the QPs ran to the iteration limit and clarabel. Not beyond 20k unknowns
-/// (`fallback_is_costly`): there a cycle costs about a second, and on the 100k dome's
-/// edge-based step the errors that called for one were at the solves' rounding: 9 of 13
-/// cycles raised the error, and the step took 39 iterations and 33 s instead of 31 and 22 s.
+/// Not beyond 20k unknowns (`fallback_is_costly`), where a cycle is expensive and the errors
+/// that call for one are the solves' own rounding, which cycles cannot remove.
 const KRYLOV_GOAL: f64 = 0.1;
 
-/// Fraction of the way to the boundary of the positive orthant taken by each step (0.995
-/// lost the last digits the 50k-vertex dome needs and fell back to clarabel).
+/// Fraction of the way to the boundary of the positive orthant taken by each step: closer to
+/// 1 loses the last digits that large QPs need.
 const STEP_FRACTION: f64 = 0.99;
 
 fn inf_norm(x: &[f64]) -> f64 {
@@ -275,12 +259,10 @@ fn unit_rows(m: &Csr, col: &[f64]) -> Vec<f64> {
 /// Per inequality row, the factor that turns its scaled slack back into the caller's units,
 /// times `unit` (by default the median row scale). The starting point is built in those units:
 /// the stress QPs' rows bound force densities (and τ), commensurate as the caller states them,
-/// while the unit-norm scaling measures a boundary edge's force density (its own unknown) about 1/ℓ²
-/// times larger than an interior edge's (a combination of Airy values). Mehrotra's uniform
-/// shift in the scaled units then started the boundary edges' slacks hundreds of times below
-/// their optimum (Cas-size dome: 65 against 3600; 50k: against 55 000), and the iterations
-/// spent 15 steps of 0.2–0.7 letting them grow. The iterates are otherwise invariant to the
-/// row scaling, which stays for the linear algebra.
+/// while the unit-norm scaling measures a boundary edge's force density (its own unknown) about
+/// 1/ℓ² times larger than an interior edge's (a combination of Airy values), so that a uniform
+/// shift in the scaled units would start the boundary edges' slacks far below their optimum.
+/// The iterates are otherwise invariant to the row scaling, which stays for the linear algebra.
 ///
 /// `unit` sets the weight of the starting point's constraint term (`START_PENALTY`) in the
 /// caller's units. The median row scale depends on the unknowns: the stress QPs pass their
@@ -423,11 +405,7 @@ impl Relabelled {
 
 /// Weight 1 / START_PENALTY of the constraint term of the starting point's problem. CVXOPT's
 /// weight 1 pulls every force density towards its bound, so that nearly every constraint
-/// starts out looking active; measured on generated domes with a hole (with the start still in
-/// the unit-norm row scaling, before `caller_units`), 100 took the iterations
-/// from 29 to 22 at 6k unknowns, 34 to 31 at 20k, 46 to 34 at 50k and 79 to 39 at 100k, and
-/// cost the shared models 0 to 6 more (11–25 in all). 10 and 1000 did less well at 100k; 30
-/// left free_vault's dual residual 5× above its tolerance (it fell back to clarabel).
+/// starts out looking active and large QPs need many more iterations.
 const START_PENALTY: f64 = 100.0;
 
 /// The interior-point iterations on a QP whose unknowns are in `normal`'s labels; the

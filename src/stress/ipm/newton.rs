@@ -11,21 +11,15 @@ use faer::{Conj, MatMut, Par};
 
 /// Regularisation δ of the constraint rows (scaled units): inequality weights z/s are capped
 /// near 1/δ, equality rows weigh 1/δ_eq. Larger weights would lose the small curvatures to
-/// rounding; refinement removes the regularisation's effect on the solution. With 1e-8 the
-/// 100k-vertex dome stalled at a dual residual near 1e-8 (and fell back to clarabel); 1e-10
-/// failed already at 6k.
+/// rounding; refinement removes the regularisation's effect on the solution, and smaller δ
+/// let rounding stall the dual residual of large QPs.
 pub(super) const DELTA: f64 = 1e-7;
 pub(super) const DELTA_EQ: f64 = 1e-6;
 
 /// δ_eq beyond 20k unknowns (`fallback_is_costly`), in every Newton system of such a QP (the
-/// start, the iterations, polishing). There the factor's rounding, amplified by
-/// equality weights of 1e6, set a floor on the dual residual above its tolerance wherever
-/// equality rows are many: the edge-based steps on the benchmark's domes with a hole (two
-/// rows per free vertex) stopped at `MaxIterations` at 10k, 50k and 100k vertices (46, 28 and
-/// 29 iterations, the dual residual stuck at 30× its tolerance at 10k), and are `Solved` with
-/// 1e-4 (18, 25 and 31; 1e-5 solved 10k but not 50k). The reduced steps there, with equality
-/// rows only on the hole's rim, take the same 20 iterations at 50k. Below 20k unknowns 1e-5
-/// and 1e-4 gave the nine shared models' reduced steps 1 and 4 more iterations in all.
+/// start, the iterations, polishing): there the factor's rounding, amplified by equality
+/// weights of 1e6, would hold the dual residual above its tolerance wherever equality rows
+/// are many (the edge-based formulation's two rows per free vertex).
 pub(super) const DELTA_EQ_LARGE: f64 = 1e-4;
 
 /// Static regularisations of the normal matrix tried in turn until the factor is sound.
@@ -288,9 +282,8 @@ impl<'a> Newton<'a> {
         (e1, e2, inf_norm(&px).max(inf_norm(&ct_w)))
     }
 
-    /// K sol = (P dx + Cᵀ w, C dx − D w). (Summed in another order than `error`: it serves
-    /// only the Krylov cycles, below 20k unknowns; `error`'s order is the one the 100k
-    /// trajectories were measured with.)
+    /// K sol = (P dx + Cᵀ w, C dx − D w), summed in its own order, since only the Krylov
+    /// cycles use it and `error`'s order fixes the rounding of everything else.
     fn product(&self, [dx, w]: &[Vec<f64>; 2]) -> [Vec<f64>; 2] {
         let n = self.normal.pattern.n;
         let px = self.normal.mul_p(dx);
@@ -369,11 +362,9 @@ impl<'a> Newton<'a> {
                 break;
             }
         }
-        // A cycle minimises the whole scaled error, and the x rows' part can rise on the way
-        // (four_holes: 3.5e-8 → 1.8e-7 → 6e-12 over two cycles): the cycles' answer is taken
-        // if its x rows' error is no larger than refinement's or within the bound that made
-        // refinement's answer sound (once in four_holes' loop it was 12 times refinement's
-        // and 2.5 times that bound).
+        // A cycle minimises the whole scaled error, so the x rows' part can rise on the way:
+        // the cycles' answer is taken only if its x rows' error is no larger than
+        // refinement's or within the bound that made refinement's answer sound.
         if let Some(current) = current.filter(|_| e_x <= start_x.max(sound)) {
             *sol = current;
         }

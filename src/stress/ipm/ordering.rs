@@ -1,12 +1,8 @@
 //! A nested-dissection ordering of the normal matrix for large QPs, from the plan positions
 //! of its unknowns. Cut by straight lines, the mesh falls into halves, quarters and so on:
 //! independent subtrees of the elimination tree, which two threads factor at once
-//! (`factorise`), in a factor that needs less work than with AMD's order. On the 100k-vertex
-//! dome (one analysis each, the same code otherwise): 4.5e9 multiply-adds (Σ (nrows − j)²
-//! over the supernodes' columns) against 6.7e9, 2.6e9 of them in sequence with two threads
-//! against 3.9e9, and 121–126 against 164 ms a factorisation; the ordering takes about
-//! 0.3 s against AMD's 0.1 s, once per form finding. (METIS's nested dissection, through
-//! pymetis, reached 3.6e9 multiply-adds in 0.7 s, and would be a C dependency.)
+//! (`factorise`), in a factor that needs less work than with AMD's order; written here
+//! rather than taken from METIS so that the library has no C dependency.
 //!
 //! A part is cut by the line that leaves the fewest unknowns next to it among a few
 //! directions and offsets; its near side's unknowns coupled to the far side are the
@@ -16,14 +12,14 @@
 use super::pattern::{amd_labels, entries};
 use crate::stress::sparse::bucketed;
 
-/// Parts of up to this many unknowns are ordered by minimum degree (`order_leaf`; with AMD
-/// on the 100k dome, 256 gave the least work of 16, 64, 256, 1000, 5000 and 30000).
+/// Parts of up to this many unknowns are ordered by minimum degree (`order_leaf`): the leaf
+/// size that gave the least factorisation work on large domes.
 const LEAF: usize = 256;
 
 /// Parts of at least this many unknowns try `DIRECTIONS` directions of cut and `OFFSETS` + 1
 /// offsets in each, from `BALANCE` of the part to 1 − `BALANCE`; smaller parts are cut across
-/// their principal axis at the median. On the 100k dome adding the search took the work from
-/// 6.1e9 to 4.9e9 multiply-adds; a balance of 0.35 or 0.3, or 16 directions, did no better.
+/// their principal axis at the median. The search pays on large parts, where a better cut
+/// saves much factorisation work.
 const SEARCH_FROM: usize = 500;
 const DIRECTIONS: usize = 8;
 const OFFSETS: usize = 10;
@@ -57,8 +53,7 @@ pub(super) fn nested_dissection_labels(
 /// The labels of the elimination order `order` (unknowns in order), renumbered in a
 /// postorder of its elimination tree: the same fill, with each subtree's columns contiguous,
 /// so that chains of columns merge into supernodes (the leaves' minimum-degree orders are
-/// not postordered; on the 100k dome 11.8k supernodes against 30.5k, though faer's merging
-/// of small supernodes then stores 15.5M values against 14.9M).
+/// not postordered).
 fn postordered(order: &[usize], adj_ptr: &[usize], adj: &[usize]) -> Vec<usize> {
     let n = order.len();
     let mut label = vec![0; n];

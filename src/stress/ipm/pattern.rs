@@ -57,7 +57,7 @@ pub struct PatternCache {
 impl PatternCache {
     /// Whether the next QP's shape is far from balance (see `StressCache::far_from_balance`).
     /// Only beyond 20k unknowns is the last active set then skipped: below, a failed attempt
-    /// costs milliseconds and a successful one can spare a fallback to clarabel (free_vault).
+    /// costs milliseconds and a successful one can spare a fallback to clarabel.
     pub fn far_from_balance(&mut self, far: bool) {
         self.far_from_balance = far;
     }
@@ -149,8 +149,8 @@ pub(super) fn product_pattern(rows: [&Csr; 2], n: usize) -> (Vec<usize>, Vec<usi
 
 /// The slot in a relabelled lower-triangle pattern of every product `products(m)` visits, in
 /// its order. Per row, the labels are sorted so that one forward scan of each column finds
-/// all the row's later labels: a binary search per product mispredicted most of its branches
-/// (20 of the 35 ms the 6k-vertex row's pattern took).
+/// all the row's later labels, where a binary search per product would mispredict most of
+/// its branches.
 pub(super) fn product_slots(
     m: &Csr,
     label: &[usize],
@@ -192,8 +192,7 @@ pub(super) fn product_slots(
 
 /// QPs with this many unknowns or more are ordered by nested dissection when their
 /// unknowns' positions are known (`ordering`). Below, AMD's order needs less work and two
-/// threads still factor it well (20k vertices: 20.4 against 19.2 ms a factorisation with the
-/// dissection's order, whose factor holds 2.76M values against 2.45M).
+/// threads still factor it well.
 const DISSECT_FROM: usize = 40_000;
 
 /// The new label of every unknown in the approximate-minimum-degree order of a symmetric

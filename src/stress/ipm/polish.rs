@@ -22,16 +22,12 @@ pub(super) struct Point<'a> {
 pub(super) enum Corrections {
     /// From an iterate's guess: a few rows, up to `POLISH_ROUNDS` times; more wrong rows
     /// than a share 1 / `POLISH_CORRECTABLE` of the active ones mean dependent active rows
-    /// or an early guess, and further rounds only chased them (cheese: each round made more
-    /// rows wrong).
+    /// or an early guess, which further rounds would only chase.
     Few,
     /// From the previous form-finding step's active set (a primal–dual active-set method):
     /// every wrong row, up to `WARM_ROUNDS` times, while their number at least halves each
-    /// round. Between late steps tens to hundreds of rows change, mostly bounds to release:
-    /// on the Cas-size dome and lilium the last 6–7 steps converged this way in 1–4 rounds
-    /// (Cas: 234 → 25 → 10 → 1 wrong rows), while on early steps the count fell by less
-    /// than half or grew from the second round on, and an attempt then costs two
-    /// factorisations.
+    /// round, because between late steps tens to hundreds of rows change, and a count that
+    /// stops halving marks an early step where the attempt only costs factorisations.
     AllWhileFewer,
 }
 pub(super) const POLISH_ROUNDS: usize = 3;
@@ -45,32 +41,26 @@ pub(super) const WARM_ROUNDS: usize = 8;
 /// (each costs a factorisation and several solves).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum PolishFailure {
-    /// The guess had more wrong rows than a round may correct, or kept finding new ones. One
-    /// more iteration usually settles it (lilium, groin), and where the gap stalls at its
-    /// rounding floor (the last form-finding steps on cheese, objective ~0) a later guess
-    /// is the way out: retried at the next iteration.
+    /// The guess had more wrong rows than a round may correct, or kept finding new ones:
+    /// retried at the next iteration, because one more iteration usually settles it and,
+    /// where the gap stalls at its rounding floor, a later guess is the way out.
     EarlyGuess,
     /// No row was wrong, yet the step missed the tolerances (or its solve failed), also when
     /// retried without the rows that wholly active groups imply: the active set is right but
-    /// the factor cannot resolve it that finely. At 100k unknowns, before that retry, this
-    /// repeated at every iteration from the 21st to the 27th: retried only once the gap has
-    /// fallen by `INEXACT_RETRY`.
+    /// the factor cannot resolve it that finely: retried only once the gap has fallen by
+    /// `INEXACT_RETRY`, since the next iteration's guess would fail the same way.
     Inexact,
 }
 
-/// After an `Inexact` failure, the factor by which the gap must fall before the next attempt
-/// (at 100k, from the gaps measured there: attempts at iterations 20, 21, 23, 25 and 27
-/// instead of every one from 20 to 27; 41 → 37 factorisations, as counted).
+/// After an `Inexact` failure, the factor by which the gap must fall before the next attempt,
+/// so that hopeless attempts do not cost a factorisation every iteration.
 pub(super) const INEXACT_RETRY: f64 = 1e-2;
 
 /// A polishing round is given up before its refinement when the unrefined step is wrong in
 /// more than this many times the rows the round may correct, counted as at least
-/// `MIN_CORRECTABLE` (a warm round allowed no wrong row saw one unrefined that refinement
-/// removed, on lilium). Failed attempts had refined their step in full first; traced on
-/// lilium's form finding the unrefined steps of those given up showed 18–33 wrong rows
-/// against 24–50 refined (3 correctable), and the nine shared models' reports stayed
-/// bit-identical. A step from a factor that refinement would have found unsound is judged
-/// the same way, as an early guess.
+/// `MIN_CORRECTABLE` (an unrefined step may show a wrong row that refinement removes), since
+/// refining a step that far off costs solves and cannot save the guess. A step from a factor
+/// that refinement would have found unsound is judged the same way, as an early guess.
 pub(super) const HOPELESS: usize = 4;
 
 /// The optimum for the active set `guess` (see `active_guess`: inequalities with z > s held
@@ -103,8 +93,8 @@ pub(super) fn polish(
     let mut last_wrong = usize::MAX;
     // The answer is the point with the active rows on their bounds: their computed slack
     // (rounding of differences of large Airy values) is an inequality residual, held to its
-    // tolerance, not complementarity. Counted in the gap it kept right active sets from
-    // being accepted (50k-vertex dome: the gap 3-11x its tolerance, the dual residual within).
+    // tolerance, not complementarity, because counted in the gap it would keep right active
+    // sets from being accepted.
     let kkt_of = |step: &PolishStep, active: &[bool]| {
         let s_new: Vec<f64> = (step.slack.iter().zip(active))
             .map(|(&s, &a)| if a { 0.0 } else { s.max(0.0) })
@@ -154,9 +144,8 @@ pub(super) fn polish(
         let wrong = wrong_rows(&step, &kkt, &active);
         if wrong.is_empty() {
             // The right active set, missed by the factor's accuracy: where whole groups of
-            // dependent rows are active, held without two rows each (at 100k the polished
-            // dual residual then came out 8-90x smaller, and the step ended at 26 iterations
-            // instead of 28).
+            // dependent rows are active, retried without two rows each, because rounding
+            // along those dependent combinations is amplified by 1/δ.
             if qp.groups.any_wholly_active(&active) {
                 let never = |_: &PolishStep| false;
                 let step =

@@ -1,14 +1,8 @@
-//! Solves with a supernodal LDLᵀ factor, one right-hand side, in place. faer's solve
-//! dispatches a dense triangular solve and a matrix–vector product for every supernode; on
-//! the small supernodes of QPs with up to a few thousand unknowns that dispatch costs more
-//! than the arithmetic, and plain loops over each supernode's columns are faster (scratch
-//! medians, own against faer's: barrel 6.97 against 7.70 ms, lilium 26.9 against 28.0 ms,
-//! cheese 141 against 154 ms). Factors too large for the cache are read downwards by the
-//! backward solve (`DOWNWARDS_FROM`), which makes these loops faster at every size (50k
-//! unknowns: 8.7 against 13.1 ms a solve, 100k: about 21 against 30 ms). Until the gauge was
-//! spread (`stress::gauge`), their other rounding took the 100k step onto a trajectory that
-//! froze a pivot, so faer's solve was kept beyond 20k unknowns. Factors of more than
-//! `SPLIT_FROM` values are solved on two threads (`Split`).
+//! Solves with a supernodal LDLᵀ factor, one right-hand side, in place: plain loops over each
+//! supernode's columns, because faer's solve dispatches dense kernels per supernode, which on
+//! the few-column supernodes of small QPs costs more than the arithmetic. Factors too large
+//! for the cache are read downwards by the backward solve (`DOWNWARDS_FROM`), and those of
+//! more than `SPLIT_FROM` values are solved on two threads (`Split`).
 
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
@@ -227,18 +221,12 @@ pub(super) fn both<A: Send, B>(
 }
 
 /// Factors with more values than this are solved on two threads where the machine has them
-/// (`Split`): from about 40k vertices. Timed within one run on the same factors (the 100k
-/// dome's 17M values: 25.2 against 20.3 ms a solve; 50k, 7.7M: 11.5 against 8.9 ms), short
-/// of the 1.5× the split allows (reading the factor from memory is shared). Below, the
-/// threads' start and the copies of x would cost more than they save, and the shared
-/// models' rounding stays as it was.
+/// (`Split`): from about 40k vertices; below, the threads' start and the copies of x cost
+/// more than they save.
 pub(super) const SPLIT_FROM: usize = 1 << 22;
 
 /// Factors with more values than this are factored on two threads (`factorise`): from about
-/// 10k vertices. Measured on the generated domes with a hole, one analysis each, time in
-/// factorisations over their number: 10k vertices (1.07M values) 12.4 → 7.4 ms, 20k 26.6 →
-/// 20.4 ms (AMD's order both); 6k (0.57M) only 4.8 → 4.1 ms, and the shared models keep
-/// faer's factorisation and its rounding. At 100k see `factorise`.
+/// 10k vertices, where the second thread saves more than it costs to start.
 pub(super) const FACTOR_SPLIT_FROM: usize = 1 << 20;
 
 /// At most this many subtrees are expanded into their children in search of a balanced
@@ -248,9 +236,7 @@ const MAX_EXPANSIONS: usize = 64;
 /// A division of a factor's supernodes into two branches, each a set of whole subtrees of
 /// its elimination tree, and the stem, the rest: the branches can be solved or factored at
 /// the same time. The solves with large factors are limited by reading them from memory,
-/// which two cores do faster than one. On the 100k dome's factor (the dissection's order)
-/// the more loaded branch and the stem hold 54% of its values and 59% of its
-/// factorisation's multiply-adds.
+/// which two cores do faster than one.
 pub(super) struct Split {
     pub(super) branches: [Vec<usize>; 2],
     pub(super) stem: Vec<usize>,
@@ -265,9 +251,8 @@ pub(super) fn owners(begin: &[usize], end: &[usize], n: usize) -> Vec<usize> {
     owner
 }
 
-/// Whether the machine runs two threads at once. Asked once per process: the answer reads the
-/// cgroup files, which cost 1% of a small stress step when asked for every QP (the barrel row,
-/// 336 vertices, profiled).
+/// Whether the machine runs two threads at once, asked once per process because the answer
+/// reads cgroup files, too slow to ask on every small QP.
 fn two_threads() -> bool {
     static TWO: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     *TWO.get_or_init(|| std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2))
@@ -421,15 +406,9 @@ fn four_sums<'a>(
 }
 
 /// Factors with more values than this are read downwards by the backward solve
-/// (`dot_downwards`), one descending stream the prefetcher follows. The backward solve visits
-/// supernodes downwards and, with `dot`, reads each column upwards: on the 100k dome's factor
-/// (17M values) that took 20 ms against 9 ms for the forward pass over the same memory, and
-/// 11 ms read downwards. Measured on the generated domes (one step each, three interleaved
-/// runs): 10k unknowns (1.07M values) 0.48–0.53 → 0.46–0.49 s, 20k (2.4M) 1.34–1.49 →
-/// 1.17–1.31 s, with the same iterations. Smaller factors stay in cache and gain nothing
-/// (6k unknowns, 0.57M values); they keep `dot`'s rounding, to which the small shared
-/// models' degenerate QPs are sensitive (read downwards, free_vault's form finding took 0.32
-/// s instead of 0.20, three_pillar's 0.54 instead of 0.29).
+/// (`dot_downwards`), one descending stream the prefetcher follows, where reading each column
+/// upwards would be limited by memory; smaller factors stay in cache and keep `dot`'s
+/// rounding, to which the small models' degenerate QPs are sensitive.
 const DOWNWARDS_FROM: usize = 1 << 20;
 
 /// `dot` from the last terms to the first (the same four partial sums, taken from the end).

@@ -801,8 +801,7 @@ fn dissection_splits_a_grid_into_halves() {
     let dissected = factor(&label);
     let grid_order = factor(&(0..=n).collect::<Vec<_>>());
     let (ours, banded) = (dissected.len_val(), grid_order.len_val());
-    // Near AMD's fill at this size: 306k stored values against 260k. (Before the postorder,
-    // 283k; with the leaves ordered by AMD on their own, 344k.)
+    // Near AMD's fill at this size (306k stored values against 260k).
     let amd = factor(&amd_labels(n + 1, &col_ptr, &row_idx).expect("AMD")).len_val();
     assert!(
         100 * ours < 125 * amd,
