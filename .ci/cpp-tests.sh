@@ -54,7 +54,8 @@ else
 fi
 
 if [ ! -d ../shared/data/models ]; then
-  echo "note: ../shared/data/models not found; the model tests will say skipped"
+  echo "note: ../shared/data/models not found; the model tests will say skipped" \
+    "(fail in CI or with VSR_REQUIRE_MODELS=1)"
 fi
 
 step "cpp_tests: Release, shared library"

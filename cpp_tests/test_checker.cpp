@@ -172,8 +172,12 @@ class Perturbed : public ::testing::TestWithParam<std::string> {
   protected:
     void SetUp() override {
         const auto g = vsrt::generated_names();
-        if (std::find(g.begin(), g.end(), GetParam()) == g.end() && !vsrt::models_available())
+        if (std::find(g.begin(), g.end(), GetParam()) == g.end() && !vsrt::models_available()) {
+            if (vsrt::models_required())
+                FAIL() << vsrt::models_dir()
+                       << " not found, and CI or VSR_REQUIRE_MODELS=1 requires it";
             GTEST_SKIP() << "skipped: " << vsrt::models_dir() << " not found";
+        }
         mesh_ = load(GetParam());
         solution_ = vsrt::solve(mesh_, Solve::Analysis);
         const CheckReport rep = vsrt::reference_check(mesh_, solution_, CheckOptions());

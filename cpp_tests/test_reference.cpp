@@ -123,8 +123,12 @@ INSTANTIATE_TEST_SUITE_P(Cgal, Generated, ::testing::ValuesIn(vsrt::generated_na
 class Model : public ::testing::TestWithParam<std::string> {
   protected:
     void SetUp() override {
-        if (!vsrt::models_available())
+        if (!vsrt::models_available()) {
+            if (vsrt::models_required())
+                FAIL() << vsrt::models_dir()
+                       << " not found, and CI or VSR_REQUIRE_MODELS=1 requires it";
             GTEST_SKIP() << "skipped: " << vsrt::models_dir() << " not found";
+        }
     }
 };
 

@@ -1,8 +1,9 @@
 //! The nine real vault models of ../shared/data/models: counts against the README table and
-//! a summary of their boundaries and supports. Skipped when the folder is absent.
+//! a summary of their boundaries and supports. Skipped when the folder is absent, except in CI
+//! or with VSR_REQUIRE_MODELS=1, where its absence fails.
 
-use std::path::PathBuf;
-
+mod common;
+use common::{find_models, models_dir, models_required};
 use voussoir::{io, Mesh};
 
 /// (name, V, E, F) from the models README.
@@ -18,11 +19,6 @@ const MODELS: [(&str, usize, usize, usize); 9] = [
     ("vault_pq", 343, 938, 596),
 ];
 
-fn models_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    dir.is_dir().then_some(dir)
-}
-
 fn load(dir: &std::path::Path, name: &str) -> Mesh {
     let obj = dir.join(format!("{name}.obj"));
     let json = dir.join(format!("{name}.json"));
@@ -31,10 +27,7 @@ fn load(dir: &std::path::Path, name: &str) -> Mesh {
 
 #[test]
 fn models_load_with_expected_counts() {
-    let Some(dir) = models_dir() else {
-        println!("skipped: ../shared/data/models not found");
-        return;
-    };
+    let Some(dir) = models_dir() else { return };
     println!(
         "{:<16} {:>5} {:>5} {:>5} {:>3} {:>5} {:>5} {:>8} {:>8} {:>9} {:>8} {:>6}",
         "model",
@@ -102,4 +95,31 @@ fn models_load_with_expected_counts() {
                 .all(|&i| !mesh.is_non_anchored(i as usize)));
         }
     }
+}
+
+#[test]
+fn models_are_required_in_ci_and_on_request_only() {
+    assert!(!models_required(None, None));
+    for ci in ["true", "1", "yes", "TRUE"] {
+        assert!(models_required(Some(ci), None), "CI={ci}");
+    }
+    for ci in ["", "0", "false", "False"] {
+        assert!(!models_required(Some(ci), None), "CI={ci:?}");
+    }
+    assert!(models_required(None, Some("1")));
+    assert!(!models_required(None, Some("0")));
+    assert!(!models_required(None, Some("")));
+}
+
+#[test]
+fn a_missing_models_folder_is_skipped_unless_required() {
+    let absent = std::env::temp_dir().join("voussoir-no-such-models-folder");
+    assert_eq!(find_models(absent.clone(), false), None);
+    let failed = std::panic::catch_unwind(|| find_models(absent, true));
+    assert!(
+        failed.is_err(),
+        "an absent, required folder must fail the test"
+    );
+    let present = std::env::temp_dir();
+    assert_eq!(find_models(present.clone(), true), Some(present));
 }

@@ -17,9 +17,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -335,6 +337,16 @@ std::string models_dir() { return VSR_MODELS_DIR; }
 
 bool models_available() {
     return std::ifstream(models_dir() + "/neumunster.obj").good();
+}
+
+bool models_required() {
+    const char *ci = std::getenv("CI");
+    std::string value = ci ? ci : "";
+    std::transform(value.begin(), value.end(), value.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const bool in_ci = !value.empty() && value != "0" && value != "false";
+    const char *require = std::getenv("VSR_REQUIRE_MODELS");
+    return in_ci || (require && std::string(require) == "1");
 }
 
 MeshData read_mesh_file(const std::string &path) {

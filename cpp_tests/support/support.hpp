@@ -105,9 +105,12 @@ std::vector<std::string> generated_names();
 MeshData generated(const std::string &name);
 
 // The shared OBJ models (../shared/data/models), read with OpenMesh; supports from the JSON
-// sidecar. `models_available()` is false when the folder is absent.
+// sidecar. `models_available()` is false when the folder is absent; `models_required()` is
+// true in CI (`CI` set, not 0 or false) or with VSR_REQUIRE_MODELS=1, where the tests that
+// need the models fail instead of saying skipped.
 std::vector<std::string> model_names();
 bool models_available();
+bool models_required();
 std::string models_dir();
 MeshData read_model(const std::string &name);
 // Writes `mesh` with the positions `positions` (#V by 3) with OpenMesh into the build's

@@ -2,7 +2,9 @@
 //! path to the shared real models.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+mod models;
+#[allow(unused_imports)] // each test binary uses its own part
+pub use models::{find_models, models_dir, models_required};
 use voussoir::generate::{self, Domain};
 use voussoir::Mesh;
 
@@ -22,17 +24,6 @@ impl Rng {
     /// Uniform in [lo, hi).
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// The folder of the shared real models, or None (with a "skipped" line) when it is absent.
-pub fn models_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: {} not found", dir.display());
-        None
     }
 }
 

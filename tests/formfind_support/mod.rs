@@ -93,15 +93,9 @@ pub fn run(cwd: &Path, args: &[&str]) -> Output {
         .expect("formfind runs")
 }
 
-pub fn models_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: {} not found", dir.display());
-        None
-    }
-}
+#[path = "../common/models.rs"]
+mod models;
+pub use models::models_dir;
 
 /// Vertices and triangles (0-based) of an OBJ file: `v x y z` and `f a b c` lines only.
 pub fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
