@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # C++ tests with CGAL and OpenMesh (issue 5), run by CI and by the README's test command:
-#   1. installs cmake libcgal-dev libopenmesh-dev libgtest-dev pkg-config g++ with apt-get when
-#      missing (CI runs as root on a fresh Debian 12 machine);
+#   1. installs cmake libcgal-dev libopenmesh-dev libgtest-dev pkg-config g++ when missing
+#      (.ci/apt.sh: apt-get as root or through sudo, else it stops with the line to run);
 #   2. reuses the staging prefix that .ci/cmake-checks.sh installed the library into
 #      (target/cmake-checks/stage; cargo is asked to bring it up to date, which is a no-op
 #      when it is); without one, builds the crate once in release with cmake/ and installs it;
@@ -21,18 +21,9 @@ start=$SECONDS
 step() { printf '\n== [%4ds] %s\n' "$((SECONDS - start))" "$*"; }
 
 step "Debian packages"
-packages=(cmake libcgal-dev libopenmesh-dev libgtest-dev pkg-config g++)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "installing ${missing[*]}"
-  apt-get update
-  DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
-else
-  echo "all present: ${packages[*]}"
-fi
+# shellcheck source=.ci/apt.sh
+source .ci/apt.sh
+ensure_debian_packages cmake libcgal-dev libopenmesh-dev libgtest-dev pkg-config g++
 
 step "the installed package"
 mkdir -p "$work"
