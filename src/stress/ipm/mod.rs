@@ -527,7 +527,7 @@ fn iterate(
     let mut polish_below = f64::INFINITY;
     // The guess of the last attempt that failed with an early guess: the same guess from
     // another iterate leads to the same step (a QP's Newton step lands on the optimum for its
-    // active set wherever it starts), so it fails again (dome with doors: iterations 14, 15).
+    // active set wherever it starts), so it would fail again.
     let mut failed_guess: Option<Vec<bool>> = None;
     let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
     let mut iterations = tol.max_iter;
