@@ -98,7 +98,7 @@ pub struct StressSettings {
     pub dual_length_smoothing: f64,
     /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10; when the solver
     /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
-    /// step is retried with ε × 100, up to twice, and the result says which ε was used.
+    /// step is repeated with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
     pub solver: QpSolver,
 }

@@ -100,7 +100,7 @@ pub struct Tolerances {
     /// Factor by which all tolerances are relaxed for `AlmostSolved`.
     pub almost: f64,
     pub max_iter: u32,
-    /// Gondzio's centrality correctors tried per iteration, at most (see `CORRECTOR_STRETCH`).
+    /// Gondzio's centrality correctors per iteration, at most (see `CORRECTOR_STRETCH`).
     pub correctors: usize,
 }
 
@@ -523,7 +523,7 @@ fn iterate(
         .zip(start_units)
         .for_each(|(v, u)| *v = (*v + dz.max(1e-8)) * u);
 
-    // Polishing is tried only while the gap is below this (see `PolishFailure`).
+    // Polishing is attempted only while the gap is below this (see `PolishFailure`).
     let mut polish_below = f64::INFINITY;
     // The guess of the last attempt that failed with an early guess: the same guess from
     // another iterate leads to the same step (a QP's Newton step lands on the optimum for its
@@ -656,7 +656,7 @@ fn iterate(
             let mut r_c: Vec<f64> = (0..m)
                 .map(|i| -s[i] * z[i] + sigma * mu - ds_a[i] * dz_a[i])
                 .collect();
-            // Gondzio's centrality correctors, tried with coarse solves: a few blocking
+            // Gondzio's centrality correctors, with coarse solves: a few blocking
             // products s_i z_i otherwise hold the step to a fraction of the way.
             let mut b2 = rhs(&r_c);
             let mut sol = newton.approximate(&minus_rd, &b2);

@@ -22,10 +22,10 @@ pub(super) const DELTA_EQ: f64 = 1e-6;
 /// are many (the edge-based formulation's two rows per free vertex).
 pub(super) const DELTA_EQ_LARGE: f64 = 1e-4;
 
-/// Static regularisations of the normal matrix tried in turn until the factor is sound.
+/// Static regularisations of the normal matrix, used in turn until the factor is sound.
 pub(super) const REGULARISATION: [f64; 3] = [1e-12, 1e-9, 1e-6];
 
-/// GMRES cycles, and basis vectors per cycle, tried where refinement stalls short of its
+/// GMRES cycles, and basis vectors per cycle, run where refinement stalls short of its
 /// target (`Newton::krylov`).
 const KRYLOV_CYCLES: usize = 3;
 const KRYLOV_BASIS: usize = 30;
@@ -44,7 +44,7 @@ pub(super) struct Newton<'a> {
     pub(super) space: &'a mut FactorSpace,
 }
 
-/// Storage of the numeric factor and its scratch, allocated once per QP: every Newton step
+/// Storage of the numeric factor and its working memory, allocated once per QP: every Newton step
 /// refactors the same pattern.
 pub(super) struct FactorSpace {
     pub(super) values: Vec<f64>,
@@ -53,21 +53,21 @@ pub(super) struct FactorSpace {
     pub(super) l_values: Vec<f64>,
     pub(super) buffer: MemBuffer,
     /// Working storage of `supernodal::solve_in_place`.
-    pub(super) scratch: Vec<f64>,
+    pub(super) work: Vec<f64>,
 }
 
 impl FactorSpace {
     pub(super) fn new(symbolic: &SymbolicCholesky<usize>, n_values: usize) -> Option<FactorSpace> {
         let par = Par::Seq;
-        let scratch = symbolic
+        let stack = symbolic
             .factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
             .or(symbolic.solve_in_place_scratch::<f64>(1, par));
         Some(FactorSpace {
             values: vec![0.0; n_values],
             signs: vec![1; symbolic.nrows()],
             l_values: vec![0.0; symbolic.len_val()],
-            buffer: MemBuffer::try_new(scratch).ok()?,
-            scratch: Vec::new(),
+            buffer: MemBuffer::try_new(stack).ok()?,
+            work: Vec::new(),
         })
     }
 }
@@ -167,13 +167,7 @@ impl<'a> Newton<'a> {
         // Our own loops over the supernodes (`supernodal`); faer's solve only for a factor
         // that is not supernodal or is permuted.
         let split = self.normal.pattern.solve_split.as_ref();
-        if !supernodal::solve_in_place(
-            symbolic,
-            &space.l_values,
-            &mut dx,
-            &mut space.scratch,
-            split,
-        ) {
+        if !supernodal::solve_in_place(symbolic, &space.l_values, &mut dx, &mut space.work, split) {
             LdltRef::new(symbolic, &space.l_values).solve_in_place_with_conj(
                 Conj::No,
                 MatMut::from_column_major_slice_mut(&mut dx, n, 1),

@@ -42,12 +42,12 @@ pub(super) const WARM_ROUNDS: usize = 8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum PolishFailure {
     /// The guess had more wrong rows than a round may correct, or kept finding new ones:
-    /// retried at the next iteration, because one more iteration usually settles it and,
+    /// attempted again at the next iteration, because one more iteration usually settles it and,
     /// where the gap stalls at its rounding floor, a later guess is the way out.
     EarlyGuess,
     /// No row was wrong, yet the step missed the tolerances (or its solve failed), also when
-    /// retried without the rows that wholly active groups imply: the active set is right but
-    /// the factor cannot resolve it that finely: retried only once the gap has fallen by
+    /// solved again without the rows that wholly active groups imply: the active set is right but
+    /// the factor cannot resolve it that finely: attempted again only once the gap has fallen by
     /// `INEXACT_RETRY`, since the next iteration's guess would fail the same way.
     Inexact,
 }
@@ -144,7 +144,7 @@ pub(super) fn polish(
         let wrong = wrong_rows(&step, &kkt, &active);
         if wrong.is_empty() {
             // The right active set, missed by the factor's accuracy: where whole groups of
-            // dependent rows are active, retried without two rows each, because rounding
+            // dependent rows are active, solved again without two rows each, because rounding
             // along those dependent combinations is amplified by 1/δ.
             if qp.groups.any_wholly_active(&active) {
                 let never = |_: &PolishStep| false;

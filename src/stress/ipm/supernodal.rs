@@ -8,17 +8,17 @@ use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 
 /// x ← (L D Lᵀ)⁻¹ x for the factor `values` of `symbolic`, which must be supernodal and
 /// without a permutation (the normal matrix is factored in its elimination order); false,
-/// with x untouched, otherwise. `scratch` is working storage; with a `split` of this
+/// with x untouched, otherwise. `work` is working storage; with a `split` of this
 /// factor's tree the two branches are solved on two threads.
 pub(super) fn solve_in_place(
     symbolic: &SymbolicCholesky<usize>,
     values: &[f64],
     x: &mut [f64],
-    scratch: &mut Vec<f64>,
+    work: &mut Vec<f64>,
     split: Option<&Split>,
 ) -> bool {
     let downwards = values.len() > DOWNWARDS_FROM;
-    solve_in_place_reading(symbolic, values, x, scratch, downwards, split)
+    solve_in_place_reading(symbolic, values, x, work, downwards, split)
 }
 
 /// `solve_in_place`, its backward solve reading each column downwards (`dot_downwards`) or
@@ -27,7 +27,7 @@ pub(super) fn solve_in_place_reading(
     symbolic: &SymbolicCholesky<usize>,
     values: &[f64],
     x: &mut [f64],
-    scratch: &mut Vec<f64>,
+    work: &mut Vec<f64>,
     downwards: bool,
     split: Option<&Split>,
 ) -> bool {
@@ -39,9 +39,9 @@ pub(super) fn solve_in_place_reading(
         Some(split) => factor.solve_split(split, x, dot),
         None => {
             let all = 0..factor.n_supernodes;
-            all.clone().for_each(|s| factor.forward(s, x, scratch));
+            all.clone().for_each(|s| factor.forward(s, x, work));
             factor.scale(x);
-            all.rev().for_each(|s| factor.backward(s, x, scratch, dot));
+            all.rev().for_each(|s| factor.backward(s, x, work, dot));
         }
     }
     true
@@ -90,11 +90,11 @@ impl<'a> Factor<'a> {
     }
 
     /// Supernode s's part of L y = b: the triangle, then the rows below, gathered in
-    /// `scratch` and subtracted once.
-    fn forward(&self, s: usize, x: &mut [f64], scratch: &mut Vec<f64>) {
+    /// `work` and subtracted once.
+    fn forward(&self, s: usize, x: &mut [f64], work: &mut Vec<f64>) {
         let (start, ncols, pattern, l, nrows) = self.block(s);
-        scratch.clear();
-        scratch.resize(pattern.len(), 0.0);
+        work.clear();
+        work.resize(pattern.len(), 0.0);
         for j in 0..ncols {
             let col = &l[j * nrows..(j + 1) * nrows];
             let xj = x[start + j];
@@ -104,11 +104,11 @@ impl<'a> Factor<'a> {
             {
                 *xi -= v * xj;
             }
-            for (t, &v) in scratch.iter_mut().zip(&col[ncols..]) {
+            for (t, &v) in work.iter_mut().zip(&col[ncols..]) {
                 *t += v * xj;
             }
         }
-        for (&r, &t) in pattern.iter().zip(scratch.iter()) {
+        for (&r, &t) in pattern.iter().zip(work.iter()) {
             x[r] -= t;
         }
     }
@@ -125,14 +125,14 @@ impl<'a> Factor<'a> {
 
     /// Supernode s's part of Lᵀ x = z (supernodes in reverse): the rows below are final,
     /// then the triangle upwards.
-    fn backward(&self, s: usize, x: &mut [f64], scratch: &mut Vec<f64>, dot: Dot) {
+    fn backward(&self, s: usize, x: &mut [f64], work: &mut Vec<f64>, dot: Dot) {
         let (start, ncols, pattern, l, nrows) = self.block(s);
-        scratch.clear();
-        scratch.extend(pattern.iter().map(|&r| x[r]));
+        work.clear();
+        work.extend(pattern.iter().map(|&r| x[r]));
         for j in (0..ncols).rev() {
             let col = &l[j * nrows..(j + 1) * nrows];
             let mut xj = x[start + j];
-            xj -= dot(&col[ncols..], scratch);
+            xj -= dot(&col[ncols..], work);
             xj -= dot(&col[j + 1..ncols], &x[start + j + 1..start + ncols]);
             x[start + j] = xj;
         }
@@ -146,10 +146,10 @@ impl<'a> Factor<'a> {
         let forward_branch = |members: &[usize], x: &[f64]| {
             let mut own = x.to_vec();
             split.stem_columns(self).for_each(|c| own[c] = 0.0);
-            let mut scratch = Vec::new();
+            let mut work = Vec::new();
             members
                 .iter()
-                .for_each(|&s| self.forward(s, &mut own, &mut scratch));
+                .for_each(|&s| self.forward(s, &mut own, &mut work));
             own
         };
         let [first, second] = on_two_threads(|branch| forward_branch(&split.branches[branch], x));
@@ -161,20 +161,20 @@ impl<'a> Factor<'a> {
         for c in split.stem_columns(self) {
             x[c] += first[c] + second[c];
         }
-        let mut scratch = Vec::new();
+        let mut work = Vec::new();
         split
             .stem
             .iter()
-            .for_each(|&s| self.forward(s, x, &mut scratch));
+            .for_each(|&s| self.forward(s, x, &mut work));
         self.scale(x);
         for &s in split.stem.iter().rev() {
-            self.backward(s, x, &mut scratch, dot);
+            self.backward(s, x, &mut work, dot);
         }
         let backward_branch = |members: &[usize], x: &[f64]| {
             let mut own = x.to_vec();
-            let mut scratch = Vec::new();
+            let mut work = Vec::new();
             for &s in members.iter().rev() {
-                self.backward(s, &mut own, &mut scratch, dot);
+                self.backward(s, &mut own, &mut work, dot);
             }
             own
         };
