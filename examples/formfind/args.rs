@@ -2,9 +2,15 @@
 
 use std::path::PathBuf;
 
-use voussoir::{EdgeScope, FormFindSettings, Formulation, LoadRule, QBound, QpSolver, TauMode};
+use voussoir::{
+    EdgeScope, FormFindSettings, FormMethod, Formulation, LoadRule, QBound, QpSolver, TauMode,
+};
 
 /// The choices of the enumerated options, as spelled on the command line.
+pub const METHODS: [(&str, FormMethod); 2] = [
+    ("nearest", FormMethod::Nearest),
+    ("paper", FormMethod::Paper),
+];
 pub const SOLVERS: [(&str, Formulation); 2] = [
     ("reduced", Formulation::Reduced),
     ("edge-based", Formulation::EdgeBased),
@@ -66,6 +72,12 @@ Outputs (all written at the end of a run, or none; existing files are replaced):
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
+  --method M             nearest | paper: the nearest self-supporting shape
+                         (least area-weighted squared height change), or
+                         the paper's loop                                  [{method}]
+  --fairness G           nearest method: weight of the change's smoothness [{fairness}]
+  --max-height-change H  nearest method: no vertex moves more than H plan
+                         diagonals                                         [{limit}]
   --solver S             reduced | edge-based                              [{solver}]
   --qp Q                 native | clarabel: the QP solver (native falls
                          back to clarabel when it does not converge)       [{qp}]
@@ -89,6 +101,9 @@ Solver:
 Exit status: 0 converged (or --stress-only solved), 3 finished without converging
 (outputs written, the report says why), 2 bad input or options, 1 other failure.
 ",
+        method = name_of(&METHODS, d.method),
+        fairness = d.fairness,
+        limit = d.max_height_change,
         solver = name_of(&SOLVERS, st.formulation),
         qp = name_of(&QP_SOLVERS, st.solver),
         tol = d.tolerance,
@@ -204,6 +219,21 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
             "--stress-only" => o.stress_only = true,
+            "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
+            "--fairness" => {
+                let g = number(&flag, &value()?)?;
+                if g < 0.0 {
+                    return Err(format!("{flag}: must be >= 0, got {g}"));
+                }
+                s.fairness = g;
+            }
+            "--max-height-change" => {
+                let h = number(&flag, &value()?)?;
+                if h <= 0.0 {
+                    return Err(format!("{flag}: must be > 0, got {h}"));
+                }
+                s.max_height_change = h;
+            }
             "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
             "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
             "--tol" => {

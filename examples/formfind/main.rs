@@ -229,7 +229,10 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 say!("  details: {detail}");
             }
             say!(
-                "height change: max {:.3}%, RMS {:.3}% of the plan diagonal",
+                "height change: max {:.3}%, area-weighted RMS {:.3}% of the plan diagonal; \
+                 surface distance: Hausdorff {:.3}%, L2 {:.3}%",
+                100.0 * outcome.max_change,
+                100.0 * outcome.rms_change,
                 100.0 * outcome.hausdorff,
                 100.0 * outcome.l2
             );

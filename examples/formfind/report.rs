@@ -3,7 +3,7 @@
 use serde_json::{json, Value};
 use voussoir::{QBound, StressResult, Termination};
 
-use crate::args::{name_of, Options, LOADS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
+use crate::args::{name_of, Options, LOADS, METHODS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
 use crate::run::Outcome;
 
 /// snake_case name of an enum variant from its `Debug` text (`Stalled { .. }` → `stalled`), so
@@ -30,6 +30,8 @@ pub fn termination(outcome: &Outcome) -> (String, Value) {
     };
     let detail = if let Termination::Stalled { vertices } = t {
         json!({ "vertices": vertices })
+    } else if let Termination::HeightLimit { vertices, hint } = t {
+        json!({ "vertices": vertices, "hint": hint })
     } else if let Termination::Infeasible { constraint } = t {
         json!({ "constraint": constraint })
     } else if let Termination::NumericalError { what } = t {
@@ -58,6 +60,9 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
         "qp_solver": name_of(&QP_SOLVERS, st.solver),
         "tolerance": s.tolerance,
         "max_iterations": s.max_iterations,
+        "method": name_of(&METHODS, s.method),
+        "fairness": s.fairness,
+        "max_height_change": s.max_height_change,
         "stall_window": s.stall_window,
         "proximal_weight": s.proximal_weight,
         "q_min": bound(st.q_min, outcome.q_unit),
@@ -126,6 +131,8 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "objective": s.objective,
         "hausdorff": outcome.hausdorff,
         "l2": outcome.l2,
+        "rms_change": outcome.rms_change,
+        "max_change": outcome.max_change,
         "timings_s": {
             "stress": outcome.stress_seconds,
             "shape": outcome.shape_seconds,

@@ -22,7 +22,7 @@ pub use result::*;
 pub use settings::*;
 pub use solve::*;
 pub use status::{
-    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrQpSolver,
+    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrQpSolver,
     VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
 };
 

@@ -211,6 +211,9 @@ pub struct StressCache {
     coarse: bool,
     /// Whether the last step's answer was solved to coarse optimality.
     last_coarse: bool,
+    /// Physical vertical loads added to those the QP balances (the nearest-shape method's
+    /// multiplier shift); the result's residuals are still those of the true loads.
+    load_offset: Option<Vec<f64>>,
 }
 
 impl StressCache {
@@ -233,6 +236,12 @@ impl StressCache {
     /// set is wrong in hundreds of rows and the failed attempt costs several factorisations.
     pub fn far_from_balance(&mut self, far: bool) {
         self.normal.far_from_balance(far);
+    }
+
+    /// Loads (physical, per vertex) the next steps add to the true loads in the QP's target;
+    /// `None`: the true loads.
+    pub(crate) fn set_load_offset(&mut self, offset: Option<Vec<f64>>) {
+        self.load_offset = offset;
     }
 
     /// Whether the last step's answer is a native QP's solved to coarse optimality: short of
@@ -307,7 +316,12 @@ pub fn analyse_cached(
 
     // Frame units: z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄.
     let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
-    let p: Vec<f64> = load.iter().map(|x| x / p_bar).collect();
+    let p: Vec<f64> = match &cache.load_offset {
+        Some(offset) => (load.iter().zip(offset))
+            .map(|(x, o)| (x + o) / p_bar)
+            .collect(),
+        None => load.iter().map(|x| x / p_bar).collect(),
+    };
     let normal = boundary_normals(mesh, &plan.u);
     let mut external: Vec<[f64; 2]> = problem
         .horizontal_forces
