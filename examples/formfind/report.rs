@@ -47,12 +47,29 @@ fn bound(b: QBound, unit: f64) -> Value {
     }
 }
 
+/// How the input was welded: the output mesh and every vertex id in this report are welded
+/// ids, numbered in the order of their first input vertex.
+fn weld(outcome: &Outcome) -> Value {
+    match &outcome.model.weld {
+        None => Value::Null,
+        Some(w) => json!({
+            "input_vertices": w.input_vertices,
+            "merged": w.merged,
+            "relative_tolerance": w.relative_tolerance,
+            "tolerance": w.tolerance,
+            "collapsed_faces": w.collapsed_faces,
+            "vertex_order": "welded vertices are numbered in the order of their first input vertex",
+        }),
+    }
+}
+
 fn settings(o: &Options, outcome: &Outcome) -> Value {
     let s = &o.settings;
     let st = &s.stress;
     json!({
         "mesh": outcome.model.source,
         "supports": outcome.model.supports,
+        "weld": weld(outcome),
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),
         "qp_solver": name_of(&QP_SOLVERS, st.solver),
