@@ -224,3 +224,73 @@ fn bad_options_of_formats_and_supports_exit_2() {
     }
     assert_eq!(dir.listing(), before);
 }
+
+/// A 6×6 grid dome over the unit square with a sliver of about 1e-9 of the median plan area
+/// (a vertex 1e-10 past the middle of an interior edge, so slightly inverted), as OBJ text.
+fn sliver_dome_obj() -> String {
+    const N: u32 = 6;
+    let id = |i: u32, j: u32| j * (N + 1) + i + 1;
+    let mut text = String::new();
+    for j in 0..=N {
+        for i in 0..=N {
+            let (x, y) = (f64::from(i) / 6.0, f64::from(j) / 6.0);
+            let z = 0.6 - (x - 0.5).powi(2) - (y - 0.5).powi(2);
+            text += &format!("v {x:?} {y:?} {z:?}\n");
+        }
+    }
+    // The middle of the diagonal of cell (2, 2), from (2, 2) to (3, 3), pushed across it.
+    let m = (N + 1) * (N + 1) + 1;
+    text += &format!("v {:?} {:?} 0.55\n", 2.5 / 6.0 + 1e-10, 2.5 / 6.0 - 1e-10);
+    for j in 0..N {
+        for i in 0..N {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i, j) == (2, 2) {
+                // (a, c, d) split at m on its edge (a, c): (a, m, d), (m, c, d) and the sliver.
+                text += &format!("f {a} {b} {c}\nf {a} {m} {d}\nf {m} {c} {d}\nf {a} {c} {m}\n");
+            } else {
+                text += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+            }
+        }
+    }
+    text
+}
+
+#[test]
+fn plan_slivers_are_repaired_and_listed_or_rejected_with_strict() {
+    let dir = Scratch::new("slivers");
+    let mesh = dir.path("sliver.obj");
+    fs::write(&mesh, sliver_dome_obj()).unwrap();
+    let report = run_ok(
+        &dir,
+        &[mesh.to_str().unwrap(), "--anchor-boundary"],
+        "out.off",
+    );
+    let repairs = report["plan_repairs"].as_array().unwrap();
+    assert_eq!(repairs.len(), 1, "{repairs:?}");
+    // Faces 28 to 31 are those of cell (2, 2): (a, b, c), then the split (a, c, d), sliver last.
+    assert_eq!(
+        repairs[0]["flip"]["faces"],
+        serde_json::json!([31, 28]),
+        "{repairs:?}"
+    );
+    assert_eq!(report["termination"], "converged");
+    let before = dir.listing();
+    let out = run(
+        &dir.0,
+        &[
+            mesh.to_str().unwrap(),
+            "--anchor-boundary",
+            "--strict",
+            "--out",
+            "strict.obj",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("faces with zero plan area: 31")
+            || stderr.contains("flipped against the majority: 31"),
+        "{stderr}"
+    );
+    assert_eq!(dir.listing(), before);
+}

@@ -63,12 +63,16 @@ Inputs:
                          relative to the bounding box diagonal, or TOLabs absolute
   --weld TOL             merge vertices closer than TOL x the bounding box diagonal; the
                          mesh is then numbered in first-occurrence order     [{weld:e}]
+  --strict               reject plan slivers (faces of almost no plan area, or slightly
+                         inverted) instead of mending them by edge flips or the smallest
+                         plan move of a non-anchored vertex (listed in the report)
   --no-weld              keep MESH's vertices as they are (not for STL, whose triangles
                          never share vertices)
 
 Outputs (all written at the end of a run, or none; existing files are replaced):
-  --out OUT              final positions, same faces, in the format of the extension:
-                         .obj, .off, .ply (17 digits) or .stl (single precision)
+  --out OUT              final positions, same faces (after any plan repair), in the
+                         format of the extension: .obj, .off, .ply (every bit kept) or
+                         .stl (single precision)
                                                         [formfind-out/NAME-formfound.obj]
   --report R.json        everything computed, as JSON   [formfind-out/report.json]
   --pictures DIR         SVG pictures                   [formfind-out/pictures]
@@ -125,6 +129,8 @@ pub struct Options {
     pub anchor_lowest: Option<(f64, bool)>,
     /// Relative welding tolerance; `None` for `--no-weld`.
     pub weld: Option<f64>,
+    /// `--strict`: no plan repair.
+    pub strict: bool,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -197,6 +203,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         anchor_boundary: false,
         anchor_lowest: None,
         weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
+        strict: false,
         out: None,
         report: None,
         pictures: None,
@@ -241,6 +248,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 o.weld = Some(t);
             }
             "--no-weld" => o.weld = None,
+            "--strict" => o.strict = true,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),

@@ -216,6 +216,17 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             w.collapsed_faces.len()
         );
     }
+    if !m.repairs.is_empty() {
+        let flips = m
+            .repairs
+            .iter()
+            .filter(|r| matches!(r, voussoir::mesh::repair::PlanRepair::Flip { .. }))
+            .count();
+        say!(
+            "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",
+            m.repairs.len() - flips
+        );
+    }
     let s = &outcome.stress;
     match &outcome.termination {
         None => say!(

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use voussoir::generate::{self, Domain};
+use voussoir::mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 use voussoir::{io, Mesh};
 
 use crate::args::Options;
@@ -19,6 +20,8 @@ pub struct Model {
     pub faces: Vec<[u32; 3]>,
     /// The welding of a mesh file (`None` for the embedded default and `--no-weld`).
     pub weld: Option<WeldSummary>,
+    /// Plan repairs made before validation (none with `--strict`).
+    pub repairs: Vec<PlanRepair>,
 }
 
 /// Plan of the embedded default: a rectangle of half-widths `HALF_X` × `HALF_Y` whose sides bow
@@ -77,6 +80,7 @@ pub fn embedded_default() -> Model {
         mesh,
         faces,
         weld: None,
+        repairs: Vec::new(),
     }
 }
 
@@ -128,13 +132,21 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
             format!("every vertex within {tol}{unit} of the lowest height (--anchor-lowest)");
         (ids, label)
     } else {
-        // Validate once with every vertex anchored to learn the boundary, then anchor it.
-        let all: Vec<u32> = (0..positions.len() as u32).collect();
-        let probe = Mesh::new(positions.clone(), faces.clone(), &all)?;
-        let boundary = (0..positions.len() as u32)
-            .filter(|&v| probe.on_boundary[v as usize] && probe.referenced[v as usize])
-            .collect();
-        (boundary, "every boundary vertex (--anchor-boundary)".into())
+        (
+            boundary_vertices(&faces),
+            "every boundary vertex (--anchor-boundary)".into(),
+        )
+    };
+    let (mut positions, mut faces) = (positions, faces);
+    let repairs = if o.strict {
+        Vec::new()
+    } else {
+        repair_plan(
+            &mut positions,
+            &mut faces,
+            &anchored,
+            DEFAULT_REPAIR_TOLERANCE,
+        )?
     };
     let mesh = Mesh::new(positions, faces.clone(), &anchored)?;
     let name = mesh_path
@@ -147,7 +159,27 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
         mesh,
         faces,
         weld: welded.map(|(_, s)| s),
+        repairs,
     })
+}
+
+/// The vertices on an edge of a single face, in id order.
+fn boundary_vertices(faces: &[[u32; 3]]) -> Vec<u32> {
+    let mut uses: std::collections::HashMap<(u32, u32), usize> = Default::default();
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut boundary: Vec<u32> = uses
+        .iter()
+        .filter(|(_, &n)| n == 1)
+        .flat_map(|(&(a, b), _)| [a, b])
+        .collect();
+    boundary.sort_unstable();
+    boundary.dedup();
+    boundary
 }
 
 /// The vertices of some face within `tol` of the lowest such vertex's height; `tol` is
