@@ -50,6 +50,14 @@ pub fn load_model(obj: &Path, supports: &Path) -> Result<Mesh> {
     Mesh::new(positions, faces, &anchored)
 }
 
+/// A crate's error message on one line (some span several, with tabs).
+fn one_line(e: &dyn std::fmt::Display) -> String {
+    e.to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// The `Error::Io` for `path`.
 fn io_error(path: &Path, err: &std::io::Error) -> crate::Error {
     crate::Error::Io {

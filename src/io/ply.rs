@@ -8,8 +8,7 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, ElementDef, Encoding, Header, Property};
 
 use super::atomic::write_atomically;
-use super::stl::one_line;
-use super::RawMesh;
+use super::{one_line, RawMesh};
 use crate::{Error, Result};
 
 /// Parses a PLY file in any of its encodings (ASCII, binary little- or big-endian). The

@@ -4,7 +4,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use super::atomic::write_atomically;
-use super::RawMesh;
+use super::{one_line, RawMesh};
 use crate::{Error, Result};
 
 /// Bytes of the binary header and triangle count, and of one binary triangle record.
@@ -137,13 +137,6 @@ fn read_triangles(bytes: &[u8], path_label: &str, first: usize) -> Result<Vec<st
         triangles.push(triangle);
     }
     Ok(triangles)
-}
-
-pub(crate) fn one_line(e: &dyn std::fmt::Display) -> String {
-    e.to_string()
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ")
 }
 
 /// Writes binary STL (through `stl_io`) or ASCII STL; positions rounded to `f32`, normals

@@ -191,14 +191,23 @@ int main(void) {
         size_t merged = 77;
         FILE *f;
         f = fopen("vsr_hostile_bad.off", "w");
-        fputs(bad_off, f);
-        fclose(f);
+        TRUE(f != NULL);
+        if (f) {
+            fputs(bad_off, f);
+            fclose(f);
+        }
         f = fopen("vsr_hostile_short.stl", "wb");
-        fwrite(short_stl, 1, sizeof short_stl, f);
-        fclose(f);
+        TRUE(f != NULL);
+        if (f) {
+            fwrite(short_stl, 1, sizeof short_stl, f);
+            fclose(f);
+        }
         f = fopen("vsr_hostile_good.off", "w");
-        fputs(good_off, f);
-        fclose(f);
+        TRUE(f != NULL);
+        if (f) {
+            fputs(good_off, f);
+            fclose(f);
+        }
         EXPECT(vsr_mesh_read(NULL, NULL, anchored, 4, 1e-9, &merged, &read),
                VSR_STATUS_NULL_POINTER, "path");
         EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, &merged, NULL),
