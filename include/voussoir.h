@@ -517,6 +517,11 @@ const char *vsr_status_name(uint32_t status);
  * - `weld_tolerance`: vertices closer than `weld_tolerance` × (bounding box diagonal) are
  *   merged into the first of them (0 merges exactly equal positions only; default in the Rust
  *   API 1e-9); finite and >= 0. STL files, whose triangles never share vertices, need it.
+ * - `repair_tolerance`: faces whose plan area is below `repair_tolerance` × (median plan
+ *   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
+ *   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
+ *   `vsr_mesh_plan_nudges`); 0 mends nothing, so such faces are rejected as by
+ *   `vsr_mesh_create`. Finite and >= 0; the Rust API's default is 1e-4.
  * - `n_merged`: receives how many of the file's vertices were merged into another; may be
  *   NULL.
  * - `out`: receives a new handle on success, owned by the caller (free with
@@ -536,7 +541,7 @@ const char *vsr_status_name(uint32_t status);
  * `path` and `supports_path` (when non-NULL) must be NUL-terminated strings; `anchored` must
  * hold `n_anchored` readable ids; `n_merged` must be NULL or writable.
  */
-VsrStatus vsr_mesh_read(const char *path, const char *supports_path, const uint32_t *anchored, size_t n_anchored, double weld_tolerance, size_t *n_merged, struct VsrMesh **out);
+VsrStatus vsr_mesh_read(const char *path, const char *supports_path, const uint32_t *anchored, size_t n_anchored, double weld_tolerance, double repair_tolerance, size_t *n_merged, struct VsrMesh **out);
 
 /**
  * The mesh vertex id of each vertex of the file `vsr_mesh_read` read (several file vertices
@@ -568,6 +573,28 @@ VsrStatus vsr_mesh_welded_ids(const struct VsrMesh *mesh, uint32_t *out, size_t 
  * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
  */
 VsrStatus vsr_result_write(const struct VsrResult *result, const struct VsrMesh *mesh, const char *path);
+
+/**
+ * The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:
+ * the two faces (which keep their ids), the two vertices of the removed edge and the two of
+ * the added edge. None for a mesh from `vsr_mesh_create`. Copy-out as described in the
+ * header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_flips(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The plan moves `vsr_mesh_read` made, in order: #nudges by 2 `uint32_t`, row-major: the
+ * moved vertex and the face it mended. The vertex keeps its height; its new plan position is
+ * the mesh's (as `vsr_result_positions` of an analysis gives it). None for a mesh from
+ * `vsr_mesh_create`. Copy-out as described in the header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_nudges(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
 
 /**
  * Creates a mesh from flat arrays and validates it.

@@ -72,6 +72,7 @@ fn read(
             if ids.is_empty() { null() } else { ids.as_ptr() },
             ids.len(),
             weld,
+            1e-4,
             &mut merged,
             &mut out,
         )
@@ -189,7 +190,7 @@ fn mesh_read_rejects_hostile_paths_and_files() {
     let merged_ptr: *mut usize = &mut merged;
     let path = c(&good);
     let call = |p: *const c_char, sp: *const c_char, a: *const u32, n: usize, w: f64, out| unsafe {
-        vsr_mesh_read(p, sp, a, n, w, merged_ptr, out)
+        vsr_mesh_read(p, sp, a, n, w, 1e-4, merged_ptr, out)
     };
     assert_failed(
         call(null(), null(), ids.as_ptr(), 4, 0.0, &mut out),
@@ -334,4 +335,92 @@ fn result_write_rejects_hostile_arguments_and_writes_nothing() {
         vsr_result_destroy(result);
         vsr_mesh_destroy(mesh);
     }
+}
+
+/// The square with a sliver: vertex 5 a hair past the middle of the diagonal (0, 2), in the
+/// face (0, 2, 5) whose plan area is about -1e-11 of the median.
+fn sliver_square(dir: &Scratch) -> PathBuf {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.75, 0.25, 0.3],
+        [0.5 + 1e-11, 0.5 - 1e-11, 0.3],
+    ];
+    let faces = vec![
+        [0, 1, 4],
+        [1, 2, 4],
+        [4, 2, 0],
+        [0, 5, 3],
+        [5, 2, 3],
+        [0, 2, 5],
+    ];
+    let path = dir.path("sliver.off");
+    io::write_mesh(&path, &positions, &faces).unwrap();
+    path
+}
+
+fn rows(
+    mesh: *const VsrMesh,
+    get: unsafe extern "C" fn(*const VsrMesh, *mut u32, usize, *mut usize) -> VsrStatus,
+) -> Vec<u32> {
+    let mut needed = usize::MAX;
+    assert_ok(unsafe { get(mesh, null_mut(), 0, &mut needed) });
+    let mut out = vec![u32::MAX; needed];
+    assert_ok(unsafe { get(mesh, out.as_mut_ptr(), out.len(), &mut needed) });
+    out
+}
+
+#[test]
+fn plan_slivers_are_repaired_and_listed_unless_the_tolerance_is_zero() {
+    let dir = Scratch::new("repair");
+    let path = c(&sliver_square(&dir));
+    let ids = [0u32, 1, 2, 3];
+    let mut out = sentinel();
+    let strict = unsafe {
+        vsr_mesh_read(
+            path.as_ptr(),
+            null(),
+            ids.as_ptr(),
+            4,
+            0.0,
+            0.0,
+            null_mut(),
+            &mut out,
+        )
+    };
+    assert_failed(strict, S::InvalidPlan, "positions");
+    assert!(last_error().contains('5'), "{}", last_error());
+    assert_eq!(out, sentinel());
+    let status = unsafe {
+        vsr_mesh_read(
+            path.as_ptr(),
+            null(),
+            ids.as_ptr(),
+            4,
+            0.0,
+            1e-4,
+            null_mut(),
+            &mut out,
+        )
+    };
+    assert_ok(status);
+    // Faces 5 (the sliver) and 2 shared the diagonal (0, 2); they now share (5, 4).
+    assert_eq!(rows(out, vsr_mesh_plan_flips), vec![5, 2, 0, 2, 5, 4]);
+    assert_eq!(rows(out, vsr_mesh_plan_nudges), Vec::<u32>::new());
+    let result = form_find(out);
+    unsafe {
+        vsr_result_destroy(result);
+        vsr_mesh_destroy(out);
+    }
+    // A mesh from arrays has no repairs.
+    let mesh = capi_support::Dome::new(2, 6).create();
+    assert!(rows(mesh, vsr_mesh_plan_flips).is_empty());
+    assert_failed(
+        unsafe { vsr_mesh_plan_nudges(null(), null_mut(), 0, null_mut()) },
+        S::NullPointer,
+        "mesh",
+    );
+    unsafe { vsr_mesh_destroy(mesh) };
 }

@@ -9,6 +9,7 @@ use super::mesh::VsrMesh;
 use super::result::VsrResult;
 use super::status::VsrStatus;
 use crate::io;
+use crate::mesh::repair::{repair_plan, PlanRepair};
 use crate::mesh::Mesh;
 use crate::problem::Problem;
 
@@ -39,6 +40,11 @@ unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
 /// - `weld_tolerance`: vertices closer than `weld_tolerance` × (bounding box diagonal) are
 ///   merged into the first of them (0 merges exactly equal positions only; default in the Rust
 ///   API 1e-9); finite and >= 0. STL files, whose triangles never share vertices, need it.
+/// - `repair_tolerance`: faces whose plan area is below `repair_tolerance` × (median plan
+///   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
+///   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
+///   `vsr_mesh_plan_nudges`); 0 mends nothing, so such faces are rejected as by
+///   `vsr_mesh_create`. Finite and >= 0; the Rust API's default is 1e-4.
 /// - `n_merged`: receives how many of the file's vertices were merged into another; may be
 ///   NULL.
 /// - `out`: receives a new handle on success, owned by the caller (free with
@@ -64,6 +70,7 @@ pub unsafe extern "C" fn vsr_mesh_read(
     anchored: *const u32,
     n_anchored: usize,
     weld_tolerance: f64,
+    repair_tolerance: f64,
     n_merged: *mut usize,
     out: *mut *mut VsrMesh,
 ) -> VsrStatus {
@@ -89,11 +96,16 @@ pub unsafe extern "C" fn vsr_mesh_read(
             // SAFETY: non-NULL; NUL-terminated by the caller's contract.
             Some(unsafe { path_arg("supports_path", supports_path)? })
         };
-        if !(weld_tolerance.is_finite() && weld_tolerance >= 0.0) {
-            return Err(Failure::invalid(
-                "weld_tolerance",
-                format!("{weld_tolerance} is not a finite number >= 0"),
-            ));
+        for (name, value) in [
+            ("weld_tolerance", weld_tolerance),
+            ("repair_tolerance", repair_tolerance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Failure::invalid(
+                    name,
+                    format!("{value} is not a finite number >= 0"),
+                ));
+            }
         }
         let (positions, faces) = io::read_mesh(&path).map_err(|e| from_error("path", e))?;
         let ids = match &supports_path {
@@ -105,11 +117,14 @@ pub unsafe extern "C" fn vsr_mesh_read(
         let anchored = welded
             .map_ids(&ids)
             .map_err(|e| from_error("anchored", e))?;
-        let mesh = Mesh::new(welded.positions.clone(), welded.faces.clone(), &anchored)
+        let (mut positions, mut faces) = (welded.positions, welded.faces);
+        let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
             .map_err(|e| from_error("path", e))?;
+        let mesh = Mesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
         let handle = Box::new(VsrMesh {
             problem: Problem::new(mesh),
             welded_ids: Some(welded.welded_id),
+            repairs,
         });
         if !n_merged.is_null() {
             // SAFETY: non-NULL; writable by the caller's contract.
@@ -200,5 +215,76 @@ pub unsafe extern "C" fn vsr_result_write(
             m.faces.clone()
         };
         io::write_mesh(&path, positions, &faces).map_err(|e| from_error("path", e))
+    })
+}
+
+/// The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:
+/// the two faces (which keep their ids), the two vertices of the removed edge and the two of
+/// the added edge. None for a mesh from `vsr_mesh_create`. Copy-out as described in the
+/// header's introduction.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_plan_flips(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let rows: Vec<u32> = mesh
+            .repairs
+            .iter()
+            .flat_map(|r| match r {
+                PlanRepair::Flip {
+                    faces,
+                    removed,
+                    added,
+                } => vec![
+                    faces[0] as u32,
+                    faces[1] as u32,
+                    removed[0],
+                    removed[1],
+                    added[0],
+                    added[1],
+                ],
+                _ => Vec::new(),
+            })
+            .collect();
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy_out(&rows, out, len, needed) }
+    })
+}
+
+/// The plan moves `vsr_mesh_read` made, in order: #nudges by 2 `uint32_t`, row-major: the
+/// moved vertex and the face it mended. The vertex keeps its height; its new plan position is
+/// the mesh's (as `vsr_result_positions` of an analysis gives it). None for a mesh from
+/// `vsr_mesh_create`. Copy-out as described in the header's introduction.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_plan_nudges(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let rows: Vec<u32> = mesh
+            .repairs
+            .iter()
+            .flat_map(|r| match r {
+                PlanRepair::Nudge { vertex, face, .. } => vec![*vertex, *face as u32],
+                _ => Vec::new(),
+            })
+            .collect();
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy_out(&rows, out, len, needed) }
     })
 }

@@ -14,6 +14,8 @@ pub struct VsrMesh {
     pub(crate) problem: Problem,
     /// For a mesh read from a file, the mesh vertex of each of the file's vertices.
     pub(crate) welded_ids: Option<Vec<u32>>,
+    /// For a mesh read from a file, the plan repairs made before validation.
+    pub(crate) repairs: Vec<crate::mesh::repair::PlanRepair>,
 }
 
 /// Largest vertex count (ids are `uint32_t`).
@@ -96,6 +98,7 @@ pub unsafe extern "C" fn vsr_mesh_create(
         let handle = Box::new(VsrMesh {
             problem: Problem::new(mesh),
             welded_ids: None,
+            repairs: Vec::new(),
         });
         // SAFETY: `out` is non-NULL and writable by the caller's contract.
         unsafe { out.write(Box::into_raw(handle)) };

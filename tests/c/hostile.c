@@ -208,26 +208,35 @@ int main(void) {
             fputs(good_off, f);
             fclose(f);
         }
-        EXPECT(vsr_mesh_read(NULL, NULL, anchored, 4, 1e-9, &merged, &read),
+        EXPECT(vsr_mesh_read(NULL, NULL, anchored, 4, 1e-9, 1e-4, &merged, &read),
                VSR_STATUS_NULL_POINTER, "path");
-        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, &merged, NULL),
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             NULL),
                VSR_STATUS_NULL_POINTER, "out");
-        EXPECT(vsr_mesh_read("vsr_hostile_missing.obj", NULL, anchored, 4, 1e-9, &merged, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_missing.obj", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
                VSR_STATUS_INVALID_ARGUMENT, "path");
-        EXPECT(vsr_mesh_read("vsr_hostile_good.xyz", NULL, anchored, 4, 1e-9, &merged, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_good.xyz", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
                VSR_STATUS_INVALID_ARGUMENT, "path");
-        EXPECT(vsr_mesh_read("vsr_hostile_bad.off", NULL, anchored, 3, 1e-9, &merged, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_bad.off", NULL, anchored, 3, 1e-9, 1e-4, &merged,
+                             &read),
                VSR_STATUS_INVALID_ARGUMENT, "path");
         TRUE(strstr(vsr_last_error_message(), "vsr_hostile_bad.off:6:") != NULL);
-        EXPECT(vsr_mesh_read("vsr_hostile_short.stl", NULL, anchored, 4, 1e-9, &merged, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_short.stl", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
                VSR_STATUS_INVALID_ARGUMENT, "path");
         EXPECT(vsr_mesh_read("vsr_hostile_good.off", "vsr_hostile_missing.json", NULL, 0, 1e-9,
-                             &merged, &read),
+                             1e-4, &merged, &read),
                VSR_STATUS_INVALID_ARGUMENT, "supports_path");
-        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, NAN, &merged, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, NAN, 1e-4, &merged,
+                             &read),
                VSR_STATUS_INVALID_ARGUMENT, "weld_tolerance");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, -1.0, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "repair_tolerance");
         TRUE(read == sentinel_mesh && merged == 77);
-        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, NULL, &read),
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, 1e-4, NULL, &read),
                VSR_STATUS_OK, "");
         EXPECT(vsr_result_write(result, read, NULL), VSR_STATUS_NULL_POINTER, "path");
         EXPECT(vsr_result_write(result, read, "vsr_hostile_no_such_dir/out.off"),
