@@ -24,15 +24,15 @@ const POSITIONS: [[f64; 3]; 5] = [
 ];
 const TRIANGLES: [[u32; 3]; 4] = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
 
-struct Scratch(PathBuf);
+struct TempDir(PathBuf);
 
-impl Scratch {
-    fn new(name: &str) -> Scratch {
+impl TempDir {
+    fn new(name: &str) -> TempDir {
         let dir =
             std::env::temp_dir().join(format!("voussoir-capi-files-{}-{name}", std::process::id()));
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
+        TempDir(dir)
     }
 
     fn path(&self, name: &str) -> PathBuf {
@@ -40,7 +40,7 @@ impl Scratch {
     }
 }
 
-impl Drop for Scratch {
+impl Drop for TempDir {
     fn drop(&mut self) {
         let _ = fs::remove_dir_all(&self.0);
     }
@@ -110,7 +110,7 @@ fn bits(p: &[[f64; 3]]) -> Vec<[u64; 3]> {
 
 #[test]
 fn every_format_reads_form_finds_and_writes_back_every_bit() {
-    let dir = Scratch::new("formats");
+    let dir = TempDir::new("formats");
     let sidecar = dir.path("s.json");
     fs::write(&sidecar, "{\"anchored\": [0, 1, 2, 3]}").unwrap();
     for name in ["m.obj", "m.off", "m.ply"] {
@@ -142,7 +142,7 @@ fn every_format_reads_form_finds_and_writes_back_every_bit() {
 
 #[test]
 fn stl_is_welded_and_ids_refer_to_its_own_vertices() {
-    let dir = Scratch::new("stl");
+    let dir = TempDir::new("stl");
     let file = dir.path("m.stl");
     io::write_mesh(&file, &POSITIONS, &TRIANGLES).unwrap();
     // The corners as the STL numbers them (corner k of triangle t is 3t + k): 0, 1, 4, 7 are
@@ -163,7 +163,7 @@ fn stl_is_welded_and_ids_refer_to_its_own_vertices() {
 
 #[test]
 fn a_clockwise_file_is_written_back_in_its_own_orientation() {
-    let dir = Scratch::new("clockwise");
+    let dir = TempDir::new("clockwise");
     let clockwise: Vec<[u32; 3]> = TRIANGLES.iter().map(|&[a, b, c]| [a, c, b]).collect();
     let file = dir.path("cw.off");
     io::write_mesh(&file, &POSITIONS, &clockwise).unwrap();
@@ -181,7 +181,7 @@ fn a_clockwise_file_is_written_back_in_its_own_orientation() {
 
 #[test]
 fn mesh_read_rejects_hostile_paths_and_files() {
-    let dir = Scratch::new("hostile");
+    let dir = TempDir::new("hostile");
     let good = dir.path("m.off");
     io::write_mesh(&good, &POSITIONS, &TRIANGLES).unwrap();
     let ids = [0u32, 1, 2, 3];
@@ -277,7 +277,7 @@ fn mesh_read_rejects_hostile_paths_and_files() {
 
 #[test]
 fn result_write_rejects_hostile_arguments_and_writes_nothing() {
-    let dir = Scratch::new("write");
+    let dir = TempDir::new("write");
     let file = dir.path("m.obj");
     io::write_mesh(&file, &POSITIONS, &TRIANGLES).unwrap();
     let (s, mesh, _) = read(&file, None, &[0, 1, 2, 3], 0.0);
@@ -339,7 +339,7 @@ fn result_write_rejects_hostile_arguments_and_writes_nothing() {
 
 /// The square with a sliver: vertex 5 a hair past the middle of the diagonal (0, 2), in the
 /// face (0, 2, 5) whose plan area is about -1e-11 of the median.
-fn sliver_square(dir: &Scratch) -> PathBuf {
+fn sliver_square(dir: &TempDir) -> PathBuf {
     let positions = vec![
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
@@ -374,7 +374,7 @@ fn rows(
 
 #[test]
 fn plan_slivers_are_repaired_and_listed_unless_the_tolerance_is_zero() {
-    let dir = Scratch::new("repair");
+    let dir = TempDir::new("repair");
     let path = c(&sliver_square(&dir));
     let ids = [0u32, 1, 2, 3];
     let mut out = sentinel();

@@ -156,8 +156,8 @@ fn binary_ply(dir: &Path) -> Vec<u8> {
 
 #[test]
 fn bad_files_exit_2_naming_the_line_or_element() {
-    let scratch = Scratch::new("ply-source");
-    let ply = binary_ply(&scratch.0);
+    let source = Scratch::new("ply-source");
+    let ply = binary_ply(&source.0);
     let mut stl = vec![0u8; 80];
     stl.extend(2u32.to_le_bytes());
     stl.extend([0u8; 60]);
