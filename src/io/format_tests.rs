@@ -295,6 +295,10 @@ fn ascii_and_big_endian_ply_with_other_properties() {
     }
     let (p, f) = parse_ply(&bytes, "x.ply").unwrap();
     assert_eq!((p[2], f), ([0.0, 1.0, 0.25], vec![[0, 1, 2]]));
+    // The sized type names some exporters write.
+    let sized = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float32 x\nproperty float32 y\nproperty float64 z\nelement face 1\nproperty list uint8 int32 vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 2.5\n3 0 1 2\n";
+    let (p, f) = parse_ply(sized.as_bytes(), "x.ply").unwrap();
+    assert_eq!((p[2], f), ([0.0, 1.0, 2.5], vec![[0, 1, 2]]));
 }
 
 #[test]
