@@ -505,6 +505,98 @@ const char *vsr_last_error_message(void);
 const char *vsr_status_name(uint32_t status);
 
 /**
+ * Creates a mesh from a file: OBJ, OFF, STL (binary or ASCII) or PLY (ASCII or binary),
+ * chosen by the extension of `path` (case-insensitive `.obj`, `.off`, `.stl`, `.ply`);
+ * polygons are split into fans.
+ *
+ * - `path`: the mesh file, a NUL-terminated UTF-8 path.
+ * - `supports_path`: a JSON file of anchored vertex ids (`{"anchored": [ids]}` or `[ids]`),
+ *   or NULL to use `anchored` instead.
+ * - `anchored`: `n_anchored` anchored vertex ids when `supports_path` is NULL (NULL when
+ *   `n_anchored` is 0). Giving both is `VSR_STATUS_INVALID_ARGUMENT`.
+ * - `weld_tolerance`: vertices closer than `weld_tolerance` × (bounding box diagonal) are
+ *   merged into the first of them (0 merges exactly equal positions only; default in the Rust
+ *   API 1e-9); finite and >= 0. STL files, whose triangles never share vertices, need it.
+ * - `repair_tolerance`: faces whose plan area is below `repair_tolerance` × (median plan
+ *   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
+ *   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
+ *   `vsr_mesh_plan_nudges`); 0 mends nothing, so such faces are rejected as by
+ *   `vsr_mesh_create`. Finite and >= 0; the Rust API's default is 1e-4.
+ * - `n_merged`: receives how many of the file's vertices were merged into another; may be
+ *   NULL.
+ * - `out`: receives a new handle on success, owned by the caller (free with
+ *   `vsr_mesh_destroy`); untouched on failure.
+ *
+ * Support ids are the file's own 0-based vertex ids (an STL file has three per triangle:
+ * vertex `3t + k` is corner `k` of triangle `t`). The mesh's vertices are the welded ones,
+ * numbered in the order of their first vertex in the file; `vsr_mesh_welded_ids` maps file
+ * ids onto them. Loads and defaults are those of `vsr_mesh_create`.
+ *
+ * Errors: NULL `path` or `out` (`VSR_STATUS_NULL_POINTER`); an unknown extension, a file
+ * that cannot be read, or a malformed file (`VSR_STATUS_INVALID_ARGUMENT`, the message names
+ * the file and its line, or the element of a binary file); a support id `>=` the file's
+ * vertex count (`VSR_STATUS_INDEX_OUT_OF_RANGE`); then the checks of `vsr_mesh_create`.
+ *
+ * # Safety
+ * `path` and `supports_path` (when non-NULL) must be NUL-terminated strings; `anchored` must
+ * hold `n_anchored` readable ids; `n_merged` must be NULL or writable.
+ */
+VsrStatus vsr_mesh_read(const char *path, const char *supports_path, const uint32_t *anchored, size_t n_anchored, double weld_tolerance, double repair_tolerance, size_t *n_merged, struct VsrMesh **out);
+
+/**
+ * The mesh vertex id of each vertex of the file `vsr_mesh_read` read (several file vertices
+ * share one id where they were welded); for a mesh from `vsr_mesh_create`, `0 .. #V - 1`.
+ * Copy-out as described in the header's introduction: `uint32_t` entries, one per file
+ * vertex.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_welded_ids(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * Writes the result's vertex positions with the mesh's triangles to `path`, in the format of
+ * its extension (`.obj`, `.off`, `.ply` binary little-endian, `.stl` binary), all or nothing:
+ * the file is written beside `path` under a temporary name and renamed over it.
+ *
+ * OBJ, OFF and PLY keep every bit of the positions (the shortest decimal that reads back the
+ * same double, or doubles). STL stores single precision by definition: about 7 significant
+ * digits, enough to view or print a shape but not to keep its equilibrium. Triangles are
+ * written in the orientation they were given (the mesh's internal reversal of a clockwise
+ * plan is undone).
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
+ * the mesh, an unknown extension, or a file that cannot be written
+ * (`VSR_STATUS_INVALID_ARGUMENT`).
+ *
+ * # Safety
+ * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
+ */
+VsrStatus vsr_result_write(const struct VsrResult *result, const struct VsrMesh *mesh, const char *path);
+
+/**
+ * The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:
+ * the two faces (which keep their ids), the two vertices of the removed edge and the two of
+ * the added edge. None for a mesh from `vsr_mesh_create`. Copy-out as described in the
+ * header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_flips(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The plan moves `vsr_mesh_read` made, in order: #nudges by 2 `uint32_t`, row-major: the
+ * moved vertex and the face it mended. The vertex keeps its height; its new plan position is
+ * the mesh's (as `vsr_result_positions` of an analysis gives it). None for a mesh from
+ * `vsr_mesh_create`. Copy-out as described in the header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_nudges(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
  * Creates a mesh from flat arrays and validates it.
  *
  * - `positions`: #V by 3 doubles, row-major (x, y, z per vertex; x, y is the plan and z the

@@ -11,12 +11,14 @@
 #![allow(unsafe_code)]
 
 mod boundary;
+mod files;
 mod mesh;
 mod result;
 mod settings;
 mod solve;
 mod status;
 
+pub use files::*;
 pub use mesh::*;
 pub use result::*;
 pub use settings::*;

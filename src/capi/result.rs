@@ -46,7 +46,7 @@ impl VsrResult {
         }
     }
 
-    fn positions(&self) -> &[[f64; 3]] {
+    pub(crate) fn positions(&self) -> &[[f64; 3]] {
         match &self.outcome {
             Outcome::Analysis { positions, .. } => positions,
             Outcome::FormFinding(f) => &f.positions,
