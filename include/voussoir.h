@@ -270,6 +270,12 @@ enum VsrTermination
    * The progress callback returned non-zero.
    */
   VSR_TERMINATION_CANCELLED = 5,
+  /**
+   * The shape cannot be balanced under the stress constraints within the height limit
+   * (`vsr_settings_set_max_height_change`): `vsr_result_termination_message` names what
+   * blocks (q_max or the limit) and `vsr_result_stalled_vertices` lists where.
+   */
+  VSR_TERMINATION_BLOCKED = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -436,6 +442,33 @@ enum VsrEdgeScope
 typedef enum VsrEdgeScope VsrEdgeScope;
 #else
 typedef uint32_t VsrEdgeScope;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
+ * How form finding moves the shape (`vsr_settings_set_method`).
+ */
+enum VsrMethod
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Default: the nearest self-supporting shape (least area-weighted squared height change,
+   * plus the fairness term, subject to equilibrium).
+   */
+  VSR_METHOD_NEAREST = 0,
+  /**
+   * The paper's loop: height steps pulled towards the current heights with the proximal
+   * schedule (`vsr_settings_set_schedule_*`).
+   */
+  VSR_METHOD_PAPER = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VsrMethod VsrMethod;
+#else
+typedef uint32_t VsrMethod;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
 
@@ -961,14 +994,26 @@ VsrStatus vsr_result_termination(const struct VsrResult *result, VsrTermination 
 VsrStatus vsr_result_termination_message(const struct VsrResult *result, char *out, size_t len, size_t *needed);
 
 /**
- * Vertices listed by a `VSR_TERMINATION_STALLED` form finding, `uint32_t` ids (0 entries for
- * any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
+ * Vertices listed by a `VSR_TERMINATION_STALLED` or `VSR_TERMINATION_BLOCKED` form
+ * finding, `uint32_t` ids (0 entries for any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
  * writable.
  */
 VsrStatus vsr_result_stalled_vertices(const struct VsrResult *result, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The height change of a form finding, over the plan bounding-box diagonal
+ * (dimensionless): `rms` = the RMS change of the non-anchored vertices weighted by their plan
+ * area shares (the nearest method's objective), `max` = the largest change at any vertex.
+ * Both pointers required; written only on success. For an analysis result:
+ * `VSR_STATUS_NOT_AVAILABLE`.
+ *
+ * # Safety
+ * `result`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_result_height_change(const struct VsrResult *result, double *rms, double *max);
 
 /**
  * Distances between the form-found and the input heights, over the plan bounding-box
@@ -996,8 +1041,11 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  *
  * | option | default |
  * |---|---|
+ * | method | `VSR_METHOD_NEAREST` |
+ * | fairness γ (nearest method) | 0.03 |
+ * | max height change (nearest method) | 1 plan diagonal |
  * | tolerance (on ε∞) | 1e-6 |
- * | max iterations | 50 |
+ * | max iterations (stress steps) | 100 |
  * | stall window | 8 iterations |
  * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
  * | q_max | none (+INFINITY) |
@@ -1008,7 +1056,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
  * | regularisation ε | 1e-10 |
  * | dual edge length bounds | none |
- * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.2, 1e-9, 1e-3, 0 |
+ * | schedule μ₀, β, μ_min, η, pull ν (paper method) | 1, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
@@ -1106,6 +1154,35 @@ VsrStatus vsr_settings_set_tau_mode(struct VsrSettings *settings, uint32_t mode)
 VsrStatus vsr_settings_set_hole_mode(struct VsrSettings *settings, uint32_t mode);
 
 /**
+ * Sets how form finding moves the shape: a `VsrMethod`. Default `VSR_METHOD_NEAREST`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_method(struct VsrSettings *settings, uint32_t method);
+
+/**
+ * Sets γ, the weight of the fairness term γ Σ_e c_e (Δz_i − Δz_j)² on the height change of
+ * the nearest method, relative to the area-weighted squared change (dimensionless; c_e is the
+ * plan area beside edge e over its squared length). Finite and >= 0; 0 turns it off. Default
+ * 0.03.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_fairness(struct VsrSettings *settings, double gamma);
+
+/**
+ * Sets the largest height change the nearest method may make at any vertex, in plan
+ * bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
+ * `VSR_TERMINATION_BLOCKED`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_max_height_change(struct VsrSettings *settings, double diagonals);
+
+/**
  * Sets how face weights become vertex loads: a `VsrLoadRule`. Default
  * `VSR_LOAD_RULE_BARYCENTRIC`.
  *
@@ -1168,8 +1245,8 @@ VsrStatus vsr_settings_set_dual_length_bounds(struct VsrSettings *settings, doub
 VsrStatus vsr_settings_set_dual_length_smoothing(struct VsrSettings *settings, double mu, double decay);
 
 /**
- * Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
- * of the height system; dimensionless). Finite and >= 0. Default 0.3.
+ * Sets μ₀ of the paper method's proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the
+ * mean diagonal of the height system; dimensionless). Finite and >= 0. Default 1.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.
@@ -1177,7 +1254,8 @@ VsrStatus vsr_settings_set_dual_length_smoothing(struct VsrSettings *settings, d
 VsrStatus vsr_settings_set_schedule_mu0(struct VsrSettings *settings, double mu0);
 
 /**
- * Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.2.
+ * Sets β, the per-iteration decay of the paper method's proximal weight μ. Finite, in
+ * [0, 1]. Default 0.25.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

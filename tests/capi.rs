@@ -423,7 +423,22 @@ fn mesh_queries_reject_null_and_short_buffers() {
 fn settings_setters_reject_bad_values() {
     let s = settings();
     type F64Setter = unsafe extern "C" fn(*mut VsrSettings, f64) -> VsrStatus;
-    let doubles: [(F64Setter, &str, f64, VsrStatus); 20] = [
+    let doubles: [(F64Setter, &str, f64, VsrStatus); 25] = [
+        (vsr_settings_set_fairness, "gamma", -0.1, S::InvalidArgument),
+        (vsr_settings_set_fairness, "gamma", f64::NAN, S::NonFinite),
+        (
+            vsr_settings_set_max_height_change,
+            "diagonals",
+            0.0,
+            S::InvalidArgument,
+        ),
+        (
+            vsr_settings_set_max_height_change,
+            "diagonals",
+            f64::INFINITY,
+            S::NonFinite,
+        ),
+        (vsr_settings_set_fairness, "settings", 0.1, S::NullPointer),
         (
             vsr_settings_set_tolerance,
             "tolerance",
@@ -539,7 +554,8 @@ fn settings_setters_reject_bad_values() {
         assert_failed(unsafe { set(target, value) }, status, name);
     }
     type EnumSetter = unsafe extern "C" fn(*mut VsrSettings, u32) -> VsrStatus;
-    let enums: [(EnumSetter, &str, u32); 5] = [
+    let enums: [(EnumSetter, &str, u32); 6] = [
+        (vsr_settings_set_method, "method", 2),
         (vsr_settings_set_tau_mode, "mode", 3),
         (vsr_settings_set_hole_mode, "mode", 2),
         (vsr_settings_set_load_rule, "rule", 3),
@@ -777,6 +793,20 @@ fn result_getters_check_pointers_buffers_and_kind() {
     assert_eq!((a, b), (-1.0, -1.0));
     assert_ok(unsafe { vsr_result_distances(form, &mut a, &mut b) });
     assert!(a >= 0.0 && b >= 0.0 && a >= b);
+    let (mut rms, mut max) = (-1.0, -1.0);
+    assert_failed(
+        unsafe { vsr_result_height_change(analysis, &mut rms, &mut max) },
+        S::NotAvailable,
+        "result",
+    );
+    assert_failed(
+        unsafe { vsr_result_height_change(form, null_mut(), &mut max) },
+        S::NullPointer,
+        "rms",
+    );
+    assert_eq!((rms, max), (-1.0, -1.0));
+    assert_ok(unsafe { vsr_result_height_change(form, &mut rms, &mut max) });
+    assert!(rms >= 0.0 && max >= rms);
 
     // Scalar getters: every NULL slot.
     let (mut st_, mut eps, mut obj, mut qi) = (VsrStressStatus::NumericalError, -1.0, -1.0, 0usize);
@@ -996,4 +1026,46 @@ fn odt_sweeps_move_the_plan_through_the_c_abi() {
         vsr_settings_destroy(s);
         vsr_mesh_destroy(mesh);
     }
+}
+
+#[test]
+fn both_methods_through_the_c_abi_equal_the_rust_ones_bit_for_bit() {
+    let mut d = Dome::new(4, 10);
+    d.positions
+        .iter_mut()
+        .skip(2)
+        .step_by(3)
+        .for_each(|z| *z *= 0.6);
+    let rust_mesh = voussoir::Mesh::new(
+        d.positions.chunks(3).map(|p| [p[0], p[1], p[2]]).collect(),
+        d.triangles.chunks(3).map(|t| [t[0], t[1], t[2]]).collect(),
+        &d.anchored,
+    )
+    .unwrap();
+    let problem = voussoir::Problem::new(rust_mesh);
+    let mesh = d.create();
+    for (method, rust_method) in [
+        (VsrMethod::Nearest, voussoir::FormMethod::Nearest),
+        (VsrMethod::Paper, voussoir::FormMethod::Paper),
+    ] {
+        let s = settings();
+        assert_ok(unsafe { vsr_settings_set_method(s, method as u32) });
+        let mut r = null_mut();
+        assert_ok(unsafe { vsr_form_find(mesh, s, &mut r) });
+        let settings = voussoir::FormFindSettings {
+            method: rust_method,
+            ..Default::default()
+        };
+        let expected = voussoir::form_find(&problem, &settings, None).unwrap();
+        let flat: Vec<f64> = expected.positions.iter().flatten().copied().collect();
+        assert_eq!(doubles(r, vsr_result_positions), flat, "{method:?}");
+        let (mut rms, mut max) = (0.0, 0.0);
+        assert_ok(unsafe { vsr_result_height_change(r, &mut rms, &mut max) });
+        assert_eq!((rms, max), (expected.rms_change, expected.max_change));
+        unsafe {
+            vsr_result_destroy(r);
+            vsr_settings_destroy(s);
+        }
+    }
+    unsafe { vsr_mesh_destroy(mesh) };
 }

@@ -31,7 +31,7 @@ pub fn termination(outcome: &Outcome) -> (String, Value) {
     };
     let detail = if let Termination::Stalled { vertices } = t {
         json!({ "vertices": vertices })
-    } else if let Termination::HeightLimit { vertices, hint } = t {
+    } else if let Termination::Blocked { vertices, hint } = t {
         json!({ "vertices": vertices, "hint": hint })
     } else if let Termination::Infeasible { constraint } = t {
         json!({ "constraint": constraint })

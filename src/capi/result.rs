@@ -697,9 +697,9 @@ pub unsafe extern "C" fn vsr_result_termination_message(
                     }
                     Termination::NumericalError { what } => format!("numerical error: {what}"),
                     Termination::Cancelled => "cancelled by the progress callback".to_string(),
-                    Termination::HeightLimit { vertices, hint } => format!(
-                        "stopped at the height limit: vertices {vertices:?} reached it; {hint}"
-                    ),
+                    Termination::Blocked { vertices, hint } => {
+                        format!("blocked: {hint}; vertices {vertices:?}")
+                    }
                 };
                 let mut bytes: Vec<c_char> = text
                     .bytes()
@@ -713,7 +713,7 @@ pub unsafe extern "C" fn vsr_result_termination_message(
     })
 }
 
-/// Vertices listed by a `VSR_TERMINATION_STALLED` or `VSR_TERMINATION_HEIGHT_LIMIT` form
+/// Vertices listed by a `VSR_TERMINATION_STALLED` or `VSR_TERMINATION_BLOCKED` form
 /// finding, `uint32_t` ids (0 entries for any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
 ///
 /// # Safety
@@ -731,8 +731,9 @@ pub unsafe extern "C" fn vsr_result_stalled_vertices(
         unsafe {
             copy(result, out, len, needed, |r| {
                 Ok(match &r.form("the stalled vertices")?.termination {
-                    Termination::Stalled { vertices }
-                    | Termination::HeightLimit { vertices, .. } => vertices.clone(),
+                    Termination::Stalled { vertices } | Termination::Blocked { vertices, .. } => {
+                        vertices.clone()
+                    }
                     _ => Vec::new(),
                 })
             })

@@ -325,7 +325,7 @@ pub unsafe extern "C" fn vsr_settings_set_fairness(
 
 /// Sets the largest height change the nearest method may make at any vertex, in plan
 /// bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
-/// `VSR_TERMINATION_HEIGHT_LIMIT`.
+/// `VSR_TERMINATION_BLOCKED`.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.

@@ -112,10 +112,10 @@ pub enum VsrTermination {
     NumericalError = 4,
     /// The progress callback returned non-zero.
     Cancelled = 5,
-    /// The nearest shape that stands lies beyond the height limit
-    /// (`vsr_settings_set_max_height_change`); `vsr_result_stalled_vertices` lists the
-    /// vertices that reached it and `vsr_result_termination_message` names what blocks.
-    HeightLimit = 6,
+    /// The shape cannot be balanced under the stress constraints within the height limit
+    /// (`vsr_settings_set_max_height_change`): `vsr_result_termination_message` names what
+    /// blocks (q_max or the limit) and `vsr_result_stalled_vertices` lists where.
+    Blocked = 6,
 }
 
 impl VsrTermination {
@@ -127,7 +127,7 @@ impl VsrTermination {
             Termination::Infeasible { .. } => VsrTermination::Infeasible,
             Termination::NumericalError { .. } => VsrTermination::NumericalError,
             Termination::Cancelled => VsrTermination::Cancelled,
-            Termination::HeightLimit { .. } => VsrTermination::HeightLimit,
+            Termination::Blocked { .. } => VsrTermination::Blocked,
         }
     }
 }

@@ -83,6 +83,66 @@ pub fn vertex_loads(
     p
 }
 
+/// Derivatives of the loads with respect to heights, ∂p_i/∂z_k, for vertices sharing a face:
+/// `diagonal[i]` = ∂p_i/∂z_i and, per edge (v0, v1), `edge[e]` = [∂p_v0/∂z_v1, ∂p_v1/∂z_v0].
+/// Nearly vertical faces make loads change fastest with heights.
+pub struct LoadJacobian {
+    pub diagonal: Vec<f64>,
+    pub edge: Vec<[f64; 2]>,
+}
+
+/// The load Jacobian at `positions` by central differences of each face's corner shares
+/// (step 1e-6 of the face's longest edge; the shares are smooth in the heights).
+pub fn load_jacobian(
+    mesh: &Mesh,
+    positions: &[[f64; 3]],
+    rule: LoadRule,
+    density: &[f64],
+) -> LoadJacobian {
+    let mut diagonal = vec![0.0; positions.len()];
+    let mut edge = vec![[0.0; 2]; mesh.edges.len()];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        let corners = f.map(|i| positions[i as usize]);
+        let size = (0..3)
+            .map(|k| {
+                dot3(
+                    sub3(corners[(k + 1) % 3], corners[k]),
+                    sub3(corners[(k + 1) % 3], corners[k]),
+                )
+            })
+            .fold(0.0f64, f64::max)
+            .sqrt();
+        let h = 1e-6 * size;
+        if h == 0.0 {
+            continue;
+        }
+        for k in 0..3 {
+            let (mut up, mut down) = (corners, corners);
+            up[k][2] += h;
+            down[k][2] -= h;
+            let (su, sd) = (corner_shares(rule, up), corner_shares(rule, down));
+            for i in 0..3 {
+                let d = density[t] * (su[i] - sd[i]) / (2.0 * h);
+                if i == k {
+                    diagonal[f[i] as usize] += d;
+                    continue;
+                }
+                let (a, b) = (f[i], f[k]);
+                let e = mesh.face_edges[t]
+                    .iter()
+                    .copied()
+                    .find(|&e| {
+                        let v = mesh.edges[e as usize].v;
+                        (v[0] == a && v[1] == b) || (v[0] == b && v[1] == a)
+                    })
+                    .expect("the corners of a face share an edge") as usize;
+                edge[e][usize::from(mesh.edges[e].v[0] != a)] += d;
+            }
+        }
+    }
+    LoadJacobian { diagonal, edge }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,4 +1,4 @@
-//! Height steps (MATH §9): with the force densities fixed, new heights for the non-anchored
+//! Height steps (docs/method.md §11): with the force densities fixed, new heights for the non-anchored
 //! vertices from one sparse least-squares system, K = L_q[V_N, V_N], b = p − L_q[V_N, V_A] z_A:
 //!
 //! - the paper's step, a proximal pull towards the current heights weighted by inverse
@@ -9,6 +9,7 @@
 //! Both share KᵀK's pattern (the two-ring of the mesh), analysed once per mesh.
 
 use crate::error::{Error, Result};
+use crate::geometry::loads::LoadJacobian;
 use crate::mesh::Mesh;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -56,6 +57,8 @@ pub struct ShapeStep {
     diag_slot: Vec<usize>,
     /// Both ends of every edge at a non-anchored vertex, for the fairness term.
     fair_edges: Vec<FairEnd>,
+    /// The two vertices of every mesh edge.
+    edge_ends: Vec<[u32; 2]>,
     symbolic: SymbolicLlt<usize>,
 }
 
@@ -153,6 +156,7 @@ impl ShapeStep {
             product_slot,
             diag_slot,
             fair_edges,
+            edge_ends: mesh.edges.iter().map(|e| e.v).collect(),
             symbolic,
         })
     }
@@ -174,7 +178,7 @@ impl ShapeStep {
         k: usize,
         schedule: &Schedule,
     ) -> Result<Vec<f64>> {
-        let normal = self.normal_equations(q, p, z);
+        let normal = self.normal_equations(q, p, z, None);
         let r_inf = normal.r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let mu = (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * normal.scale;
         let nu = schedule.pull * normal.scale;
@@ -195,6 +199,8 @@ impl ShapeStep {
     /// The heights minimising ‖K z − b‖² + ρ Σ_i a_i (z_i − z⁰_i)² + ρ γ Σ_e c_e (Δ_i − Δ_j)²
     /// (Δ = z − z⁰; `fair` = (γ, c_e per mesh edge)): the height step of the nearest-shape
     /// method, whose normal equations are those of the paper's step with another diagonal.
+    /// With `jacobian`, the loads are linearised at `z` (p + J (z' − z)) instead of held.
+    #[allow(clippy::too_many_arguments)]
     pub fn nearest(
         &self,
         q: &[f64],
@@ -204,8 +210,9 @@ impl ShapeStep {
         rho: f64,
         area: &[f64],
         fair: Option<(f64, &[f64])>,
+        jacobian: Option<&LoadJacobian>,
     ) -> Result<Vec<f64>> {
-        let normal = self.normal_equations(q, p, z);
+        let normal = self.normal_equations(q, p, z, jacobian);
         let pull: Vec<(f64, f64)> = (area.iter().zip(&self.vertices))
             .map(|(&a, &v)| (rho * a, rho * a * z0[v as usize]))
             .collect();
@@ -213,10 +220,17 @@ impl ShapeStep {
         self.solve(normal, &pull, fair, z)
     }
 
-    /// K's values, b, the residual r = K z − b, KᵀK on the fixed pattern and Kᵀb.
-    fn normal_equations(&self, q: &[f64], p: &[f64], z: &[f64]) -> Normal {
+    /// K's values, b, the residual r = K z − b, KᵀK on the fixed pattern and Kᵀb; with the
+    /// loads' Jacobian J, K − J and b − J z (free columns), the residual of linearised loads.
+    fn normal_equations(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        z: &[f64],
+        jacobian: Option<&LoadJacobian>,
+    ) -> Normal {
         let m = self.vertices.len();
-        let k_val: Vec<f64> = (self.k.edge.iter().zip(&self.k.negative))
+        let mut k_val: Vec<f64> = (self.k.edge.iter().zip(&self.k.negative))
             .map(|(&e, &negative)| {
                 if negative {
                     -q[e as usize]
@@ -225,13 +239,19 @@ impl ShapeStep {
                 }
             })
             .collect();
+        let mut shift = vec![0.0; m];
+        if let Some(jac) = jacobian {
+            self.subtract_jacobian(jac, z, &mut k_val, &mut shift);
+        }
         let k_rows: Vec<(&[usize], &[f64])> = (0..m)
             .map(|i| {
                 let range = self.k.start[i]..self.k.start[i + 1];
                 (&self.k.col[range.clone()], &k_val[range])
             })
             .collect();
-        let mut b: Vec<f64> = self.vertices.iter().map(|&v| p[v as usize]).collect();
+        let mut b: Vec<f64> = (self.vertices.iter().zip(&shift))
+            .map(|(&v, s)| p[v as usize] - s)
+            .collect();
         for &(ra, e, c) in &self.k.anchored {
             b[ra] += q[e as usize] * z[c as usize];
         }
@@ -263,6 +283,37 @@ impl ShapeStep {
             ktb,
             r,
             scale: if mean_diag > 0.0 { mean_diag } else { 1.0 },
+        }
+    }
+
+    /// K − J on K's entries (J's diagonal on each row's first entry, a diagonal one; J_ac on
+    /// the entry of column c), and J z over the free columns per row into `shift`.
+    fn subtract_jacobian(
+        &self,
+        jac: &LoadJacobian,
+        z: &[f64],
+        k_val: &mut [f64],
+        shift: &mut [f64],
+    ) {
+        for (row, &v) in self.vertices.iter().enumerate() {
+            let d = jac.diagonal[v as usize];
+            let range = self.k.start[row]..self.k.start[row + 1];
+            if range.is_empty() {
+                continue;
+            }
+            k_val[range.start] -= d;
+            shift[row] += d * z[v as usize];
+            for k in range {
+                if !self.k.negative[k] {
+                    continue;
+                }
+                let e = self.k.edge[k] as usize;
+                let ends = self.edge_ends[e];
+                let j_vc = jac.edge[e][usize::from(ends[0] != v)];
+                let c = self.vertices[self.k.col[k]];
+                k_val[k] -= j_vc;
+                shift[row] += j_vc * z[c as usize];
+            }
         }
     }
 
@@ -471,7 +522,9 @@ mod tests {
         for (rho, gamma) in [(1e3, 0.0), (1e3, 0.5), (1e-2, 2.0)] {
             let terms = (rho, &area[..], gamma, &c[..]);
             let fair = (gamma > 0.0).then_some((gamma, &c[..]));
-            let zs = step.nearest(&q, &p, &z, &z0, rho, &rows, fair).unwrap();
+            let zs = step
+                .nearest(&q, &p, &z, &z0, rho, &rows, fair, None)
+                .unwrap();
             let (_, g0) = objective(&mesh, &q, &p, &z, &z0, terms);
             let (j, g) = objective(&mesh, &q, &p, &zs, &z0, terms);
             let norm = |g: &[f64]| g.iter().map(|x| x * x).sum::<f64>().sqrt();

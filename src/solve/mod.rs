@@ -1,4 +1,4 @@
-//! Form finding (MATH §11): the nearest self-supporting shape to the input
+//! Form finding (docs/method.md §13): the nearest self-supporting shape to the input
 //! ([`FormMethod::Nearest`], the default) or the paper's loop ([`FormMethod::Paper`]). Either
 //! way the result carries the best certified state reached and an honest termination status.
 
@@ -32,10 +32,11 @@ pub enum Termination {
     },
     /// The progress callback asked to stop.
     Cancelled,
-    /// The nearest shape that stands lies beyond the height limit
-    /// ([`FormFindSettings::max_height_change`]): the listed vertices reached it. `hint` names
-    /// the setting that holds the forces down (q_max) or says that the limit blocks.
-    HeightLimit {
+    /// The shape cannot be balanced under the stress constraints within the height limit
+    /// ([`FormFindSettings::max_height_change`]): `hint` names what blocks (q_max holding the
+    /// force densities down, or the height limit) and `vertices` lists where (the vertices at
+    /// the height limit, or those beside edges at q_max with the largest residuals).
+    Blocked {
         vertices: Vec<u32>,
         hint: String,
     },
@@ -66,7 +67,7 @@ pub struct FormFindSettings {
     /// shape; larger values spread a change over a wider, smoother patch. Default 0.03.
     pub fairness: f64,
     /// Largest height change allowed at any vertex, in plan bounding-box diagonals (nearest
-    /// method only). A shape that cannot stand within it ends `HeightLimit`. Default 1.
+    /// method only). A shape that cannot stand within it ends `Blocked`. Default 1.
     pub max_height_change: f64,
     /// Stop when ε∞ = max|r_i| / mean p_i < tolerance. Default 1e-6.
     pub tolerance: f64,
@@ -197,7 +198,7 @@ fn validate(settings: &FormFindSettings) -> Result<()> {
     if !(settings.fairness >= 0.0 && settings.fairness.is_finite()) {
         return bad("fairness", "must be finite and >= 0");
     }
-    if !(settings.max_height_change > 0.0) {
+    if settings.max_height_change.is_nan() || settings.max_height_change <= 0.0 {
         return bad("max_height_change", "must be > 0");
     }
     Ok(())

@@ -1,16 +1,18 @@
-//! The nearest self-supporting shape (docs/method.md, "Form finding"): minimise
+//! The nearest self-supporting shape (docs/method.md §13): minimise
 //!
 //!   E(z) = Σ_i a_i (Δz_i / L₀)² + γ Σ_e c_e ((Δz_i − Δz_j) / L₀)²,   Δz = z − z⁰,
 //!
-//! over the heights of the non-anchored vertices, subject to equilibrium r(z, y) = 0 under the
-//! stress constraints, by a penalty continuation on the merit F_w = E + w R, R the mean
-//! squared residual over the mean load. For fixed forces F_w is a convex quadratic in z
-//! (loads lagged), for fixed heights the stress QP minimises R exactly; each step minimises
-//! one block, so F_w never increases: height steps are checked against F_w with the loads
-//! recomputed and shortened until it decreases, and a stress answer that balances worse than
-//! the forces at hand is not taken. w grows when a round of both steps no longer lowers F_w
-//! by a fixed fraction; as w grows the height step tends to the exact solve K z = b and the
-//! loop ends on a certificate, ε∞ < tolerance.
+//! over the heights of the non-anchored vertices, subject to equilibrium r̂(z, y) = 0 under the
+//! stress constraints (r̂ = r / (p̄ √n), y the stress unknowns), by the method of multipliers:
+//! for fixed multipliers λ and weight w, the augmented Lagrangian L = E + w ‖r̂ + λ/2w‖² is
+//! lowered by alternating exact block minimisations. For fixed forces L is a convex quadratic
+//! in z (loads lagged): the height step solves it, then is shortened to the height limit and
+//! until L with the loads recomputed decreases. For fixed heights the stress QP minimises
+//! ‖r̂ + λ/2w‖² (the loads shifted by −p̄ √n λ/2w); an answer that does worse than the forces
+//! at hand is not taken. So every accepted step lowers L. When a round no longer lowers it by
+//! a fixed fraction, λ ← λ + 2w r̂, and w grows unless ‖r̂‖ has fallen enough. The answer is
+//! the nearest stress step's state in equilibrium (ε∞ < tolerance, certified by recomputed
+//! residuals), taken once a further one is no nearer.
 
 use super::{
     area_shares, blocking_vertices, finish, infeasibility_hint, FormFindResult, FormFindSettings,
@@ -21,31 +23,33 @@ use crate::geometry::Frame;
 use crate::problem::Problem;
 use crate::shape::ShapeStep;
 use crate::stress::{
-    analyse_cached, Prior, QpSolver, StressCache, StressResult, StressSettings, StressStatus,
+    analyse_cached, EdgeScope, Prior, QpSolver, StressCache, StressResult, StressSettings,
+    StressStatus,
 };
 use std::time::Instant;
 
-/// A round of a height and a stress step that lowers F_w by less than this fraction ends the
-/// round's penalty stage.
+/// A round (a height and a stress step) that lowers L by less than this fraction ends the
+/// minimisation for the current multipliers.
 const STAGE_DECREASE: f64 = 0.02;
-/// Rounds at most per penalty stage.
+/// Rounds at most between multiplier updates.
 const STAGE_ROUNDS: usize = 6;
-/// Factor on w between stages.
+/// Factor on w when it grows.
 const GROWTH: f64 = 10.0;
 /// Halvings of a height step before it is given up.
 const BACKTRACKS: usize = 6;
-/// The grid of the starting weight: w × factorᵏ, k < trials.
+/// The grid of the starting weight, w × factorᵏ for k < trials, and the decrease of R its
+/// first height step must reach (see `Nearest::initial_weight`).
 const INITIAL_WEIGHT_FACTOR: f64 = 3.0;
 const INITIAL_WEIGHT_TRIALS: usize = 40;
 const INITIAL_DECREASE: f64 = 0.1;
-/// w grows at a multiplier update unless ‖r̂‖ has fallen below this fraction of its value at
-/// the update before.
+/// The multipliers are updated where ‖r̂‖ has fallen below this fraction of its value at the
+/// last update; otherwise w grows.
 const RESIDUAL_FACTOR: f64 = 0.5;
 /// A state in equilibrium that is no nearer than the nearest one before it by this fraction
 /// of E ends the search.
 const SETTLED: f64 = 1e-3;
 /// Stalling is judged only once w has grown by this factor from its start: before, the pull
-/// to the input may hold ε∞ up on purpose.
+/// to the input may hold ε∞ up on purpose (rounds that still lower L also count as progress).
 const STALL_AFTER_GROWTH: f64 = 1e3;
 
 pub(super) fn nearest(
@@ -55,7 +59,15 @@ pub(super) fn nearest(
 ) -> Result<FormFindResult> {
     let start = Instant::now();
     let mut state = Nearest::new(problem, settings, progress)?;
-    let ended = state.run()?;
+    let mut ended = state.run()?;
+    if state.feasible.is_none()
+        && matches!(
+            ended,
+            Termination::MaxIterations | Termination::Stalled { .. }
+        )
+    {
+        ended = state.polish()?;
+    }
     // A certified state in equilibrium is the answer whatever stopped the search for a nearer
     // one; without one, the lowest-ε∞ state is.
     let (termination, best) = match state.feasible.take() {
@@ -206,10 +218,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 Ok(moved) => moved,
                 Err(e) => return Ok(numerical(e)),
             };
-            if moved && self.held.eps_inf < self.settings.tolerance {
-                self.history.push(self.held.eps_inf);
-            }
-            if self.record() {
+            if moved && self.record_height_state() {
                 return Ok(Termination::Converged);
             }
             let prior = self.held.clone();
@@ -223,16 +232,8 @@ impl<'a, 'p> Nearest<'a, 'p> {
             }
             stage_rounds += 1;
             let after = self.merit(&self.positions, &self.held);
-            if std::env::var_os("VSR_TRACE").is_some() {
-                eprintln!(
-                    "k {} w {:.3e} E {:.3e} R {:.3e} F {:.3e} -> {:.3e} eps {:.3e} moved {moved} limit {}",
-                    self.iterations, self.w, self.energy(&self.positions),
-                    residual_term(&self.held, self.shape.vertices()), before, after,
-                    self.held.eps_inf, self.at_limit().len()
-                );
-            }
-            let progressed = moved && after <= (1.0 - tune::stage_decrease()) * before;
-            if !progressed || stage_rounds >= tune::stage_rounds() {
+            let progressed = moved && after <= (1.0 - STAGE_DECREASE) * before;
+            if !progressed || stage_rounds >= STAGE_ROUNDS {
                 self.update_multipliers(&mut last_norm);
                 stage_rounds = 0;
             }
@@ -247,6 +248,93 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 return Ok(self.stalled());
             }
         }
+    }
+
+    /// Stress steps the nearest method may take: all but a quarter of `max_iterations`, which
+    /// [`Nearest::polish`] may need.
+    fn budget(&self) -> usize {
+        let max = self.settings.max_iterations.max(1);
+        max - max / 4
+    }
+
+    /// Where the nearest method found no state in equilibrium (height steps whose lagged loads
+    /// do not settle, as on nearly vertical strips), the paper's loop from the best state
+    /// reached, with the rest of the iteration budget: its proximal steps damp what the
+    /// nearest method's exact ones cannot. Its answer replaces the best state if it balances
+    /// better.
+    fn polish(&mut self) -> Result<Termination> {
+        let remaining = self.settings.max_iterations.saturating_sub(self.iterations);
+        if remaining == 0 || !self.best.eps.is_finite() {
+            return Ok(Termination::MaxIterations);
+        }
+        let mut start = self.problem.clone();
+        start.mesh.positions = self.best.positions.clone();
+        let settings = FormFindSettings {
+            method: crate::FormMethod::Paper,
+            max_iterations: remaining,
+            odt_iterations: 0,
+            ..self.settings.clone()
+        };
+        let offset = self.iterations;
+        let r = match self.progress.as_mut() {
+            Some(cb) => {
+                let mut shifted = |k: usize, eps: f64| cb(k + offset, eps);
+                super::paper::paper(&start, &settings, Some(&mut shifted))?
+            }
+            None => super::paper::paper(&start, &settings, None)?,
+        };
+        self.iterations += r.iterations;
+        self.solvers.extend(&r.solvers);
+        self.history.extend(&r.history);
+        self.stress_seconds += r.stress_seconds;
+        self.shape_seconds += r.shape_seconds;
+        if r.stress.eps_inf < self.best.eps {
+            self.best = Best {
+                eps: r.stress.eps_inf,
+                energy: self.energy(&r.positions),
+                positions: r.positions,
+                stress: r.stress,
+            };
+        }
+        Ok(r.termination)
+    }
+
+    /// Records a height step's state (the held forces certified at new heights) as a state in
+    /// equilibrium where it is one and its forces still meet their bounds at these heights
+    /// (relative bounds move with the loads); see [`Nearest::record`].
+    fn record_height_state(&mut self) -> bool {
+        if self.held.eps_inf >= self.settings.tolerance || !self.meets_bounds(&self.held) {
+            return false;
+        }
+        self.history.push(self.held.eps_inf);
+        self.record()
+    }
+
+    /// Whether the force densities of `s` meet the stress settings' bounds at the current
+    /// heights, to a relative 1e-6.
+    fn meets_bounds(&self, s: &StressResult) -> bool {
+        let mesh = &self.problem.mesh;
+        let st = &self.settings.stress;
+        let p_bar = mean_load(s, self.shape.vertices());
+        let unit = p_bar / self.l0;
+        let q_min = st.q_min.physical(unit);
+        let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
+        mesh.edges.iter().zip(&s.force_densities).all(|(edge, &q)| {
+            let active = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
+            if !active {
+                return true;
+            }
+            let interior = !edge.is_boundary();
+            let scoped = st.q_min_scope == EdgeScope::All || interior;
+            let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
+            if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
+                let [a, b] = edge.v.map(|v| self.positions[v as usize]);
+                let length = (a[0] - b[0]).hypot(a[1] - b[1]);
+                lo = lo.max(d_lo * p_bar / length);
+                hi = hi.min(d_hi * p_bar / length);
+            }
+            q >= lo * (1.0 - 1e-6) && q <= hi * (1.0 + 1e-6)
+        })
     }
 
     /// Records the current state as the best so far where it is; true when it is in
@@ -267,12 +355,15 @@ impl<'a, 'p> Nearest<'a, 'p> {
         if first || (usable && self.held.eps_inf < self.best.eps) {
             self.best = current.clone();
         }
-        if !(usable && self.held.eps_inf < self.settings.tolerance) {
+        // An answer in equilibrium counts once its QP met the full tolerances, so that the
+        // horizontal rows hold as tightly as an analysis's.
+        let solved = self.held.status == StressStatus::Solved;
+        if !(solved && self.held.eps_inf < self.settings.tolerance) {
             return false;
         }
         let settled = match &self.feasible {
             None => current.energy == 0.0,
-            Some(f) => current.energy > (1.0 - tune::settled()) * f.energy,
+            Some(f) => current.energy > (1.0 - SETTLED) * f.energy,
         };
         if self
             .feasible
@@ -285,8 +376,8 @@ impl<'a, 'p> Nearest<'a, 'p> {
     }
 
     /// One stress QP at the current heights, with the held forces as proximal centre. An
-    /// answer that balances the shape worse than the held forces (a QP stopped short of its
-    /// optimum) gives way to them once the dual-length smoothing has faded.
+    /// answer that stopped short of its optimum and lowers L less than the held forces gives
+    /// way to them once the dual-length smoothing has faded.
     fn stress_step(&mut self, held: Option<&StressResult>) -> Result<StressResult> {
         let t = Instant::now();
         let settings = self.step_settings();
@@ -305,10 +396,17 @@ impl<'a, 'p> Nearest<'a, 'p> {
             &mut self.cache,
         )?;
         self.solvers.push(answer.solver);
+        // A solved answer is the optimum over the constraints at these heights (relative
+        // bounds move with the loads), which the held forces may no longer meet.
+        let short = self.cache.last_was_coarse()
+            || matches!(
+                answer.status,
+                StressStatus::AlmostSolved | StressStatus::MaxIterations
+            );
         let answer = match held {
             Some(h)
-                if settings.dual_length_smoothing == 0.0
-                    && answer.status != StressStatus::Infeasible
+                if short
+                    && settings.dual_length_smoothing == 0.0
                     && self.merit(&self.positions, h) < self.merit(&self.positions, &answer) =>
             {
                 h.clone()
@@ -357,13 +455,12 @@ impl<'a, 'p> Nearest<'a, 'p> {
             }
             _ => {}
         }
-        (self.iterations >= self.settings.max_iterations.max(1))
-            .then_some(Termination::MaxIterations)
+        (self.iterations >= self.budget()).then_some(Termination::MaxIterations)
     }
 
     /// The starting w: the least, on a geometric grid from the weight that balances the
     /// diagonals of both terms' Hessians, whose height step (held forces) lowers the residual
-    /// term R by `tune::initial_decrease()`. Smaller weights spend stress steps on a shape the pull
+    /// term R by `INITIAL_DECREASE`. Smaller weights spend stress steps on a shape the pull
     /// holds in place; larger ones start the continuation where little of the input is kept.
     fn initial_weight(&self) -> Result<f64> {
         let kappa = self.mean_ktk_diagonal(&self.held.force_densities);
@@ -383,10 +480,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 &self.held.at_heights(self.problem, &trial, &settings),
                 self.shape.vertices(),
             );
-            if std::env::var_os("VSR_TRACE").is_some() {
-                eprintln!("w0 trial {w:.3e}: R {r:.3e} of {r0:.3e}");
-            }
-            if r <= (1.0 - tune::initial_decrease()) * r0 {
+            if r <= (1.0 - INITIAL_DECREASE) * r0 {
                 return Ok(w);
             }
             w *= INITIAL_WEIGHT_FACTOR;
@@ -426,22 +520,25 @@ impl<'a, 'p> Nearest<'a, 'p> {
         self.energy(positions) + self.w * shifted
     }
 
-    /// λ ← λ + 2w r̂ at the current state; w grows when ‖r̂‖ has not fallen to a quarter of its
-    /// value at the last update (the method of multipliers' penalty rule).
+    /// The method of multipliers' update: λ ← λ + 2w r̂ where ‖r̂‖ has fallen below
+    /// `RESIDUAL_FACTOR` of its value at the last update, else w grows and λ stays (so the
+    /// shift λ/2w shrinks).
     fn update_multipliers(&mut self, last_norm: &mut f64) {
         let rows = self.shape.vertices();
         let scale = mean_load(&self.held, rows) * (rows.len() as f64).sqrt();
-        let mut norm = 0.0;
-        for (l, &v) in self.lambda.iter_mut().zip(rows) {
-            let r = self.held.residuals[v as usize] / scale;
-            *l += 2.0 * self.w * r;
-            norm += r * r;
+        let r: Vec<f64> = rows
+            .iter()
+            .map(|&v| self.held.residuals[v as usize] / scale)
+            .collect();
+        let norm = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm <= RESIDUAL_FACTOR * *last_norm {
+            for (l, ri) in self.lambda.iter_mut().zip(&r) {
+                *l += 2.0 * self.w * ri;
+            }
+            *last_norm = norm;
+        } else {
+            self.w *= GROWTH;
         }
-        let norm = norm.sqrt();
-        if norm > tune::residual_factor() * *last_norm {
-            self.w *= tune::growth();
-        }
-        *last_norm = norm;
         self.shift_loads();
     }
 
@@ -478,20 +575,13 @@ impl<'a, 'p> Nearest<'a, 'p> {
         e
     }
 
-    /// A height step for the held forces: the minimiser of F_w with the loads lagged, shortened
-    /// to the height limit and until F_w (loads recomputed) decreases. Returns whether the
+    /// A height step for the held forces: the minimiser of L with the loads lagged, shortened
+    /// to the height limit and until L (loads recomputed) decreases. Returns whether the
     /// heights moved; `held` is then certified at the new heights.
     fn height_step(&mut self) -> Result<bool> {
         let t = Instant::now();
         let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
         let target = self.height_target(self.w)?;
-        let relax = std::env::var("VSR_RELAX")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.0f64);
-        let target: Vec<f64> = (z.iter().zip(&target))
-            .map(|(a, b)| a + relax * (b - a))
-            .collect();
         let mut step = self.limit_step(&z, &target);
         let settings = self.step_settings();
         let current = self.merit(&self.positions, &self.held);
@@ -514,13 +604,19 @@ impl<'a, 'p> Nearest<'a, 'p> {
         Ok(moved)
     }
 
-    /// The minimiser over z of F_w for the held forces, loads lagged.
+    /// The minimiser over z of L for the held forces, loads lagged.
     fn height_target(&self, w: f64) -> Result<Vec<f64>> {
         let rows = self.shape.vertices();
         let p_bar = mean_load(&self.held, rows);
         let rho = rows.len() as f64 * p_bar * p_bar / (w * self.l0 * self.l0);
         let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
         let fair = self.fair.as_deref().map(|c| (self.settings.fairness, c));
+        let jacobian = crate::geometry::loads::load_jacobian(
+            &self.problem.mesh,
+            &self.positions,
+            self.settings.stress.load_rule,
+            &self.problem.face_density,
+        );
         let loads: Vec<f64> = (self.held.loads.iter().zip(&self.load_offset))
             .map(|(p, o)| p + o)
             .collect();
@@ -532,6 +628,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             rho,
             &self.area,
             fair,
+            Some(&jacobian),
         )
     }
 
@@ -567,24 +664,56 @@ impl<'a, 'p> Nearest<'a, 'p> {
             .collect()
     }
 
-    /// The termination of a loop whose best ε∞ stopped improving.
+    /// The termination of a loop whose best ε∞ stopped improving: blocked by the height limit
+    /// or by q_max where either holds, else stalled at vertices that carry no stress.
     fn stalled(&self) -> Termination {
+        let capped = self.at_q_max();
+        let q_max = "q_max holds the force densities down where the shape is out of balance";
         let at_limit = self.at_limit();
         if !at_limit.is_empty() {
-            let hint = if self.settings.stress.q_max.is_some() {
-                "q_max holds the force densities down, so standing needs heights beyond the \
-                 limit (raise q_max or max_height_change)"
+            let hint = if capped.is_empty() {
+                "the shape cannot stand within the height limit (raise max_height_change)".into()
             } else {
-                "the shape cannot stand within the height limit (raise max_height_change)"
+                format!("{q_max}, so standing needs heights beyond the limit (raise q_max)")
             };
-            return Termination::HeightLimit {
+            return Termination::Blocked {
                 vertices: at_limit,
-                hint: hint.into(),
+                hint,
+            };
+        }
+        if !capped.is_empty() {
+            return Termination::Blocked {
+                vertices: capped,
+                hint: format!("{q_max} (raise q_max)"),
             };
         }
         Termination::Stalled {
             vertices: blocking_vertices(self.problem, &self.held),
         }
+    }
+
+    /// Non-anchored vertices with a residual above a tenth of the largest one and an edge at
+    /// q_max (empty without q_max).
+    fn at_q_max(&self) -> Vec<u32> {
+        let Some(bound) = self.settings.stress.q_max else {
+            return Vec::new();
+        };
+        let mesh = &self.problem.mesh;
+        let rows = self.shape.vertices();
+        let q_max = bound.physical(mean_load(&self.held, rows) / self.l0);
+        let r = &self.held.residuals;
+        let r_max = rows
+            .iter()
+            .map(|&v| r[v as usize].abs())
+            .fold(0.0, f64::max);
+        (rows.iter().copied())
+            .filter(|&v| r[v as usize].abs() > 0.1 * r_max)
+            .filter(|&v| {
+                mesh.edges_at(v as usize)
+                    .iter()
+                    .any(|&e| self.held.force_densities[e as usize] >= q_max * (1.0 - 1e-3))
+            })
+            .collect()
     }
 }
 
@@ -670,33 +799,6 @@ fn placeholder() -> StressResult {
         lifted: false,
         regularisation: 0.0,
         seconds: 0.0,
-    }
-}
-
-mod tune {
-    fn get(name: &str, default: f64) -> f64 {
-        std::env::var(name)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(default)
-    }
-    pub fn stage_decrease() -> f64 {
-        get("VSR_DECREASE", super::STAGE_DECREASE)
-    }
-    pub fn stage_rounds() -> usize {
-        get("VSR_ROUNDS", super::STAGE_ROUNDS as f64) as usize
-    }
-    pub fn growth() -> f64 {
-        get("VSR_GROWTH", super::GROWTH)
-    }
-    pub fn residual_factor() -> f64 {
-        get("VSR_RFAC", super::RESIDUAL_FACTOR)
-    }
-    pub fn settled() -> f64 {
-        get("VSR_SETTLED", super::SETTLED)
-    }
-    pub fn initial_decrease() -> f64 {
-        get("VSR_INIT", super::INITIAL_DECREASE)
     }
 }
 

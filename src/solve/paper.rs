@@ -1,4 +1,4 @@
-//! The paper's form-finding loop (MATH §11): stress step → stop if ε∞ < tol → height step
+//! The paper's form-finding loop (docs/method.md §13): stress step → stop if ε∞ < tol → height step
 //! pulled towards the current heights → stop if the same forces certify ε∞ < tol at the new
 //! heights, repeated.
 
