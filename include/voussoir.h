@@ -22,9 +22,11 @@
  * Errors. Every function that can fail returns a VsrStatus; VSR_STATUS_OK is 0. On failure
  * nothing is written to the outputs (except `needed`, above) and the handles keep their
  * previous state; vsr_last_error_message() returns a one-line message naming the argument,
- * vertex, face or edge at fault. A solve that does not converge is still VSR_STATUS_OK: read
- * its outcome with vsr_result_termination(). Enum arguments are passed as uint32_t and
- * checked (VSR_STATUS_INVALID_ENUM). Panics never cross the boundary (VSR_STATUS_PANIC).
+ * vertex, face or edge at fault. Every status-returning call clears that message when it
+ * succeeds, even after a failing call made inside it by a progress callback. A solve that
+ * does not converge is still VSR_STATUS_OK: read its outcome with vsr_result_termination().
+ * Enum arguments are passed as uint32_t and checked (VSR_STATUS_INVALID_ENUM). Panics never
+ * cross the boundary (VSR_STATUS_PANIC).
  *
  * Thread safety. Every function may be called from any thread. A handle passed as `const`
  * (VsrMesh, VsrSettings to the solves, VsrResult to its getters) may be used by several
@@ -490,7 +492,7 @@ uint32_t vsr_abi_version(void);
 /**
  * A one-line, NUL-terminated UTF-8 message about the last failed call on this thread, naming
  * the argument, vertex, face or edge at fault; "" when the last status-returning call
- * succeeded. Never NULL. The string belongs to the library and stays valid until the next
+ * succeeded, even if a call made inside it (by a progress callback) failed. Never NULL. The string belongs to the library and stays valid until the next
  * status-returning call on the same thread; copy it to keep it. Calls to `vsr_version`,
  * `vsr_abi_version`, `vsr_status_name`, `vsr_last_error_message` and the `_destroy`
  * functions leave it untouched.

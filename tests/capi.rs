@@ -997,3 +997,30 @@ fn odt_sweeps_move_the_plan_through_the_c_abi() {
         vsr_mesh_destroy(mesh);
     }
 }
+
+/// A progress callback that makes a failing call (a NULL handle) and lets the solve go on.
+unsafe extern "C" fn fail_inside(
+    _user: *mut std::ffi::c_void,
+    _iteration: usize,
+    _eps: f64,
+) -> std::ffi::c_int {
+    let s = unsafe { vsr_settings_set_tolerance(null_mut(), 1e-6) };
+    assert_eq!(s, S::NullPointer);
+    0
+}
+
+#[test]
+fn a_failing_call_inside_the_progress_callback_leaves_no_message() {
+    let mesh = Dome::new(3, 8).create();
+    let s = settings();
+    assert_ok(unsafe { vsr_settings_set_progress(s, Some(fail_inside), null_mut()) });
+    let mut r = null_mut();
+    let status = unsafe { vsr_form_find(mesh, s, &mut r) };
+    assert_eq!(status, S::Ok);
+    assert_eq!(last_error(), "", "a stale message after a successful solve");
+    unsafe {
+        vsr_result_destroy(r);
+        vsr_settings_destroy(s);
+        vsr_mesh_destroy(mesh);
+    }
+}
