@@ -20,7 +20,7 @@ use std::path::Path;
 
 use crate::{Mesh, Result};
 
-pub use obj::{parse_obj, read_obj, write_obj};
+pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
 pub use supports::{parse_supports, read_supports};
 
 /// Vertex positions (x, y plan; z height) and triangles (0-based vertex ids), as read from a
