@@ -749,6 +749,11 @@ fn result_getters_check_pointers_buffers_and_kind() {
     let mut solvers = [VsrQpSolver::Clarabel; 3];
     let st = unsafe { vsr_result_step_solvers(analysis, solvers.as_mut_ptr(), 3, &mut needed) };
     assert_failed(st, S::NotAvailable, "result");
+    assert!(
+        last_error().contains("only a result of vsr_form_find has the step solvers"),
+        "{}",
+        last_error()
+    );
     assert_eq!((needed, solvers), (5, [VsrQpSolver::Clarabel; 3]));
     let (mut t, mut it) = (VsrTermination::Cancelled, 77usize);
     assert_failed(
