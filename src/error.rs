@@ -37,8 +37,12 @@ pub enum Error {
     InconsistentOrientation { edge: [usize; 2], faces: [usize; 2] },
     /// Faces whose plan orientation is opposite to the majority: the plan folds over itself.
     FlippedFaces { faces: Vec<usize> },
-    /// Interior vertices whose plan angles do not sum to 2π: the plan wraps around them.
+    /// Vertices whose plan angles do not sum to 2π (interior vertices) or exceed 2π (boundary
+    /// vertices): the plan wraps around them.
     OverlappingPlan { vertices: Vec<usize> },
+    /// Two faces that overlap in plan away from any shared vertex (a strip winding over
+    /// itself, two components stacked in plan).
+    OverlappingFaces { faces: [usize; 2] },
     /// A connected component of the mesh has no anchored vertex.
     UnsupportedComponent {
         component: usize,
@@ -116,8 +120,13 @@ impl fmt::Display for Error {
             ),
             OverlappingPlan { vertices } => write!(
                 f,
-                "the plan overlaps itself around interior vertices {}",
+                "the plan overlaps itself around vertices {}",
                 ids(vertices)
+            ),
+            OverlappingFaces { faces } => write!(
+                f,
+                "the plan overlaps itself: faces {} and {} overlap in plan",
+                faces[0], faces[1]
             ),
             UnsupportedComponent { component, vertices } => write!(
                 f,

@@ -181,6 +181,50 @@ fn mesh_create_rejects_bad_ids_values_and_topology() {
 }
 
 #[test]
+fn mesh_create_rejects_plans_overlapping_away_from_shared_vertices() {
+    // Two unit squares, the second shifted by (0.5, 0.5): two components stacked in plan.
+    let positions = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, //
+        0.5, 0.5, 1.0, 1.5, 0.5, 1.0, 1.5, 1.5, 1.0, 0.5, 1.5, 1.0,
+    ];
+    let triangles = [0u32, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7];
+    // A strip between radii 1 and 2 winding 1.6 turns, rising: one component, every vertex
+    // on the boundary, no face flipped.
+    let mut strip = Vec::new();
+    for s in 0..=16 {
+        let angle = std::f64::consts::TAU * f64::from(s) / 10.0;
+        for r in [1.0, 2.0] {
+            strip.extend([r * angle.cos(), r * angle.sin(), 0.1 * f64::from(s)]);
+        }
+    }
+    let strip_triangles: Vec<u32> = (0..16u32)
+        .flat_map(|s| [2 * s, 2 * s + 1, 2 * s + 3, 2 * s, 2 * s + 3, 2 * s + 2])
+        .collect();
+    type Case<'a> = (&'a [f64], &'a [u32], &'a [u32], &'a str);
+    let cases: [Case; 2] = [
+        (&positions, &triangles, &[0, 4], "faces 0 and 2 overlap"),
+        (&strip, &strip_triangles, &[0, 1], "faces 0 and 20 overlap"),
+    ];
+    for (p, t, a, detail) in cases {
+        let mut out = sentinel();
+        let s = unsafe {
+            vsr_mesh_create(
+                p.as_ptr(),
+                p.len() / 3,
+                t.as_ptr(),
+                t.len() / 3,
+                a.as_ptr(),
+                a.len(),
+                &mut out,
+            )
+        };
+        assert_failed(s, S::InvalidPlan, "positions");
+        assert!(last_error().contains(detail), "{}", last_error());
+        assert_eq!(out, sentinel());
+    }
+}
+
+#[test]
 fn destroy_null_is_a_no_op_and_keeps_the_last_error() {
     let mut out = sentinel();
     let s = unsafe { vsr_mesh_create(null(), 0, null(), 0, null(), 0, &mut out) };

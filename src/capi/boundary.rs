@@ -265,9 +265,10 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
         | NonManifoldVertex { .. }
         | InconsistentOrientation { .. }
         | HoleNotCuttable { .. } => (VsrStatus::InvalidTopology, "triangles"),
-        DegenerateFaces { .. } | FlippedFaces { .. } | OverlappingPlan { .. } => {
-            (VsrStatus::InvalidPlan, "positions")
-        }
+        DegenerateFaces { .. }
+        | FlippedFaces { .. }
+        | OverlappingPlan { .. }
+        | OverlappingFaces { .. } => (VsrStatus::InvalidPlan, "positions"),
         UnsupportedComponent { .. } | NoSupports => (VsrStatus::NoSupport, "anchored"),
         Numerical { .. } => (VsrStatus::Numerical, arg),
         Io { .. } | Parse { .. } => (VsrStatus::InvalidArgument, arg),

@@ -12,7 +12,8 @@ use crate::{Error, Result};
 
 /// A face is degenerate when |plan area| <= `AREA_TOL` × (plan bounding-box diagonal)².
 pub const AREA_TOL: f64 = 1e-12;
-/// An interior vertex overlaps when its plan angle sum differs from 2π by more than this.
+/// An interior vertex overlaps when its plan angle sum differs from 2π by more than this, a
+/// boundary vertex when its sum exceeds 2π by more.
 pub const ANGLE_TOL: f64 = 1e-6;
 
 impl Mesh {
@@ -35,7 +36,9 @@ impl Mesh {
     /// 10. a vertex whose faces form more than one fan: [`Error::NonManifoldVertex`];
     /// 11. plan orientation: if most faces are clockwise in plan, all faces are reversed
     ///     (`reversed = true`); faces still clockwise: [`Error::FlippedFaces`]; interior
-    ///     vertices whose plan angles do not sum to 2π: [`Error::OverlappingPlan`];
+    ///     vertices whose plan angles do not sum to 2π, or boundary vertices whose angles sum
+    ///     to more: [`Error::OverlappingPlan`]; two faces overlapping in plan elsewhere (a strip
+    ///     winding over itself, components stacked in plan): [`Error::OverlappingFaces`];
     /// 12. supports: [`Error::NoSupports`], then [`Error::UnsupportedComponent`] for the
     ///     first connected component without an anchored vertex.
     pub fn new(positions: Vec<[f64; 3]>, faces: Vec<[u32; 3]>, anchored: &[u32]) -> Result<Mesh> {
@@ -87,6 +90,9 @@ impl Mesh {
             on_boundary[e.v[1] as usize] = true;
         }
         check_angle_sums(&positions, &faces, &referenced, &on_boundary)?;
+        if let Some(faces) = super::overlap::first_overlap(&positions, &faces, &edges) {
+            return Err(Error::OverlappingFaces { faces });
+        }
         // 12. components and supports
         let (vertex_component, n_components) = components(&faces, &referenced);
         check_supports(
@@ -334,7 +340,8 @@ fn check_vertex_fans(faces: &[[u32; 3]], halves: &[HalfEdge], n: usize) -> Resul
     }
 }
 
-/// Interior vertices must see their (counter-clockwise) faces sum to 2π in plan.
+/// Interior vertices must see their (counter-clockwise) faces sum to 2π in plan, boundary
+/// vertices at most 2π (more and the fan of faces around them wraps over itself).
 fn check_angle_sums(
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
@@ -353,9 +360,12 @@ fn check_angle_sums(
     let full = std::f64::consts::TAU;
     let vertices: Vec<usize> = (0..positions.len())
         .filter(|&v| {
-            referenced[v]
-                && !on_boundary[v]
-                && ((sums[v] - full).abs() > ANGLE_TOL || sums[v].is_nan())
+            let off = if on_boundary[v] {
+                sums[v] - full
+            } else {
+                (sums[v] - full).abs()
+            };
+            referenced[v] && (off > ANGLE_TOL || sums[v].is_nan())
         })
         .collect();
     if vertices.is_empty() {

@@ -7,6 +7,7 @@
 
 mod build;
 mod connectivity;
+mod overlap;
 mod query;
 pub use build::{ANGLE_TOL, AREA_TOL};
 

@@ -102,6 +102,19 @@ int main(void) {
            VSR_STATUS_NON_FINITE, "positions");
     EXPECT(vsr_mesh_create(positions, 5, triangles, 4, anchored, 0, &mesh), VSR_STATUS_NO_SUPPORT,
            "anchored");
+    {
+        /* The square twice, the second copy shifted by half its side: stacked in plan. */
+        double stacked[30];
+        uint32_t stacked_triangles[24];
+        const uint32_t stacked_anchors[] = {0, 1, 2, 3, 5, 6, 7, 8};
+        memcpy(stacked, positions, sizeof positions);
+        memcpy(stacked_triangles, triangles, sizeof triangles);
+        for (i = 0; i < 15; ++i) stacked[15 + i] = positions[i] + (i % 3 == 2 ? 1.0 : 0.5);
+        for (i = 0; i < 12; ++i) stacked_triangles[12 + i] = triangles[i] + 5;
+        EXPECT(vsr_mesh_create(stacked, 10, stacked_triangles, 8, stacked_anchors, 8, &mesh),
+               VSR_STATUS_INVALID_PLAN, "positions");
+        TRUE(strstr(vsr_last_error_message(), "overlap") != NULL);
+    }
     TRUE(mesh == sentinel_mesh);
 
     /* A valid mesh; the last error is cleared by success but kept by destroy(NULL). */
