@@ -57,7 +57,8 @@ Inputs:
   --supports S.json      anchored vertex ids, 0-based: {{\"anchored\": [ids]}} or [ids]
   --anchor-boundary      anchor every boundary vertex (instead of --supports)
 
-Outputs (all written at the end of a run, or none; existing files are replaced):
+Outputs (checked before the run; all written at the end of it, or none; existing files
+are replaced only when every output is written; two outputs may not share a path):
   --out OUT.obj          final positions, same faces    [formfind-out/NAME-formfound.obj]
   --report R.json        everything computed, as JSON   [formfind-out/report.json]
   --pictures DIR         SVG pictures                   [formfind-out/pictures]
