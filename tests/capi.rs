@@ -1073,3 +1073,43 @@ fn a_failing_call_inside_the_progress_callback_leaves_no_message() {
         vsr_mesh_destroy(mesh);
     }
 }
+
+/// Loads a solve cannot use: none at all (density 0 everywhere), or models in units whose
+/// loads double precision cannot carry (coordinates of 1e78 or 1e-100); coordinates of 1e200
+/// are refused by `vsr_mesh_create` itself. Each gets its status and a message that says why.
+#[test]
+fn solves_reject_weightless_and_unrepresentable_loads() {
+    let s = settings();
+    let d = Dome::new(3, 8);
+    let weightless = d.create();
+    let zeros = vec![0.0; d.n_triangles()];
+    assert_ok(unsafe { vsr_mesh_set_face_density(weightless, zeros.as_ptr(), zeros.len()) });
+    let mut meshes = vec![(weightless, "no weight to balance")];
+    for factor in [1e78, 1e-100] {
+        let mut scaled = Dome::new(3, 8);
+        scaled.positions.iter_mut().for_each(|c| *c *= factor);
+        meshes.push((scaled.create(), "cannot be represented in double precision"));
+    }
+    for (mesh, why) in meshes {
+        for solve in [vsr_analyse, vsr_form_find] {
+            let mut out = sentinel();
+            assert_failed(
+                unsafe { solve(mesh, s, &mut out) },
+                S::InvalidArgument,
+                "loads",
+            );
+            assert!(last_error().contains(why), "{}", last_error());
+            assert_eq!(out, sentinel());
+        }
+        unsafe { vsr_mesh_destroy(mesh) };
+    }
+    let (status, out) = create_with(|p, _, _| p.iter_mut().for_each(|c| *c *= 1e200));
+    assert_failed(status, S::InvalidArgument, "positions");
+    assert!(
+        last_error().contains("cannot be represented"),
+        "{}",
+        last_error()
+    );
+    assert_eq!(out, sentinel());
+    unsafe { vsr_settings_destroy(s) };
+}

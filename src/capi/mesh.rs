@@ -174,7 +174,11 @@ unsafe fn set_rows(
 /// load rule decides which area, see `vsr_settings_set_load_rule`).
 ///
 /// `density`: #F doubles, finite and >= 0; `n_faces` must equal the mesh's #F. Default: 1 on
-/// every face. The array is copied. On failure the mesh keeps its previous values.
+/// every face. The array is copied. On failure the mesh keeps its previous values. Zeros are
+/// accepted here, but `vsr_analyse` and `vsr_form_find` return `VSR_STATUS_INVALID_ARGUMENT`
+/// (naming `loads`) when the loads on the non-anchored vertices average 0 or less (nothing to
+/// balance), or lie beyond what double precision carries through a solve (a mean outside
+/// 1e-150 to 1e150).
 ///
 /// # Safety
 /// `mesh`: a valid handle with exclusive access; `density`: `n_faces` readable doubles.

@@ -9,7 +9,7 @@ mod build;
 mod connectivity;
 mod overlap;
 mod query;
-pub use build::{ANGLE_TOL, AREA_TOL};
+pub use build::{ANGLE_TOL, AREA_TOL, MAX_COORDINATE, MIN_PLAN_EXTENT};
 
 #[cfg(test)]
 mod tests;

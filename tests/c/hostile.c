@@ -158,6 +158,25 @@ int main(void) {
     EXPECT(vsr_form_find(mesh, settings, NULL), VSR_STATUS_NULL_POINTER, "out");
     TRUE(result == sentinel_result);
 
+    /* Density 0 everywhere: nothing to balance, so no solve; the density is set back after. */
+    {
+        const double zeros[4] = {0, 0, 0, 0};
+        const double ones[4] = {1, 1, 1, 1};
+        EXPECT(vsr_mesh_set_face_density(mesh, zeros, 4), VSR_STATUS_OK, "");
+        EXPECT(vsr_analyse(mesh, settings, &result), VSR_STATUS_INVALID_ARGUMENT, "loads");
+        EXPECT(vsr_form_find(mesh, settings, &result), VSR_STATUS_INVALID_ARGUMENT, "loads");
+        EXPECT(vsr_mesh_set_face_density(mesh, ones, 4), VSR_STATUS_OK, "");
+    }
+    /* Coordinates whose areas double precision cannot hold. */
+    {
+        double huge[15];
+        VsrMesh *huge_mesh = sentinel_mesh;
+        for (i = 0; i < 15; ++i) huge[i] = positions[i] * 1e200;
+        EXPECT(vsr_mesh_create(huge, 5, triangles, 4, anchored, 4, &huge_mesh),
+               VSR_STATUS_INVALID_ARGUMENT, "positions");
+        TRUE(huge_mesh == sentinel_mesh);
+    }
+
     /* Reuse after the failed calls: the handles still work. */
     EXPECT(vsr_analyse(mesh, settings, &result), VSR_STATUS_OK, "");
     TRUE(result != sentinel_result && result != NULL);
