@@ -241,6 +241,42 @@ fn bad_input_gets_one_line_and_no_output() {
     );
     rejects(&sq, &["--supports", "s.json"], "need a MESH.obj");
     rejects(&sq, &["sq.obj", "--supports", "s.json", "--out"], "--out");
+    // A misspelt face line would otherwise drop a face unseen.
+    rejects(
+        &[
+            ("bad.obj", format!("{SQUARE}F 1 2 3\n").as_str()),
+            ("s.json", "[0, 1, 2, 3]"),
+        ],
+        &["bad.obj", "--supports", "s.json"],
+        "bad.obj:10: unknown statement `F`",
+    );
+    // Two squares stacked in plan.
+    let stacked = format!(
+        "{SQUARE}v 0.5 0.5 1\nv 1.5 0.5 1\nv 1.5 1.5 1\nv 0.5 1.5 1\nv 1 1 1.3\n\
+         f 6 7 10\nf 7 8 10\nf 8 9 10\nf 9 6 10\n"
+    );
+    rejects(
+        &[
+            ("st.obj", &stacked[..]),
+            ("s.json", "[0, 1, 2, 3, 5, 6, 7, 8]"),
+        ],
+        &["st.obj", "--supports", "s.json"],
+        "overlap in plan",
+    );
+    // Units double precision cannot carry: refused by the mesh (1e200) or the solve (1e78).
+    for (factor, needle) in [("1e200", "vertex 1 has the coordinate"), ("1e78", "loads")] {
+        let f: f64 = factor.parse().unwrap();
+        let scaled = format!(
+            "v 0 0 0\nv {f:e} 0 0\nv {f:e} {f:e} 0\nv 0 {f:e} 0\nv {h:e} {h:e} 0.3\n\
+             f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n",
+            h = f / 2.0
+        );
+        rejects(
+            &[("big.obj", &scaled[..]), ("s.json", "[0, 1, 2, 3]")],
+            &["big.obj", "--supports", "s.json"],
+            needle,
+        );
+    }
 }
 
 /// Runs formfind with `args` in a scratch folder set up by `prepare`; asserts exit status
