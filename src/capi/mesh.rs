@@ -47,9 +47,13 @@ fn too_many(name: &str, count: &str, n: usize, max: usize) -> CResult {
 /// Checked in this order: NULL pointers; lengths (`n * 3` overflow, at most 2^32 - 1 vertices
 /// and (2^32 - 1) / 6 triangles: `VSR_STATUS_LENGTH_OVERFLOW`); empty mesh; ids `>= n_vertices`
 /// (`VSR_STATUS_INDEX_OUT_OF_RANGE`); repeated supports; NaN or infinite coordinates of vertices
-/// used by a triangle (`VSR_STATUS_NON_FINITE`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan
-/// validity (`VSR_STATUS_INVALID_PLAN`); supports (`VSR_STATUS_NO_SUPPORT`). The message names
-/// the offending vertex, face or edge ids. Vertices used by no triangle are ignored.
+/// used by a triangle (`VSR_STATUS_NON_FINITE`); coordinates beyond ±1e150, or a plan less than
+/// 1e-150 across, whose areas double precision cannot represent
+/// (`VSR_STATUS_INVALID_ARGUMENT`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan validity:
+/// zero-area, flipped or overlapping faces, including faces that overlap away from any shared
+/// vertex (a strip winding over itself, components stacked in plan) (`VSR_STATUS_INVALID_PLAN`);
+/// supports (`VSR_STATUS_NO_SUPPORT`). The message names the offending vertex, face or edge
+/// ids. Vertices used by no triangle are ignored.
 ///
 /// # Safety
 /// Each non-NULL array must hold the stated number of readable elements.
