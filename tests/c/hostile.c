@@ -1,8 +1,8 @@
 /*
  * Hostile input through the installed C library: each case checks the status, a non-empty
  * one-line message naming the argument at fault, and untouched outputs. Built against the
- * installed package by examples/CMakeLists.txt and .ci/cmake-checks.sh; prints one line per
- * failure and exits non-zero if any.
+ * installed package by examples/CMakeLists.txt and .ci/cmake-checks.sh, and against the build
+ * tree by the latter; prints one line per failure and exits non-zero if any.
  */
 #include <math.h>
 #include <stdint.h>
