@@ -88,7 +88,8 @@ Solver:
   -h, --help             this text
 
 Exit status: 0 converged (or --stress-only solved), 3 finished without converging
-(outputs written, the report says why), 2 bad input or options, 1 other failure.
+(outputs written, the report says why), 2 bad input, options or output paths (nothing
+written), 1 other failure (nothing written).
 ",
         solver = name_of(&SOLVERS, st.formulation),
         qp = name_of(&QP_SOLVERS, st.solver),
