@@ -1,13 +1,13 @@
 //! The last plan check: no two faces overlap in plan.
 //!
 //! With every face counter-clockwise, the number of faces covering a plan point changes only
-//! across boundary edges, so where faces overlap, a face with a boundary edge overlaps another
-//! one (the edge of the overlap region lies on a boundary edge, and on its inner side two
-//! faces cover it, that edge's face among them). Only pairs with such a face are tested: the
-//! faces with a boundary edge go into a uniform grid, and every face is tested against those
-//! in the grid cells its bounding box covers. Faces sharing a vertex are never tested: the
-//! plan angle checks before this one ensure that their sectors at that vertex, and so the
-//! faces themselves, do not overlap.
+//! across boundary edges. So where faces overlap, the region they overlap in is bounded by
+//! boundary edges, and a point of such an edge lies in a face other than the edge's own, the
+//! two faces overlapping on the edge's inner side. The boundary edges go into a uniform grid;
+//! each face is tested (separating axes) against the faces of the boundary edges in the cells
+//! it covers, row by row, so that a long thin face visits only the cells along it. Faces
+//! sharing a vertex are never tested: the plan angle checks before this one ensure that their
+//! sectors at that vertex, and so the faces themselves, do not overlap.
 
 use super::Edge;
 
@@ -47,7 +47,8 @@ fn interiors_overlap(a: &[[f64; 2]; 3], b: &[[f64; 2]; 3], tol: f64) -> bool {
     !an_edge_separates(a, b, tol) && !an_edge_separates(b, a, tol)
 }
 
-/// Uniform grid over the plan holding the faces with a boundary edge, as CSR lists per cell.
+/// Uniform grid over the plan holding the boundary edges (as their faces' ids), as CSR
+/// lists per cell.
 struct Grid {
     lo: [f64; 2],
     cell: f64,
@@ -57,18 +58,18 @@ struct Grid {
 }
 
 impl Grid {
-    /// Cells at least as large as the mean extent of the faces stored, and at most about
-    /// 12 per stored face in all, so that neither the cells nor the lists grow quadratic.
-    fn new(plan: Box2, stored: &[(u32, Box2)]) -> Grid {
+    /// Cells at least as large as the mean boundary edge, and at most about 12 per boundary
+    /// edge in all, so that neither the cells nor the lists grow quadratic.
+    fn new(plan: Box2, segments: &[(u32, [[f64; 2]; 2])]) -> Grid {
         let (lo, hi) = plan;
         let size = [hi[0] - lo[0], hi[1] - lo[1]];
-        let m = stored.len().max(1) as f64;
-        let mean_extent = stored
+        let m = segments.len().max(1) as f64;
+        let mean_length = segments
             .iter()
-            .map(|(_, (a, b))| (b[0] - a[0]).max(b[1] - a[1]))
+            .map(|(_, [a, b])| (b[0] - a[0]).hypot(b[1] - a[1]))
             .sum::<f64>()
             / m;
-        let cell = mean_extent
+        let cell = mean_length
             .max((size[0] * size[1] / (4.0 * m)).sqrt())
             .max(size[0].max(size[1]) / (4.0 * m));
         let cell = if cell > 0.0 && cell.is_finite() {
@@ -84,45 +85,70 @@ impl Grid {
             start: vec![0; dims[0] * dims[1] + 1],
             faces: Vec::new(),
         };
-        for (_, b) in stored {
-            for c in grid.cells(b) {
-                grid.start[c + 1] += 1;
-            }
+        let mut count = vec![0usize; dims[0] * dims[1]];
+        for (_, seg) in segments {
+            grid.cover(seg, |c| count[c] += 1);
         }
-        for c in 0..dims[0] * dims[1] {
-            grid.start[c + 1] += grid.start[c];
+        for (c, n) in count.iter().enumerate() {
+            grid.start[c + 1] = grid.start[c] + n;
         }
         let mut fill = grid.start.clone();
-        grid.faces = vec![0; grid.start[dims[0] * dims[1]]];
-        for (t, b) in stored {
-            for c in grid.cells(b) {
-                grid.faces[fill[c]] = *t;
+        let mut faces = vec![0; grid.start[count.len()]];
+        for (face, seg) in segments {
+            grid.cover(seg, |c| {
+                faces[fill[c]] = *face;
                 fill[c] += 1;
-            }
+            });
         }
+        grid.faces = faces;
         grid
     }
 
-    /// The cell index range (clamped to the grid) of coordinate `x` along axis `d`.
+    /// The cell index (clamped to the grid) of coordinate `x` along axis `d`.
     fn index(&self, x: f64, d: usize) -> usize {
         let k = ((x - self.lo[d]) / self.cell).floor();
         (k.max(0.0) as usize).min(self.dims[d] - 1)
     }
 
-    /// The cells a bounding box covers, row by row.
-    fn cells(&self, (lo, hi): &Box2) -> impl Iterator<Item = usize> {
-        let (x0, x1) = (self.index(lo[0], 0), self.index(hi[0], 0));
-        let (y0, y1) = (self.index(lo[1], 1), self.index(hi[1], 1));
-        let nx = self.dims[0];
-        (y0..=y1).flat_map(move |y| (x0..=x1).map(move |x| y * nx + x))
-    }
-
-    /// The first cell two boxes share (where their intersection's lower corner lies): a pair
-    /// found in several cells is tested in that one only.
-    fn first_shared_cell(&self, a: &Box2, b: &Box2) -> usize {
-        let x = self.index(a.0[0].max(b.0[0]), 0);
-        let y = self.index(a.0[1].max(b.0[1]), 1);
-        y * self.dims[0] + x
+    /// Visits the cells that the convex polygon (or segment) `points` meets, row by row: in
+    /// each row, those between the polygon's least and greatest x within the row's band (its
+    /// vertices in the band and its edges' crossings of the band's edges), widened by a
+    /// hundredth of a cell against rounding. A long thin face visits the cells along it only.
+    fn cover(&self, points: &[[f64; 2]], mut visit: impl FnMut(usize)) {
+        let margin = 0.01 * self.cell;
+        let y_lo = points.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        let y_hi = points
+            .iter()
+            .map(|p| p[1])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let (r0, r1) = (self.index(y_lo - margin, 1), self.index(y_hi + margin, 1));
+        for r in r0..=r1 {
+            let band_lo = (self.lo[1] + r as f64 * self.cell - margin).max(y_lo);
+            let band_hi = (self.lo[1] + (r + 1) as f64 * self.cell + margin).min(y_hi);
+            let (mut x_lo, mut x_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut take = |x: f64| {
+                x_lo = x_lo.min(x);
+                x_hi = x_hi.max(x);
+            };
+            for (k, a) in points.iter().enumerate() {
+                if (band_lo..=band_hi).contains(&a[1]) {
+                    take(a[0]);
+                }
+                let b = points[(k + 1) % points.len()];
+                for y in [band_lo, band_hi] {
+                    if (a[1] - y) * (b[1] - y) < 0.0 {
+                        take(a[0] + (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]));
+                    }
+                }
+            }
+            if x_lo > x_hi {
+                continue;
+            }
+            let (c0, c1) = (self.index(x_lo - margin, 0), self.index(x_hi + margin, 0));
+            for c in c0..=c1 {
+                visit(r * self.dims[0] + c);
+            }
+        }
     }
 
     fn list(&self, c: usize) -> &[u32] {
@@ -130,31 +156,35 @@ impl Grid {
     }
 }
 
-fn boxes_meet(a: &Box2, b: &Box2, tol: f64) -> bool {
-    (0..2).all(|d| a.0[d] <= b.1[d] + tol && b.0[d] <= a.1[d] + tol)
-}
-
 /// A pair of faces whose interiors overlap in plan (smaller id first), the one of the
-/// smallest face id that has one. `faces` are
-/// counter-clockwise in plan, with valid plan angles at every vertex (checks 1-11 passed).
+/// smallest face id that has one. `faces` are counter-clockwise in plan, with valid plan
+/// angles at every vertex (checks 1-11 passed).
+///
+/// Where two faces overlap, a point of a boundary edge lies in a face other than its own with
+/// the overlap on the edge's inner side (see the module's documentation); so each face is
+/// tested against the faces of the boundary edges in the cells it covers.
 pub(super) fn first_overlap(
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
     edges: &[Edge],
 ) -> Option<[usize; 2]> {
     let triangles: Vec<[[f64; 2]; 3]> = faces.iter().map(|f| plan_of(positions, f)).collect();
-    let boxes: Vec<Box2> = triangles.iter().map(bounding_box).collect();
-    let mut on_boundary = vec![false; faces.len()];
-    for e in edges.iter().filter(|e| e.is_boundary()) {
-        if let Some(side) = e.left.or(e.right) {
-            on_boundary[side.face as usize] = true;
-        }
-    }
-    let stored: Vec<(u32, Box2)> = (0..faces.len())
-        .filter(|&t| on_boundary[t])
-        .map(|t| (t as u32, boxes[t]))
+    let plan_xy = |v: u32| {
+        let p = positions[v as usize];
+        [p[0], p[1]]
+    };
+    let segments: Vec<(u32, [[f64; 2]; 2])> = edges
+        .iter()
+        .filter_map(|e| {
+            let side = if e.is_boundary() {
+                e.left.or(e.right)
+            } else {
+                None
+            }?;
+            Some((side.face, e.v.map(plan_xy)))
+        })
         .collect();
-    let plan = boxes.iter().fold(
+    let plan = triangles.iter().map(bounding_box).fold(
         ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
         |(lo, hi), (a, b)| {
             (
@@ -164,20 +194,22 @@ pub(super) fn first_overlap(
         },
     );
     let tol = TOUCH_TOL * (plan.1[0] - plan.0[0]).hypot(plan.1[1] - plan.0[1]);
-    let grid = Grid::new(plan, &stored);
+    let grid = Grid::new(plan, &segments);
+    // The last face each boundary face was tested against: a pair met in several cells, or
+    // through several boundary edges, is tested once.
+    let mut tested_with = vec![u32::MAX; faces.len()];
     for (g, f) in faces.iter().enumerate() {
         let mut partner: Option<usize> = None;
-        for c in grid.cells(&boxes[g]) {
+        grid.cover(&triangles[g], |c| {
             for &h in grid.list(c) {
+                if tested_with[h as usize] == g as u32 {
+                    continue;
+                }
+                tested_with[h as usize] = g as u32;
                 let h = h as usize;
-                // Pairs of two stored faces are tested from the smaller id only.
-                let tested_elsewhere = on_boundary[g] && h < g;
                 if h == g
-                    || tested_elsewhere
                     || partner.is_some_and(|p| p <= h)
                     || faces[h].iter().any(|v| f.contains(v))
-                    || !boxes_meet(&boxes[g], &boxes[h], tol)
-                    || grid.first_shared_cell(&boxes[g], &boxes[h]) != c
                 {
                     continue;
                 }
@@ -185,7 +217,7 @@ pub(super) fn first_overlap(
                     partner = Some(h);
                 }
             }
-        }
+        });
         if let Some(h) = partner {
             return Some([g.min(h), g.max(h)]);
         }
@@ -223,6 +255,40 @@ mod tests {
         for offset in [[1.0, 0.0], [1.0, 1.0], [1.0 + 1e-15, 0.3], [0.0, -1.0]] {
             assert!(two_squares(offset).is_ok(), "{offset:?}");
         }
+    }
+
+    /// A thin strip of two faces along the diagonal from `a` to `b`, `width` wide (vertices
+    /// 4 k .. 4 k + 3).
+    fn strip(k: u32, a: [f64; 2], b: [f64; 2], width: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len = d[0].hypot(d[1]);
+        let n = [-d[1] / len * width, d[0] / len * width];
+        let corners = [a, b, [b[0] + n[0], b[1] + n[1]], [a[0] + n[0], a[1] + n[1]]];
+        let base = 4 * k;
+        (
+            corners.iter().map(|c| [c[0], c[1], 0.0]).collect(),
+            vec![[base, base + 1, base + 2], [base, base + 2, base + 3]],
+        )
+    }
+
+    fn two_strips(second: (Vec<[f64; 3]>, Vec<[u32; 3]>)) -> crate::Result<Mesh> {
+        let (mut p, mut f) = strip(0, [0.0, 0.0], [100.0, 100.0], 0.01);
+        p.extend(second.0);
+        f.extend(second.1);
+        Mesh::new(p, f, &[0, 4])
+    }
+
+    /// Long thin faces are found where they cross, away from their ends, and not where they
+    /// only run close beside each other.
+    #[test]
+    fn long_thin_faces_crossing_mid_way_overlap() {
+        let crossing = two_strips(strip(1, [0.0, 100.0], [100.0, 0.0], 0.01));
+        assert!(
+            matches!(crossing, Err(crate::Error::OverlappingFaces { .. })),
+            "{crossing:?}"
+        );
+        let beside = two_strips(strip(1, [0.02, 0.0], [100.02, 100.0], 0.01));
+        assert!(beside.is_ok(), "{beside:?}");
     }
 
     #[test]
