@@ -176,8 +176,8 @@ impl fmt::Display for crate::Termination {
 }
 
 /// A failed sparse Cholesky factorisation of `matrix` as an [`Error::Numerical`] in words
-/// (faer's own `Display` of these errors is their `Debug` text). Meant for the shape step's
-/// factorisations in `src/shape`, which still format faer's text themselves.
+/// (faer's own `Display` of these errors is their `Debug` text), for the shape step's
+/// factorisations (`src/shape`).
 #[allow(dead_code)]
 pub(crate) fn factorisation_failure(matrix: &str, e: &faer::sparse::linalg::LltError) -> Error {
     use faer::sparse::linalg::LltError;

@@ -751,13 +751,13 @@ fn check_mean_load(load: &[f64], free: &[u32]) -> Result<()> {
         format!(
             "the loads on the non-anchored vertices average {mean:e}: beyond {MAX_MEAN_LOAD:e}, \
              force densities and squared residuals cannot be represented in double precision \
-             (express the model in smaller units or lower the density)"
+             (express the model in larger units or lower the density)"
         )
     } else if mean < MIN_MEAN_LOAD {
         format!(
             "the loads on the non-anchored vertices average {mean:e}: below {MIN_MEAN_LOAD:e}, \
              force densities and squared residuals cannot be represented in double precision \
-             (express the model in larger units or raise the density)"
+             (express the model in smaller units or raise the density)"
         )
     } else {
         return Ok(());
