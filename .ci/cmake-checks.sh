@@ -7,7 +7,9 @@
 #      installed package with find_package(Voussoir CONFIG REQUIRED) and runs under ctest:
 #      shared library; static library with AddressSanitizer + UBSan (Debug);
 #   4. the C dome and hostile-input test build with `pkg-config --cflags --libs voussoir` alone;
-#   5. the Rust example (examples/dome.rs) runs.
+#   5. the hostile-input test links against the build tree (cargo's target/release, where the
+#      CMake build leaves the SONAME'd library and its libvoussoir.so.1 link) with an rpath;
+#   6. the Rust example (examples/dome.rs) runs.
 # Needs cmake, pkg-config, a C/C++ compiler and OpenMesh (Debian: cmake pkg-config g++
 # libopenmesh-dev). Work files go to $VSR_CHECK_DIR (default target/cmake-checks).
 set -euo pipefail
@@ -70,6 +72,16 @@ for prog in examples/c/dome.c tests/c/hostile.c; do
   "$exe" >"$exe.log" || { cat "$exe.log"; exit 1; }
   tail -n 1 "$exe.log"
 done
+
+step "the build tree: -L target/release -lvoussoir with an rpath"
+tree=${CARGO_TARGET_DIR:-$root/target}/release
+mkdir -p "$work/tree"
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror -I include tests/c/hostile.c -o "$work/tree/hostile" \
+  -L "$tree" -lvoussoir -lm -Wl,-rpath,"$tree"
+readelf -d "$work/tree/hostile" | grep -q 'Shared library: \[libvoussoir.so.1\]' \
+  || { echo "the build tree's library lacks the SONAME libvoussoir.so.1" >&2; exit 1; }
+"$work/tree/hostile" >"$work/tree/hostile.log" || { cat "$work/tree/hostile.log"; exit 1; }
+tail -n 1 "$work/tree/hostile.log"
 
 step "Rust example: cargo run --example dome"
 cargo run --quiet --locked --example dome | tail -n 3

@@ -111,6 +111,24 @@ std::vector<MeshCase> mesh_cases() {
         p[12] = 0.5, p[13] = 0.0;   // centre on the edge 0-1: face 0 has zero plan area
         return p;
     }();
+    // The square twice, the copy shifted by half a side and raised: stacked in plan.
+    static std::vector<double> stacked = [] {
+        auto p = kPositions;
+        for (std::size_t i = 0; i < kPositions.size(); ++i)
+            p.push_back(kPositions[i] + (i % 3 == 2 ? 1.0 : 0.5));
+        return p;
+    }();
+    static std::vector<uint32_t> stacked_triangles = [] {
+        auto t = kTriangles;
+        for (uint32_t v : kTriangles) t.push_back(v + 5);
+        return t;
+    }();
+    static const std::vector<uint32_t> stacked_anchors = {0, 1, 2, 3, 5, 6, 7, 8};
+    static std::vector<double> huge = [] {
+        auto p = kPositions;
+        for (double &c : p) c *= 1e200;
+        return p;
+    }();
     static const std::vector<uint32_t> bad_anchors = {0, 1, 2, 99};
     static const std::vector<uint32_t> twice = {0, 1, 2, 2};
     const double *p = kPositions.data();
@@ -165,6 +183,15 @@ std::vector<MeshCase> mesh_cases() {
          VSR_STATUS_INVALID_PLAN, "positions"},
         {"no_support", [=](VsrMesh **o) { return vsr_mesh_create(p, kV, t, kF, a, 0, o); },
          VSR_STATUS_NO_SUPPORT, "anchored"},
+        {"stacked_in_plan",
+         [=](VsrMesh **o) {
+             return vsr_mesh_create(stacked.data(), 2 * kV, stacked_triangles.data(), 2 * kF,
+                                    stacked_anchors.data(), 8, o);
+         },
+         VSR_STATUS_INVALID_PLAN, "positions"},
+        {"coordinates_of_1e200",
+         [=](VsrMesh **o) { return vsr_mesh_create(huge.data(), kV, t, kF, a, 4, o); },
+         VSR_STATUS_INVALID_ARGUMENT, "positions"},
     };
 }
 
@@ -406,6 +433,15 @@ TEST(Contract, SolvesRejectNullAndLeaveTheOutputAlone) {
     VsrSettings *s = kSentinelSettings;
     EXPECT_TRUE(Fails(vsr_settings_create(nullptr), VSR_STATUS_NULL_POINTER, "out"));
     EXPECT_EQ(s, kSentinelSettings);
+    // Density 0 everywhere: nothing to balance.
+    const std::vector<double> zeros(kF, 0.0), ones(kF, 1.0);
+    EXPECT_TRUE(Succeeds(vsr_mesh_set_face_density(mesh.get(), zeros.data(), kF)));
+    EXPECT_TRUE(Fails(vsr_analyse(mesh.get(), settings.get(), &out), VSR_STATUS_INVALID_ARGUMENT,
+                      "loads"));
+    EXPECT_TRUE(Fails(vsr_form_find(mesh.get(), settings.get(), &out),
+                      VSR_STATUS_INVALID_ARGUMENT, "loads"));
+    EXPECT_EQ(out, kSentinelResult);
+    EXPECT_TRUE(Succeeds(vsr_mesh_set_face_density(mesh.get(), ones.data(), kF)));
     // Reuse after the failed calls.
     EXPECT_TRUE(Succeeds(vsr_analyse(mesh.get(), settings.get(), &out)));
     ResultPtr result(out);

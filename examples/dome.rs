@@ -69,7 +69,7 @@ fn main() -> Result<(), voussoir::Error> {
         .iter()
         .fold(0.0f64, |m, r| m.max(r.abs()));
     println!(
-        "{:?} after {} iterations",
+        "{} after {} iterations",
         result.termination, result.iterations
     );
     println!(

@@ -22,9 +22,11 @@
  * Errors. Every function that can fail returns a VsrStatus; VSR_STATUS_OK is 0. On failure
  * nothing is written to the outputs (except `needed`, above) and the handles keep their
  * previous state; vsr_last_error_message() returns a one-line message naming the argument,
- * vertex, face or edge at fault. A solve that does not converge is still VSR_STATUS_OK: read
- * its outcome with vsr_result_termination(). Enum arguments are passed as uint32_t and
- * checked (VSR_STATUS_INVALID_ENUM). Panics never cross the boundary (VSR_STATUS_PANIC).
+ * vertex, face or edge at fault. Every status-returning call clears that message when it
+ * succeeds, even after a failing call made inside it by a progress callback. A solve that
+ * does not converge is still VSR_STATUS_OK: read its outcome with vsr_result_termination().
+ * Enum arguments are passed as uint32_t and checked (VSR_STATUS_INVALID_ENUM). Panics never
+ * cross the boundary (VSR_STATUS_PANIC).
  *
  * Thread safety. Every function may be called from any thread. A handle passed as `const`
  * (VsrMesh, VsrSettings to the solves, VsrResult to its getters) may be used by several
@@ -523,7 +525,7 @@ uint32_t vsr_abi_version(void);
 /**
  * A one-line, NUL-terminated UTF-8 message about the last failed call on this thread, naming
  * the argument, vertex, face or edge at fault; "" when the last status-returning call
- * succeeded. Never NULL. The string belongs to the library and stays valid until the next
+ * succeeded, even if a call made inside it (by a progress callback) failed. Never NULL. The string belongs to the library and stays valid until the next
  * status-returning call on the same thread; copy it to keep it. Calls to `vsr_version`,
  * `vsr_abi_version`, `vsr_status_name`, `vsr_last_error_message` and the `_destroy`
  * functions leave it untouched.
@@ -648,9 +650,13 @@ VsrStatus vsr_mesh_plan_nudges(const struct VsrMesh *mesh, uint32_t *out, size_t
  * Checked in this order: NULL pointers; lengths (`n * 3` overflow, at most 2^32 - 1 vertices
  * and (2^32 - 1) / 6 triangles: `VSR_STATUS_LENGTH_OVERFLOW`); empty mesh; ids `>= n_vertices`
  * (`VSR_STATUS_INDEX_OUT_OF_RANGE`); repeated supports; NaN or infinite coordinates of vertices
- * used by a triangle (`VSR_STATUS_NON_FINITE`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan
- * validity (`VSR_STATUS_INVALID_PLAN`); supports (`VSR_STATUS_NO_SUPPORT`). The message names
- * the offending vertex, face or edge ids. Vertices used by no triangle are ignored.
+ * used by a triangle (`VSR_STATUS_NON_FINITE`); coordinates beyond ±1e150, or a plan less than
+ * 1e-150 across, whose areas double precision cannot represent
+ * (`VSR_STATUS_INVALID_ARGUMENT`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan validity:
+ * zero-area, flipped or overlapping faces, including faces that overlap away from any shared
+ * vertex (a strip winding over itself, components stacked in plan) (`VSR_STATUS_INVALID_PLAN`);
+ * supports (`VSR_STATUS_NO_SUPPORT`). The message names the offending vertex, face or edge
+ * ids. Vertices used by no triangle are ignored.
  *
  * # Safety
  * Each non-NULL array must hold the stated number of readable elements.
@@ -671,7 +677,11 @@ void vsr_mesh_destroy(struct VsrMesh *mesh);
  * load rule decides which area, see `vsr_settings_set_load_rule`).
  *
  * `density`: #F doubles, finite and >= 0; `n_faces` must equal the mesh's #F. Default: 1 on
- * every face. The array is copied. On failure the mesh keeps its previous values.
+ * every face. The array is copied. On failure the mesh keeps its previous values. Zeros are
+ * accepted here, but `vsr_analyse` and `vsr_form_find` return `VSR_STATUS_INVALID_ARGUMENT`
+ * (naming `loads`) when the loads on the non-anchored vertices average 0 or less (nothing to
+ * balance), or lie beyond what double precision carries through a solve (a mean outside
+ * 1e-150 to 1e150).
  *
  * # Safety
  * `mesh`: a valid handle with exclusive access; `density`: `n_faces` readable doubles.

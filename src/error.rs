@@ -37,8 +37,12 @@ pub enum Error {
     InconsistentOrientation { edge: [usize; 2], faces: [usize; 2] },
     /// Faces whose plan orientation is opposite to the majority: the plan folds over itself.
     FlippedFaces { faces: Vec<usize> },
-    /// Interior vertices whose plan angles do not sum to 2π: the plan wraps around them.
+    /// Vertices whose plan angles do not sum to 2π (interior vertices) or exceed 2π (boundary
+    /// vertices): the plan wraps around them.
     OverlappingPlan { vertices: Vec<usize> },
+    /// Two faces that overlap in plan away from any shared vertex (a strip winding over
+    /// itself, two components stacked in plan).
+    OverlappingFaces { faces: [usize; 2] },
     /// A connected component of the mesh has no anchored vertex.
     UnsupportedComponent {
         component: usize,
@@ -123,8 +127,13 @@ impl fmt::Display for Error {
             ),
             OverlappingPlan { vertices } => write!(
                 f,
-                "the plan overlaps itself around interior vertices {}",
+                "the plan overlaps itself around vertices {}",
                 ids(vertices)
+            ),
+            OverlappingFaces { faces } => write!(
+                f,
+                "the plan overlaps itself: faces {} and {} overlap in plan",
+                faces[0], faces[1]
             ),
             UnsupportedComponent { component, vertices } => write!(
                 f,
@@ -150,5 +159,118 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// The sentence a user reads for a termination (the C API's termination message).
+impl fmt::Display for crate::Termination {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use crate::Termination::*;
+        match self {
+            Converged => write!(f, "converged: eps_inf is below the tolerance"),
+            MaxIterations => write!(f, "reached the iteration limit"),
+            Stalled { vertices } if vertices.is_empty() => {
+                write!(f, "stalled: eps_inf stopped improving")
+            }
+            Stalled { vertices } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(
+                    f,
+                    "stalled: eps_inf stopped improving; vertices {} carry (almost) no stress \
+                     (raise q_min)",
+                    ids(&list)
+                )
+            }
+            Infeasible { constraint } => {
+                write!(f, "infeasible stress constraints: relax {constraint}")
+            }
+            NumericalError { what } => write!(f, "numerical error: {what}"),
+            Cancelled => write!(f, "cancelled by the progress callback"),
+            Blocked { vertices, hint } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(f, "blocked: {hint}; vertices {}", ids(&list))
+            }
+        }
+    }
+}
+
+/// A failed sparse Cholesky factorisation of `matrix` as an [`Error::Numerical`] in words
+/// (faer's own `Display` of these errors is their `Debug` text), for the shape step's
+/// factorisations (`src/shape`).
+pub(crate) fn factorisation_failure(matrix: &str, e: &faer::sparse::linalg::LltError) -> Error {
+    use faer::sparse::linalg::LltError;
+    let why = match e {
+        LltError::Numeric(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot {
+            index,
+        }) => format!(
+            "the Cholesky factorisation met a non-positive pivot at row {index}: the matrix is \
+             not positive definite"
+        ),
+        LltError::Generic(g) => faer_failure(g),
+    };
+    Error::Numerical {
+        what: format!("{matrix}: {why}"),
+    }
+}
+
+/// faer's non-numerical failures in words (a symbolic analysis fails with these alone).
+pub(crate) fn faer_failure(e: &faer::sparse::FaerError) -> String {
+    match e {
+        faer::sparse::FaerError::IndexOverflow => {
+            "the matrix has more entries than its index type can count".to_string()
+        }
+        faer::sparse::FaerError::OutOfMemory => "memory ran out".to_string(),
+        _ => "the sparse matrix library failed".to_string(),
+    }
+}
+
 /// Shorthand used across the crate.
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Termination;
+
+    #[test]
+    fn factorisation_failures_are_sentences() {
+        use faer::linalg::cholesky::llt::factor::LltError as Dense;
+        use faer::sparse::linalg::LltError;
+        let pivot = LltError::Numeric(Dense::NonPositivePivot { index: 1 });
+        let text = factorisation_failure("shape system", &pivot).to_string();
+        assert_eq!(
+            text,
+            "numerical failure: shape system: the Cholesky factorisation met a non-positive \
+             pivot at row 1: the matrix is not positive definite"
+        );
+        let memory = LltError::Generic(faer::sparse::FaerError::OutOfMemory);
+        let text = factorisation_failure("shape system", &memory).to_string();
+        assert_eq!(text, "numerical failure: shape system: memory ran out");
+    }
+
+    #[test]
+    fn terminations_read_as_sentences() {
+        let stalled = Termination::Stalled {
+            vertices: vec![4, 9],
+        };
+        assert_eq!(
+            stalled.to_string(),
+            "stalled: eps_inf stopped improving; vertices 4, 9 carry (almost) no stress (raise q_min)"
+        );
+        let many = Termination::Stalled {
+            vertices: (0..20).collect(),
+        };
+        assert!(many.to_string().contains("... (20 in all)"), "{many}");
+        for t in [
+            Termination::Converged,
+            Termination::MaxIterations,
+            Termination::Cancelled,
+            Termination::Infeasible {
+                constraint: "q_min".into(),
+            },
+            Termination::NumericalError {
+                what: "stress QP failed".into(),
+            },
+        ] {
+            let text = t.to_string();
+            assert!(!text.contains(['{', '[', '(']), "{text}");
+        }
+    }
+}

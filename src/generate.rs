@@ -45,6 +45,21 @@ pub fn rectangle(x0: f64, y0: f64, x1: f64, y1: f64, nx: usize, ny: usize) -> Ve
     p
 }
 
+/// Why spade refused a point, in words (its `Display` is the variant's name).
+fn insertion_failure(point: &str, e: spade::InsertionError) -> String {
+    match e {
+        spade::InsertionError::TooSmall => format!(
+            "{point} has a coordinate closer to 0 than {:e} (and not 0)",
+            spade::MIN_ALLOWED_VALUE
+        ),
+        spade::InsertionError::TooLarge => format!(
+            "{point} has a coordinate larger than {:e} in magnitude",
+            spade::MAX_ALLOWED_VALUE
+        ),
+        spade::InsertionError::NAN => format!("{point} has a NaN coordinate"),
+    }
+}
+
 /// Plan points and triangles of `domain`, refined until no triangle is larger than `max_area`
 /// (angles at least 25° away from constraints).
 pub fn triangulate(domain: &Domain, max_area: f64) -> Result<PlanMesh> {
@@ -53,12 +68,19 @@ pub fn triangulate(domain: &Domain, max_area: f64) -> Result<PlanMesh> {
         reason,
     };
     let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-    for poly in std::iter::once(&domain.outer).chain(&domain.holes) {
+    for (k, poly) in std::iter::once(&domain.outer)
+        .chain(&domain.holes)
+        .enumerate()
+    {
         let mut handles = Vec::with_capacity(poly.len());
-        for p in poly {
+        for (i, p) in poly.iter().enumerate() {
+            let point = match k {
+                0 => format!("point {i} of the outer boundary"),
+                h => format!("point {i} of hole {}", h - 1),
+            };
             handles.push(
                 cdt.insert(Point2::new(p[0], p[1]))
-                    .map_err(|e| bad(format!("{e:?}")))?,
+                    .map_err(|e| bad(insertion_failure(&point, e)))?,
             );
         }
         for k in 0..handles.len() {
@@ -403,5 +425,34 @@ impl SplitMix {
 
     fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refused_points_are_named_in_words() {
+        let mut hole = circle([0.0, 0.0], 0.3, 8);
+        hole[5] = [f64::NAN, 0.0];
+        let domain = Domain {
+            outer: rectangle(-1.0, -1.0, 1.0, 1.0, 4, 4),
+            holes: vec![hole],
+        };
+        let message = triangulate(&domain, 0.1).unwrap_err().to_string();
+        assert_eq!(
+            message,
+            "invalid argument `domain`: point 5 of hole 0 has a NaN coordinate"
+        );
+        let domain = Domain {
+            outer: vec![[0.0, 0.0], [1e300, 0.0], [0.0, 1.0]],
+            holes: Vec::new(),
+        };
+        let message = triangulate(&domain, 0.1).unwrap_err().to_string();
+        assert!(
+            message.contains("point 1 of the outer boundary has a coordinate larger than"),
+            "{message}"
+        );
     }
 }

@@ -40,7 +40,8 @@ impl Problem {
         }
     }
 
-    /// Per-face density: finite and >= 0.
+    /// Per-face density: finite and >= 0. Zeros are accepted here, but a solve needs a
+    /// positive mean load on the non-anchored vertices (see [`crate::analyse`]).
     pub fn with_face_density(mut self, density: Vec<f64>) -> Result<Problem> {
         check_len("face_density", density.len(), self.mesh.faces.len(), "face")?;
         if let Some(t) = density.iter().position(|d| !d.is_finite() || *d < 0.0) {

@@ -181,6 +181,50 @@ fn mesh_create_rejects_bad_ids_values_and_topology() {
 }
 
 #[test]
+fn mesh_create_rejects_plans_overlapping_away_from_shared_vertices() {
+    // Two unit squares, the second shifted by (0.5, 0.5): two components stacked in plan.
+    let positions = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, //
+        0.5, 0.5, 1.0, 1.5, 0.5, 1.0, 1.5, 1.5, 1.0, 0.5, 1.5, 1.0,
+    ];
+    let triangles = [0u32, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7];
+    // A strip between radii 1 and 2 winding 1.6 turns, rising: one component, every vertex
+    // on the boundary, no face flipped.
+    let mut strip = Vec::new();
+    for s in 0..=16 {
+        let angle = std::f64::consts::TAU * f64::from(s) / 10.0;
+        for r in [1.0, 2.0] {
+            strip.extend([r * angle.cos(), r * angle.sin(), 0.1 * f64::from(s)]);
+        }
+    }
+    let strip_triangles: Vec<u32> = (0..16u32)
+        .flat_map(|s| [2 * s, 2 * s + 1, 2 * s + 3, 2 * s, 2 * s + 3, 2 * s + 2])
+        .collect();
+    type Case<'a> = (&'a [f64], &'a [u32], &'a [u32], &'a str);
+    let cases: [Case; 2] = [
+        (&positions, &triangles, &[0, 4], "faces 0 and 2 overlap"),
+        (&strip, &strip_triangles, &[0, 1], "faces 0 and 20 overlap"),
+    ];
+    for (p, t, a, detail) in cases {
+        let mut out = sentinel();
+        let s = unsafe {
+            vsr_mesh_create(
+                p.as_ptr(),
+                p.len() / 3,
+                t.as_ptr(),
+                t.len() / 3,
+                a.as_ptr(),
+                a.len(),
+                &mut out,
+            )
+        };
+        assert_failed(s, S::InvalidPlan, "positions");
+        assert!(last_error().contains(detail), "{}", last_error());
+        assert_eq!(out, sentinel());
+    }
+}
+
+#[test]
 fn destroy_null_is_a_no_op_and_keeps_the_last_error() {
     let mut out = sentinel();
     let s = unsafe { vsr_mesh_create(null(), 0, null(), 0, null(), 0, &mut out) };
@@ -765,6 +809,11 @@ fn result_getters_check_pointers_buffers_and_kind() {
     let mut solvers = [VsrQpSolver::Clarabel; 3];
     let st = unsafe { vsr_result_step_solvers(analysis, solvers.as_mut_ptr(), 3, &mut needed) };
     assert_failed(st, S::NotAvailable, "result");
+    assert!(
+        last_error().contains("only a result of vsr_form_find has the step solvers"),
+        "{}",
+        last_error()
+    );
     assert_eq!((needed, solvers), (5, [VsrQpSolver::Clarabel; 3]));
     let (mut t, mut it) = (VsrTermination::Cancelled, 77usize);
     assert_failed(
@@ -1068,4 +1117,71 @@ fn both_methods_through_the_c_abi_equal_the_rust_ones_bit_for_bit() {
         }
     }
     unsafe { vsr_mesh_destroy(mesh) };
+}
+
+/// A progress callback that makes a failing call (a NULL handle) and lets the solve go on.
+unsafe extern "C" fn fail_inside(
+    _user: *mut std::ffi::c_void,
+    _iteration: usize,
+    _eps: f64,
+) -> std::ffi::c_int {
+    let s = unsafe { vsr_settings_set_tolerance(null_mut(), 1e-6) };
+    assert_eq!(s, S::NullPointer);
+    0
+}
+
+#[test]
+fn a_failing_call_inside_the_progress_callback_leaves_no_message() {
+    let mesh = Dome::new(3, 8).create();
+    let s = settings();
+    assert_ok(unsafe { vsr_settings_set_progress(s, Some(fail_inside), null_mut()) });
+    let mut r = null_mut();
+    let status = unsafe { vsr_form_find(mesh, s, &mut r) };
+    assert_eq!(status, S::Ok);
+    assert_eq!(last_error(), "", "a stale message after a successful solve");
+    unsafe {
+        vsr_result_destroy(r);
+        vsr_settings_destroy(s);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
+/// Loads a solve cannot use: none at all (density 0 everywhere), or models in units whose
+/// loads double precision cannot carry (coordinates of 1e78 or 1e-100); coordinates of 1e200
+/// are refused by `vsr_mesh_create` itself. Each gets its status and a message that says why.
+#[test]
+fn solves_reject_weightless_and_unrepresentable_loads() {
+    let s = settings();
+    let d = Dome::new(3, 8);
+    let weightless = d.create();
+    let zeros = vec![0.0; d.n_triangles()];
+    assert_ok(unsafe { vsr_mesh_set_face_density(weightless, zeros.as_ptr(), zeros.len()) });
+    let mut meshes = vec![(weightless, "no weight to balance")];
+    for factor in [1e78, 1e-100] {
+        let mut scaled = Dome::new(3, 8);
+        scaled.positions.iter_mut().for_each(|c| *c *= factor);
+        meshes.push((scaled.create(), "cannot be represented in double precision"));
+    }
+    for (mesh, why) in meshes {
+        for solve in [vsr_analyse, vsr_form_find] {
+            let mut out = sentinel();
+            assert_failed(
+                unsafe { solve(mesh, s, &mut out) },
+                S::InvalidArgument,
+                "loads",
+            );
+            assert!(last_error().contains(why), "{}", last_error());
+            assert_eq!(out, sentinel());
+        }
+        unsafe { vsr_mesh_destroy(mesh) };
+    }
+    let (status, out) = create_with(|p, _, _| p.iter_mut().for_each(|c| *c *= 1e200));
+    assert_failed(status, S::InvalidArgument, "positions");
+    assert!(
+        last_error().contains("cannot be represented"),
+        "{}",
+        last_error()
+    );
+    assert_eq!(out, sentinel());
+    unsafe { vsr_settings_destroy(s) };
 }

@@ -241,17 +241,111 @@ fn bad_input_gets_one_line_and_no_output() {
     );
     rejects(&sq, &["--supports", "s.json"], "need a MESH");
     rejects(&sq, &["sq.obj", "--supports", "s.json", "--out"], "--out");
+    // A misspelt face line would otherwise drop a face unseen.
+    rejects(
+        &[
+            ("bad.obj", format!("{SQUARE}F 1 2 3\n").as_str()),
+            ("s.json", "[0, 1, 2, 3]"),
+        ],
+        &["bad.obj", "--supports", "s.json"],
+        "bad.obj:10: unknown statement `F`",
+    );
+    // Two squares stacked in plan.
+    let stacked = format!(
+        "{SQUARE}v 0.5 0.5 1\nv 1.5 0.5 1\nv 1.5 1.5 1\nv 0.5 1.5 1\nv 1 1 1.3\n\
+         f 6 7 10\nf 7 8 10\nf 8 9 10\nf 9 6 10\n"
+    );
+    rejects(
+        &[
+            ("st.obj", &stacked[..]),
+            ("s.json", "[0, 1, 2, 3, 5, 6, 7, 8]"),
+        ],
+        &["st.obj", "--supports", "s.json"],
+        "overlap in plan",
+    );
+    // Units double precision cannot carry: refused by the mesh (1e200) or the solve (1e78).
+    for (factor, needle) in [("1e200", "vertex 1 has the coordinate"), ("1e78", "loads")] {
+        let f: f64 = factor.parse().unwrap();
+        let scaled = format!(
+            "v 0 0 0\nv {f:e} 0 0\nv {f:e} {f:e} 0\nv 0 {f:e} 0\nv {h:e} {h:e} 0.3\n\
+             f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n",
+            h = f / 2.0
+        );
+        rejects(
+            &[("big.obj", &scaled[..]), ("s.json", "[0, 1, 2, 3]")],
+            &["big.obj", "--supports", "s.json"],
+            needle,
+        );
+    }
+}
+
+/// Runs formfind with `args` in a scratch folder set up by `prepare`; asserts exit status
+/// `code`, a single stderr line containing every needle, and that every file and folder is as
+/// it was, contents included.
+fn fails_and_leaves_all_as_it_was(
+    prepare: impl FnOnce(&Scratch),
+    args: &[&str],
+    code: i32,
+    needles: &[&str],
+) {
+    static CASE: AtomicUsize = AtomicUsize::new(0);
+    let dir = Scratch::new(&format!(
+        "untouched-{}",
+        CASE.fetch_add(1, Ordering::Relaxed)
+    ));
+    prepare(&dir);
+    let before = dir.snapshot();
+    let out = run(&dir.0, args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+    assert_eq!(
+        stderr.lines().count(),
+        1,
+        "{args:?}: not one line: {stderr}"
+    );
+    for needle in needles {
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: `{stderr}` lacks `{needle}`"
+        );
+    }
+    assert!(
+        dir.snapshot() == before,
+        "{args:?}: files changed: {:?}",
+        dir.listing()
+    );
+}
+
+fn old_mesh(dir: &Scratch) {
+    fs::write(dir.path("o.obj"), "# the previous result\n").unwrap();
 }
 
 #[test]
-fn failed_write_leaves_nothing_behind() {
-    // The pictures go last and cannot be written (their folder would be inside a file): the
-    // mesh and report staged before them must be removed too.
-    let dir = Scratch::new("write-fails");
-    fs::write(dir.path("file"), "").unwrap();
-    let before = dir.listing();
-    let out = run(
-        &dir.0,
+fn unwritable_outputs_are_rejected_before_the_run() {
+    let outputs = ["--out", "o.obj", "--report", "r.json", "--pictures", "pics"];
+    // The report's path is a folder: the mesh before it must not be written or replaced.
+    fails_and_leaves_all_as_it_was(
+        |d| {
+            old_mesh(d);
+            fs::create_dir(d.path("R")).unwrap();
+        },
+        &["--out", "o.obj", "--report", "R", "--pictures", "pics"],
+        2,
+        &["--report", "`R` is a folder"],
+    );
+    // One picture's path is a folder.
+    fails_and_leaves_all_as_it_was(
+        |d| {
+            old_mesh(d);
+            fs::create_dir_all(d.path("pics/residuals.svg")).unwrap();
+        },
+        &outputs,
+        2,
+        &["--pictures", "residuals.svg` is a folder"],
+    );
+    // The pictures' folder would be inside a file.
+    fails_and_leaves_all_as_it_was(
+        |d| fs::write(d.path("file"), "").unwrap(),
         &[
             "--out",
             "a/o.obj",
@@ -260,12 +354,94 @@ fn failed_write_leaves_nothing_behind() {
             "--pictures",
             "file/pics",
         ],
+        2,
+        &["--pictures", "`file` is not a folder"],
     );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("file/pics"), "{stderr}");
-    assert_eq!(dir.listing(), before);
+}
+
+#[test]
+fn clashing_output_paths_are_rejected_naming_both_options() {
+    fails_and_leaves_all_as_it_was(
+        old_mesh,
+        &["--out", "o.obj", "--report", "o.obj"],
+        2,
+        &["--out and --report name the same file `o.obj`"],
+    );
+    fails_and_leaves_all_as_it_was(
+        |d| fs::create_dir(d.path("sub")).unwrap(),
+        &["--out", "./x.obj", "--report", "sub/../x.obj"],
+        2,
+        &["--out and --report name the same file"],
+    );
+    fails_and_leaves_all_as_it_was(
+        |_| {},
+        &["--pictures", "p", "--report", "p/residuals.svg"],
+        2,
+        &["--report and --pictures name the same file"],
+    );
+    fails_and_leaves_all_as_it_was(
+        |_| {},
+        &["--out", "d", "--pictures", "d"],
+        2,
+        &["--out `d` and --pictures `d/plan_forces.svg` clash"],
+    );
+    // The embedded input's copy goes beside --out.
+    fails_and_leaves_all_as_it_was(
+        |_| {},
+        &["--out", "o.obj", "--report", "vault-input.obj"],
+        2,
+        &["--report and the embedded input's copy"],
+    );
+}
+
+#[test]
+fn a_failed_write_leaves_nothing_behind_and_keeps_old_files() {
+    // The report's name is valid but its temporary file's (longer by its prefix and suffix)
+    // is not: the write fails after the checks, once the mesh is already staged.
+    let long = format!("{}.json", "r".repeat(245));
+    fails_and_leaves_all_as_it_was(
+        old_mesh,
+        &[
+            "--stress-only",
+            "--out",
+            "o.obj",
+            "--report",
+            &long,
+            "--pictures",
+            "a/pics",
+        ],
+        1,
+        &["File name too long"],
+    );
+}
+
+#[test]
+fn existing_outputs_are_replaced_when_all_are_written() {
+    let dir = Scratch::new("replace");
+    old_mesh(&dir);
+    let out = run(
+        &dir.0,
+        &[
+            "--stress-only",
+            "--out",
+            "o.obj",
+            "--report",
+            "r.json",
+            "--pictures",
+            "p",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (positions, _) = read_obj(&dir.path("o.obj"));
+    assert!(!positions.is_empty(), "o.obj was not replaced");
+    let hidden: Vec<String> = (dir.listing().into_iter())
+        .filter(|n| n.contains(".formfind-"))
+        .collect();
+    assert!(hidden.is_empty(), "left behind: {hidden:?}");
 }
 
 #[test]

@@ -75,7 +75,8 @@ Inputs:
   --no-weld              keep MESH's vertices as they are (not for STL, whose triangles
                          never share vertices)
 
-Outputs (all written at the end of a run, or none; existing files are replaced):
+Outputs (checked before the run; all written at the end of it, or none; existing files
+are replaced only when every output is written; two outputs may not share a path):
   --out OUT              final positions, same faces (after any plan repair), in the
                          format of the extension: .obj, .off, .ply (every bit kept) or
                          .stl (single precision)
@@ -114,7 +115,8 @@ Solver:
   -h, --help             this text
 
 Exit status: 0 converged (or --stress-only solved), 3 finished without converging
-(outputs written, the report says why), 2 bad input or options, 1 other failure.
+(outputs written, the report says why), 2 bad input, options or output paths (nothing
+written), 1 other failure (nothing written).
 ",
         method = name_of(&METHODS, d.method),
         fairness = d.fairness,

@@ -6,8 +6,10 @@
 //! cargo run --release --example formfind -- --help             # every option and default
 //! ```
 //!
-//! Reads OBJ, OFF, STL or PLY; writes the form-found mesh (in the format of `--out`), a JSON report and SVG pictures, all or nothing: bad input
-//! gets a one-line message on stderr, a non-zero exit status and no output files.
+//! Reads OBJ, OFF, STL or PLY; writes the form-found mesh (in the format of `--out`), a JSON
+//! report and SVG pictures, all or nothing: bad input or output paths get a one-line message
+//! on stderr, a non-zero exit status and no output files, and existing files are replaced only
+//! when every output is written.
 
 mod args;
 mod draw;
@@ -95,6 +97,52 @@ fn report_text(report: &Value) -> String {
     format!("{{\n{}\n}}\n", lines.join(",\n"))
 }
 
+/// Where a run writes.
+struct Paths {
+    out: PathBuf,
+    report: PathBuf,
+    pictures: PathBuf,
+    /// Where the embedded input and its supports are copied (without MESH.obj).
+    input_copy: Option<(PathBuf, PathBuf)>,
+}
+
+impl Paths {
+    fn of(o: &args::Options, name: &str) -> Paths {
+        let dir = PathBuf::from(OUT_DIR);
+        let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{name}-formfound.obj")));
+        let input_copy = o.mesh.is_none().then(|| {
+            let base = out.parent().unwrap_or(Path::new(""));
+            (
+                base.join(format!("{name}-input.obj")),
+                base.join(format!("{name}-supports.json")),
+            )
+        });
+        Paths {
+            report: o.report.clone().unwrap_or_else(|| dir.join("report.json")),
+            pictures: o.pictures.clone().unwrap_or_else(|| dir.join("pictures")),
+            out,
+            input_copy,
+        }
+    }
+
+    /// Every file a run writes, with the option that names it.
+    fn targets(&self, stress_only: bool) -> Vec<output::Target> {
+        let target = |option: &str, path: &Path| output::Target {
+            option: option.into(),
+            path: path.to_path_buf(),
+        };
+        let mut targets = vec![target("--out", &self.out), target("--report", &self.report)];
+        for file in pictures::names(stress_only) {
+            targets.push(target("--pictures", &self.pictures.join(file)));
+        }
+        if let Some((obj, json)) = &self.input_copy {
+            targets.push(target("the embedded input's copy (beside --out)", obj));
+            targets.push(target("the embedded input's supports (beside --out)", json));
+        }
+        targets
+    }
+}
+
 fn formfind() -> Result<ExitCode, Failure> {
     let o = match args::parse(std::env::args_os().skip(1)).map_err(bad_input)? {
         args::Parsed::Help => {
@@ -107,12 +155,14 @@ fn formfind() -> Result<ExitCode, Failure> {
         None => model::embedded_default(),
         Some(path) => model::from_files(path, &o).map_err(bad_input)?,
     };
-    let dir = PathBuf::from(OUT_DIR);
-    let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{}-formfound.obj", model.name)));
-    let report_path = o.report.clone().unwrap_or_else(|| dir.join("report.json"));
-    let pictures_dir = o.pictures.clone().unwrap_or_else(|| dir.join("pictures"));
-    let embedded = o.mesh.is_none();
-    let name = model.name.clone();
+    let paths = Paths::of(&o, &model.name);
+    output::check(&paths.targets(o.stress_only)).map_err(bad_input)?;
+    let Paths {
+        out,
+        report: report_path,
+        pictures: pictures_dir,
+        input_copy,
+    } = paths;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
     let report = report::build(&o, &outcome);
@@ -132,13 +182,6 @@ fn formfind() -> Result<ExitCode, Failure> {
             .write(&pictures_dir.join(file), svg.as_bytes())
             .map_err(failed)?;
     }
-    let input_copy = embedded.then(|| {
-        let base = out.parent().unwrap_or(Path::new(""));
-        (
-            base.join(format!("{name}-input.obj")),
-            base.join(format!("{name}-supports.json")),
-        )
-    });
     if let Some((obj, json)) = &input_copy {
         let anchored: Vec<usize> = (0..mesh.n_vertices())
             .filter(|&v| mesh.anchored[v])

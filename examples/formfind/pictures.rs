@@ -390,15 +390,29 @@ fn height_change(o: &Outcome) -> Document {
         .add(draw::scale_bar(view, (640.0, y + 10.0), 200.0, "length"))
 }
 
-/// The pictures of a run as (file name, SVG text).
+/// The file names of the pictures (no height change without form finding).
+pub fn names(stress_only: bool) -> Vec<&'static str> {
+    let all = [
+        "plan_forces.svg",
+        "force_diagram.svg",
+        "residuals.svg",
+        "height_change.svg",
+    ];
+    all[..if stress_only { 3 } else { 4 }].to_vec()
+}
+
+/// The pictures of a run as (file name, SVG text), in the order of [`names`].
 pub fn all(o: &Outcome) -> Vec<(&'static str, String)> {
     let mut out = vec![
-        ("plan_forces.svg", plan_forces(o).to_string()),
-        ("force_diagram.svg", force_diagram(o).to_string()),
-        ("residuals.svg", residuals(o).to_string()),
+        plan_forces(o).to_string(),
+        force_diagram(o).to_string(),
+        residuals(o).to_string(),
     ];
     if o.termination.is_some() {
-        out.push(("height_change.svg", height_change(o).to_string()));
+        out.push(height_change(o).to_string());
     }
-    out
+    names(o.termination.is_none())
+        .into_iter()
+        .zip(out)
+        .collect()
 }

@@ -1,7 +1,8 @@
 //! The panic boundary, the thread-local last error and the checked readers of caller memory.
 //!
 //! Every exported function runs inside [`boundary!`]: status-returning functions clear the last
-//! error on entry and set it on failure; the few infallible ones (`vsr_version`,
+//! error on entry, set it on failure and clear it again on success (a progress callback may
+//! have made a failing call in between); the few infallible ones (`vsr_version`,
 //! `vsr_status_name`, `vsr_last_error_message`, the `_destroy` functions) leave it untouched so
 //! that a host can clean up or format a message before it reads the error.
 
@@ -74,11 +75,16 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     format!("internal error (panic) in voussoir: {what}")
 }
 
-/// Runs a status-returning body: clears the last error, catches panics.
+/// Runs a status-returning body: clears the last error, catches panics. The message is
+/// cleared again on success: calls made inside the body (a progress callback's) may have set
+/// one, and a successful call always leaves "".
 pub(crate) fn run(f: impl FnOnce() -> CResult) -> VsrStatus {
     set_last_error("");
     match catch_unwind(AssertUnwindSafe(f)) {
-        Ok(Ok(())) => VsrStatus::Ok,
+        Ok(Ok(())) => {
+            set_last_error("");
+            VsrStatus::Ok
+        }
         Ok(Err(failure)) => {
             set_last_error(&failure.message);
             failure.status
@@ -259,9 +265,10 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
         | NonManifoldVertex { .. }
         | InconsistentOrientation { .. }
         | HoleNotCuttable { .. } => (VsrStatus::InvalidTopology, "triangles"),
-        DegenerateFaces { .. } | FlippedFaces { .. } | OverlappingPlan { .. } => {
-            (VsrStatus::InvalidPlan, "positions")
-        }
+        DegenerateFaces { .. }
+        | FlippedFaces { .. }
+        | OverlappingPlan { .. }
+        | OverlappingFaces { .. } => (VsrStatus::InvalidPlan, "positions"),
         UnsupportedComponent { .. } | NoSupports => (VsrStatus::NoSupport, "anchored"),
         Numerical { .. } => (VsrStatus::Numerical, arg),
         Io { .. } | Parse { .. } | Malformed { .. } => (VsrStatus::InvalidArgument, arg),
@@ -295,6 +302,13 @@ mod tests {
         assert!(last_error().contains("again"));
         // A successful call clears it.
         assert_eq!(run(|| Ok(())), VsrStatus::Ok);
+        assert_eq!(last_error(), "");
+        // Also when a call inside it (a progress callback's) failed.
+        let status = run(|| {
+            assert_eq!(run(|| Err(Failure::null("inner"))), VsrStatus::NullPointer);
+            Ok(())
+        });
+        assert_eq!(status, VsrStatus::Ok);
         assert_eq!(last_error(), "");
     }
 

@@ -51,9 +51,13 @@ fn too_many(name: &str, count: &str, n: usize, max: usize) -> CResult {
 /// Checked in this order: NULL pointers; lengths (`n * 3` overflow, at most 2^32 - 1 vertices
 /// and (2^32 - 1) / 6 triangles: `VSR_STATUS_LENGTH_OVERFLOW`); empty mesh; ids `>= n_vertices`
 /// (`VSR_STATUS_INDEX_OUT_OF_RANGE`); repeated supports; NaN or infinite coordinates of vertices
-/// used by a triangle (`VSR_STATUS_NON_FINITE`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan
-/// validity (`VSR_STATUS_INVALID_PLAN`); supports (`VSR_STATUS_NO_SUPPORT`). The message names
-/// the offending vertex, face or edge ids. Vertices used by no triangle are ignored.
+/// used by a triangle (`VSR_STATUS_NON_FINITE`); coordinates beyond ±1e150, or a plan less than
+/// 1e-150 across, whose areas double precision cannot represent
+/// (`VSR_STATUS_INVALID_ARGUMENT`); topology (`VSR_STATUS_INVALID_TOPOLOGY`); plan validity:
+/// zero-area, flipped or overlapping faces, including faces that overlap away from any shared
+/// vertex (a strip winding over itself, components stacked in plan) (`VSR_STATUS_INVALID_PLAN`);
+/// supports (`VSR_STATUS_NO_SUPPORT`). The message names the offending vertex, face or edge
+/// ids. Vertices used by no triangle are ignored.
 ///
 /// # Safety
 /// Each non-NULL array must hold the stated number of readable elements.
@@ -180,7 +184,11 @@ unsafe fn set_rows(
 /// load rule decides which area, see `vsr_settings_set_load_rule`).
 ///
 /// `density`: #F doubles, finite and >= 0; `n_faces` must equal the mesh's #F. Default: 1 on
-/// every face. The array is copied. On failure the mesh keeps its previous values.
+/// every face. The array is copied. On failure the mesh keeps its previous values. Zeros are
+/// accepted here, but `vsr_analyse` and `vsr_form_find` return `VSR_STATUS_INVALID_ARGUMENT`
+/// (naming `loads`) when the loads on the non-anchored vertices average 0 or less (nothing to
+/// balance), or lie beyond what double precision carries through a solve (a mean outside
+/// 1e-150 to 1e150).
 ///
 /// # Safety
 /// `mesh`: a valid handle with exclusive access; `density`: `n_faces` readable doubles.

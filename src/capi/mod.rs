@@ -60,7 +60,7 @@ pub extern "C" fn vsr_abi_version() -> u32 {
 
 /// A one-line, NUL-terminated UTF-8 message about the last failed call on this thread, naming
 /// the argument, vertex, face or edge at fault; "" when the last status-returning call
-/// succeeded. Never NULL. The string belongs to the library and stays valid until the next
+/// succeeded, even if a call made inside it (by a progress callback) failed. Never NULL. The string belongs to the library and stays valid until the next
 /// status-returning call on the same thread; copy it to keep it. Calls to `vsr_version`,
 /// `vsr_abi_version`, `vsr_status_name`, `vsr_last_error_message` and the `_destroy`
 /// functions leave it untouched.

@@ -59,8 +59,8 @@ impl VsrResult {
             Outcome::Analysis { .. } => Err(Failure::new(
                 VsrStatus::NotAvailable,
                 format!(
-                    "argument `result`: {what} exists only for results of vsr_form_find, \
-                     this one comes from vsr_analyse"
+                    "argument `result`: only a result of vsr_form_find has {what}, and this \
+                     one comes from vsr_analyse"
                 ),
             )),
         }
@@ -526,7 +526,7 @@ pub unsafe extern "C" fn vsr_result_eps_history(
         // SAFETY: forwarded caller's contract.
         unsafe {
             copy(result, out, len, needed, |r| {
-                Ok(r.form("the eps history")?.history.clone())
+                Ok(r.form("an eps history")?.history.clone())
             })
         }
     })
@@ -682,25 +682,7 @@ pub unsafe extern "C" fn vsr_result_termination_message(
         // SAFETY: forwarded caller's contract.
         unsafe {
             copy(result, out, len, needed, |r| {
-                let text = match &r.form("the termination message")?.termination {
-                    Termination::Converged => "converged: eps_inf < tolerance".to_string(),
-                    Termination::MaxIterations => "reached the iteration limit".to_string(),
-                    Termination::Stalled { vertices } if vertices.is_empty() => {
-                        "stalled: eps_inf stopped improving".to_string()
-                    }
-                    Termination::Stalled { vertices } => format!(
-                        "stalled: eps_inf stopped improving; vertices {vertices:?} carry \
-                         (almost) no stress (raise q_min)"
-                    ),
-                    Termination::Infeasible { constraint } => {
-                        format!("infeasible stress constraints: relax {constraint}")
-                    }
-                    Termination::NumericalError { what } => format!("numerical error: {what}"),
-                    Termination::Cancelled => "cancelled by the progress callback".to_string(),
-                    Termination::Blocked { vertices, hint } => {
-                        format!("blocked: {hint}; vertices {vertices:?}")
-                    }
-                };
+                let text = r.form("the termination message")?.termination.to_string();
                 let mut bytes: Vec<c_char> = text
                     .bytes()
                     .filter(|&b| b != 0)

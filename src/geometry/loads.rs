@@ -30,8 +30,28 @@ fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// Area shares of the three corners of triangle (a, b, c) under `rule`.
+/// 2^e, exactly (for e in the normal exponent range).
+fn power_of_two(e: i32) -> f64 {
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
+/// Area shares of the three corners of triangle (a, b, c) under `rule`, computed on the
+/// triangle scaled by a power of two to coordinates of order 1 and scaled back: the squares
+/// inside the area formulas then neither overflow (coordinates beyond about 1e77) nor
+/// underflow (below about 1e-77), and in between the result is bit for bit the unscaled one.
 fn corner_shares(rule: LoadRule, p: [[f64; 3]; 3]) -> [f64; 3] {
+    let largest = p.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+    if !largest.is_normal() {
+        return unscaled_shares(rule, p);
+    }
+    // 2^(2e) stays a double; beyond, the coordinates are far outside what a mesh accepts.
+    let e = (largest.log2().floor() as i32).clamp(-511, 511);
+    let scaled = p.map(|q| q.map(|c| c * power_of_two(-e)));
+    unscaled_shares(rule, scaled).map(|s| s * power_of_two(2 * e))
+}
+
+/// Area shares of the three corners of triangle (a, b, c) under `rule`.
+fn unscaled_shares(rule: LoadRule, p: [[f64; 3]; 3]) -> [f64; 3] {
     match rule {
         LoadRule::Barycentric => {
             let n = cross3(sub3(p[1], p[0]), sub3(p[2], p[0]));
@@ -161,6 +181,21 @@ mod tests {
                 "{s:?} vs {area}"
             );
             assert!(s.iter().all(|&x| x > 0.0));
+        }
+    }
+
+    #[test]
+    fn shares_are_exact_at_extreme_scales() {
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.1, 0.3], [0.4, 0.9, -0.2]];
+        for rule in [LoadRule::Barycentric, LoadRule::Voronoi, LoadRule::PlanArea] {
+            let unit = corner_shares(rule, tri);
+            // Powers of two: the shares scale exactly by the square.
+            for e in [-250, -80, 80, 250] {
+                let s = 2f64.powi(e);
+                let scaled = corner_shares(rule, tri.map(|p| p.map(|c| c * s)));
+                let expected = unit.map(|a| a * s * s);
+                assert_eq!(scaled, expected, "{rule:?} at 2^{e}");
+            }
         }
     }
 

@@ -32,7 +32,7 @@ use std::path::Path;
 use crate::{Mesh, Result};
 
 pub use format::{read_mesh, write_mesh, write_mesh_as, MeshFormat};
-pub use obj::{parse_obj, read_obj, write_obj};
+pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
 pub use off::parse_off;
 pub use ply::parse_ply;
 pub use stl::parse_stl;

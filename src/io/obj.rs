@@ -18,16 +18,22 @@ pub fn read_obj(path: &Path) -> Result<RawMesh> {
     )
 }
 
+/// OBJ statements that carry nothing the solver uses: skipped by [`parse_obj`] (as are
+/// comments and blank lines).
+pub const IGNORED_KEYWORDS: [&str; 9] = ["vn", "vt", "vp", "g", "o", "s", "usemtl", "mtllib", "l"];
+
 /// Parses OBJ text: `v x y z` lines give vertices (extra values such as `w` or colours are
 /// ignored), `f` lines give faces with 1-based indices, in any of the forms `i`, `i/t`,
 /// `i//n`, `i/t/n`; negative indices count back from the last vertex read so far. Polygons
-/// are split into a fan of triangles `(p0, p[i], p[i+1])`. Comments (`#`) and every other
-/// statement (`vn`, `vt`, `g`, `o`, `s`, `usemtl`, `l`, ...) are ignored.
+/// are split into a fan of triangles `(p0, p[i], p[i+1])`. Blank lines, comments (`#`) and
+/// the statements in [`IGNORED_KEYWORDS`] (normals, texture coordinates, groups, materials,
+/// lines) are ignored; a byte-order mark at the start of the text is skipped.
 ///
-/// Errors are [`Error::Parse`] with `path_label` and the 1-based line: a vertex with fewer
-/// than 3 coordinates or a bad number, a face with fewer than 3 vertices, an index that is
-/// not an integer, is 0, or refers past the last vertex of the file (or, when negative,
-/// before the first vertex).
+/// Errors are [`Error::Parse`] with `path_label` and the 1-based line: any other statement
+/// (a misspelt `F`, `f,`, a keyword behind an invisible character: skipping it would drop a
+/// face or a vertex unseen), a vertex with fewer than 3 coordinates or a bad number, a face
+/// with fewer than 3 vertices, an index that is not an integer, is 0, or refers past the last
+/// vertex of the file (or, when negative, before the first vertex).
 pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
     let err = |line: usize, reason: String| Error::Parse {
         path: path_label.to_string(),
@@ -40,6 +46,7 @@ pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
     let mut forward_refs: Vec<(usize, u64)> = Vec::new();
     let mut polygon: Vec<u32> = Vec::new();
 
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let content = raw.split('#').next().unwrap_or("");
@@ -81,7 +88,18 @@ pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
                     faces.push([polygon[0], polygon[k], polygon[k + 1]]);
                 }
             }
-            _ => {}
+            Some(keyword) if IGNORED_KEYWORDS.contains(&keyword) => {}
+            Some(keyword) => {
+                return Err(err(
+                    line,
+                    format!(
+                        "unknown statement `{}`: only v and f are read, and {} are skipped",
+                        keyword.escape_debug(),
+                        IGNORED_KEYWORDS.join(", ")
+                    ),
+                ))
+            }
+            None => {}
         }
     }
     let n = positions.len() as u64;

@@ -68,6 +68,8 @@ fn slash_forms_negative_indices_and_ignored_lines() {
                 g group\n\
                 s off\n\
                 usemtl stone\n\
+                mtllib stone.mtl\n\
+                vp 0.5\n\
                 l 1 2\n\
                 f 1/1/1 2/2/1 3/3/1\n\
                 f 1//1 3//1 4//1\n\
@@ -82,6 +84,14 @@ fn slash_forms_negative_indices_and_ignored_lines() {
         faces,
         vec![[0, 1, 2], [0, 2, 3], [0, 2, 3], [0, 1, 2], [3, 0, 2]]
     );
+}
+
+#[test]
+fn a_byte_order_mark_at_the_start_is_skipped() {
+    let (positions, faces) =
+        parse_obj("\u{feff}v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "x").unwrap();
+    assert_eq!(positions.len(), 3);
+    assert_eq!(faces, vec![[0, 1, 2]]);
 }
 
 #[test]
@@ -130,6 +140,24 @@ fn malformed_lines_report_their_line_number() {
             4,
             "too large",
         ),
+        // Statements that are not OBJ's would drop a face or a vertex unseen.
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nF 1 2 3\n",
+            4,
+            "unknown statement `F`",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf, 1 2 3\n",
+            4,
+            "unknown statement `f,`",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\n\u{200b}f 1 2 3\n",
+            4,
+            "unknown statement `\\u{200b}f`",
+        ),
+        ("v 0 0 0\n\u{feff}v 1 0 0\n", 2, "unknown statement"),
+        ("vertex 0 0 0\n", 1, "only v and f are read"),
     ];
     for &(text, line, needle) in cases {
         let (got, reason) = parse_line_error(text);

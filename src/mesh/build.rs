@@ -12,7 +12,14 @@ use crate::{Error, Result};
 
 /// A face is degenerate when |plan area| <= `AREA_TOL` × (plan bounding-box diagonal)².
 pub const AREA_TOL: f64 = 1e-12;
-/// An interior vertex overlaps when its plan angle sum differs from 2π by more than this.
+/// Largest coordinate magnitude accepted: squares and products of two coordinates (areas,
+/// loads, Airy values) then stay far from the largest double (about 1.8e308).
+pub const MAX_COORDINATE: f64 = 1e150;
+/// Smallest plan extent (bounding-box diagonal) accepted, unless it is 0 (then every face is
+/// degenerate): areas then stay far from the smallest normal double (about 2.2e-308).
+pub const MIN_PLAN_EXTENT: f64 = 1e-150;
+/// An interior vertex overlaps when its plan angle sum differs from 2π by more than this, a
+/// boundary vertex when its sum exceeds 2π by more.
 pub const ANGLE_TOL: f64 = 1e-6;
 
 impl Mesh {
@@ -27,6 +34,9 @@ impl Mesh {
     /// 2. a face index `>= n_vertices`: [`Error::IndexOutOfRange`] (first such face);
     /// 3. an anchored id out of range or listed twice: [`Error::InvalidAnchor`];
     /// 4. a NaN / infinite coordinate on a referenced vertex: [`Error::NonFiniteCoordinate`];
+    ///    a coordinate beyond ±[`MAX_COORDINATE`], or a plan less than [`MIN_PLAN_EXTENT`]
+    ///    across (but not 0): [`Error::InvalidArgument`] for `positions` (areas and loads
+    ///    could not be represented in double precision);
     /// 5. a face repeating a vertex: [`Error::RepeatedVertexInFace`];
     /// 6. two faces on the same three vertices (any order): [`Error::DuplicateFace`];
     /// 7. faces of (near) zero plan area: [`Error::DegenerateFaces`] (all of them);
@@ -35,7 +45,9 @@ impl Mesh {
     /// 10. a vertex whose faces form more than one fan: [`Error::NonManifoldVertex`];
     /// 11. plan orientation: if most faces are clockwise in plan, all faces are reversed
     ///     (`reversed = true`); faces still clockwise: [`Error::FlippedFaces`]; interior
-    ///     vertices whose plan angles do not sum to 2π: [`Error::OverlappingPlan`];
+    ///     vertices whose plan angles do not sum to 2π, or boundary vertices whose angles sum
+    ///     to more: [`Error::OverlappingPlan`]; two faces overlapping in plan elsewhere (a strip
+    ///     winding over itself, components stacked in plan): [`Error::OverlappingFaces`];
     /// 12. supports: [`Error::NoSupports`], then [`Error::UnsupportedComponent`] for the
     ///     first connected component without an anchored vertex.
     pub fn new(positions: Vec<[f64; 3]>, faces: Vec<[u32; 3]>, anchored: &[u32]) -> Result<Mesh> {
@@ -50,6 +62,7 @@ impl Mesh {
         let anchored_flags = check_anchors(anchored, n)?;
         let referenced = referenced_flags(&faces, n);
         check_finite(&positions, &referenced)?;
+        check_magnitudes(&positions, &referenced)?;
         check_repeated_vertices(&faces)?;
         // 6.-7. duplicates and degenerate faces
         check_duplicate_faces(&faces)?;
@@ -87,6 +100,9 @@ impl Mesh {
             on_boundary[e.v[1] as usize] = true;
         }
         check_angle_sums(&positions, &faces, &referenced, &on_boundary)?;
+        if let Some(faces) = super::overlap::first_overlap(&positions, &faces, &edges) {
+            return Err(Error::OverlappingFaces { faces });
+        }
         // 12. components and supports
         let (vertex_component, n_components) = components(&faces, &referenced);
         check_supports(
@@ -204,6 +220,45 @@ fn check_finite(positions: &[[f64; 3]], referenced: &[bool]) -> Result<()> {
         Some(vertex) => Err(Error::NonFiniteCoordinate { vertex }),
         None => Ok(()),
     }
+}
+
+/// Coordinates whose squares (areas, loads) double precision can represent with room to spare.
+fn check_magnitudes(positions: &[[f64; 3]], referenced: &[bool]) -> Result<()> {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for (v, (p, _)) in positions
+        .iter()
+        .zip(referenced)
+        .enumerate()
+        .filter(|(_, (_, &r))| r)
+    {
+        if let Some(c) = p.iter().find(|c| c.abs() > MAX_COORDINATE) {
+            return Err(Error::InvalidArgument {
+                name: "positions",
+                reason: format!(
+                    "vertex {v} has the coordinate {c:e}: beyond ±{MAX_COORDINATE:e}, areas and \
+                     loads cannot be represented in double precision (express the model in \
+                     larger units)"
+                ),
+            });
+        }
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    // NaN (no referenced vertex) fails both comparisons.
+    let extent = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    if extent > 0.0 && extent < MIN_PLAN_EXTENT {
+        return Err(Error::InvalidArgument {
+            name: "positions",
+            reason: format!(
+                "the plan is {extent:e} across: below {MIN_PLAN_EXTENT:e}, areas and loads \
+                 cannot be represented in double precision (express the model in smaller units)"
+            ),
+        });
+    }
+    Ok(())
 }
 
 fn check_repeated_vertices(faces: &[[u32; 3]]) -> Result<()> {
@@ -334,7 +389,8 @@ fn check_vertex_fans(faces: &[[u32; 3]], halves: &[HalfEdge], n: usize) -> Resul
     }
 }
 
-/// Interior vertices must see their (counter-clockwise) faces sum to 2π in plan.
+/// Interior vertices must see their (counter-clockwise) faces sum to 2π in plan, boundary
+/// vertices at most 2π (more and the fan of faces around them wraps over itself).
 fn check_angle_sums(
     positions: &[[f64; 3]],
     faces: &[[u32; 3]],
@@ -353,9 +409,12 @@ fn check_angle_sums(
     let full = std::f64::consts::TAU;
     let vertices: Vec<usize> = (0..positions.len())
         .filter(|&v| {
-            referenced[v]
-                && !on_boundary[v]
-                && ((sums[v] - full).abs() > ANGLE_TOL || sums[v].is_nan())
+            let off = if on_boundary[v] {
+                sums[v] - full
+            } else {
+                (sums[v] - full).abs()
+            };
+            referenced[v] && (off > ANGLE_TOL || sums[v].is_nan())
         })
         .collect();
     if vertices.is_empty() {

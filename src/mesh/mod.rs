@@ -7,9 +7,10 @@
 
 mod build;
 mod connectivity;
+mod overlap;
 mod query;
 pub mod repair;
-pub use build::{ANGLE_TOL, AREA_TOL};
+pub use build::{ANGLE_TOL, AREA_TOL, MAX_COORDINATE, MIN_PLAN_EXTENT};
 
 #[cfg(test)]
 mod repair_tests;

@@ -220,7 +220,33 @@ fn bad_meshes() -> Vec<Case> {
         faces: double_fan().1,
         anchored: vec![1],
         expected: Error::OverlappingPlan { vertices: vec![0] },
-        needles: vec!["interior vertices 0"],
+        needles: vec!["around vertices 0"],
+    });
+    cases.push(Case {
+        name: "open fan wrapping 1.5 times around a boundary vertex",
+        positions: open_fan().0,
+        faces: open_fan().1,
+        anchored: vec![1],
+        expected: Error::OverlappingPlan { vertices: vec![0] },
+        needles: vec!["around vertices 0"],
+    });
+    cases.push(Case {
+        name: "helical strip of 1.6 turns (no interior vertex, no flipped face)",
+        positions: helix().0,
+        faces: helix().1,
+        anchored: vec![0, 1],
+        expected: Error::OverlappingFaces { faces: [0, 20] },
+        needles: vec!["faces 0 and 20 overlap"],
+    });
+    let mut stacked = quad.clone();
+    stacked.extend(quad.iter().map(|p| [p[0] + 0.5, p[1] + 0.5, 1.0]));
+    cases.push(Case {
+        name: "two squares stacked in plan",
+        positions: stacked,
+        faces: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
+        anchored: vec![0, 4],
+        expected: Error::OverlappingFaces { faces: [0, 2] },
+        needles: vec!["faces 0 and 2 overlap"],
     });
 
     let mut two = tri.clone();
@@ -267,6 +293,41 @@ fn double_fan() -> (Positions, Faces) {
         positions.push([r * angle.cos(), r * angle.sin(), 0.0]);
     }
     let faces = (1..=8u32).map(|i| [0, i, i % 8 + 1]).collect();
+    (positions, faces)
+}
+
+/// Vertex 0 at the origin, vertices 1..=7 around it a quarter turn apart (radius growing),
+/// faces (0, i, i + 1): an open fan of six quarter turns, so vertex 0 is on the boundary.
+fn open_fan() -> (Positions, Faces) {
+    let mut positions = vec![[0.0, 0.0, 1.0]];
+    for i in 0..7u32 {
+        let angle = std::f64::consts::FRAC_PI_2 * f64::from(i) + 0.1;
+        let r = 1.0 + 0.2 * f64::from(i);
+        positions.push([r * angle.cos(), r * angle.sin(), 0.0]);
+    }
+    let faces = (1..=6u32).map(|i| [0, i, i + 1]).collect();
+    (positions, faces)
+}
+
+/// A strip between radii 1 and 2 rising as it winds 1.6 turns, ten segments a turn: inner
+/// vertex 2s and outer 2s + 1 at angle 36° s; segment s has the counter-clockwise faces 2s
+/// (inner s, outer s, outer s + 1) and 2s + 1 (inner s, outer s + 1, inner s + 1). Segment
+/// 10 lies on segment 0 in plan, face 20 on face 0.
+fn helix() -> (Positions, Faces) {
+    let mut positions = Vec::new();
+    for s in 0..=16u32 {
+        let angle = std::f64::consts::TAU * f64::from(s) / 10.0;
+        let z = 0.1 * f64::from(s);
+        for r in [1.0, 2.0] {
+            positions.push([r * angle.cos(), r * angle.sin(), z]);
+        }
+    }
+    let mut faces = Vec::new();
+    for s in 0..16u32 {
+        let (i0, o0, i1, o1) = (2 * s, 2 * s + 1, 2 * s + 2, 2 * s + 3);
+        faces.push([i0, o0, o1]);
+        faces.push([i0, o1, i1]);
+    }
     (positions, faces)
 }
 

@@ -146,7 +146,10 @@ impl ShapeStep {
         let structure = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
         let symbolic =
             SymbolicLlt::try_new(structure, Side::Lower).map_err(|e| Error::Numerical {
-                what: format!("shape system analysis: {e:?}"),
+                what: format!(
+                    "the height system's analysis failed: {}",
+                    crate::error::faer_failure(&e)
+                ),
             })?;
         Ok(ShapeStep {
             vertices,
@@ -350,14 +353,8 @@ impl ShapeStep {
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx),
             &ktk[..],
         );
-        let llt =
-            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).map_err(|_| {
-                Error::Numerical {
-                    what: "the height system is not positive definite (a vertex carries no \
-                           stress and nothing pulls it)"
-                        .into(),
-                }
-            })?;
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower)
+            .map_err(|e| crate::error::factorisation_failure("the height system", &e))?;
         llt.solve_in_place(rhs.as_mut());
         let mut out = z.to_vec();
         for (i, &v) in self.vertices.iter().enumerate() {

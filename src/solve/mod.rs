@@ -237,6 +237,15 @@ fn finish(problem: &Problem, run: Run, start: Instant) -> FormFindResult {
     }
 }
 
+/// A failed step as a termination, its message without the error kind's prefix.
+pub(super) fn numerical(e: crate::Error) -> Termination {
+    let what = match e {
+        crate::Error::Numerical { what } => what,
+        other => other.to_string(),
+    };
+    Termination::NumericalError { what }
+}
+
 /// Plan area share of every non-anchored vertex (a third of each incident face's plan area),
 /// normalised to sum to 1; 0 elsewhere.
 pub(crate) fn area_shares(problem: &Problem) -> Vec<f64> {

@@ -207,7 +207,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         }
         self.w = match self.initial_weight() {
             Ok(w) => w,
-            Err(e) => return Ok(numerical(e)),
+            Err(e) => return Ok(super::numerical(e)),
         };
         let w_start = self.w;
         let mut last_norm = residual_term(&self.held, self.shape.vertices()).sqrt();
@@ -216,7 +216,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             let before = self.merit(&self.positions, &self.held);
             let moved = match self.height_step() {
                 Ok(moved) => moved,
-                Err(e) => return Ok(numerical(e)),
+                Err(e) => return Ok(super::numerical(e)),
             };
             if moved && self.record_height_state() {
                 return Ok(Termination::Converged);
@@ -714,12 +714,6 @@ impl<'a, 'p> Nearest<'a, 'p> {
                     .any(|&e| self.held.force_densities[e as usize] >= q_max * (1.0 - 1e-3))
             })
             .collect()
-    }
-}
-
-fn numerical(e: crate::Error) -> Termination {
-    Termination::NumericalError {
-        what: e.to_string(),
     }
 }
 

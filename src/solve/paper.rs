@@ -139,9 +139,7 @@ pub(super) fn paper(
         match shape.step(&s.force_densities, &s.loads, &z, &z0, k, &settings.schedule) {
             Ok(z_new) => positions.iter_mut().zip(z_new).for_each(|(p, z)| p[2] = z),
             Err(e) => {
-                termination = Termination::NumericalError {
-                    what: e.to_string(),
-                };
+                termination = super::numerical(e);
                 break;
             }
         }

@@ -119,6 +119,11 @@ pub struct StressResult {
 }
 
 /// Optimises the stress of `problem` as given (its mesh positions).
+///
+/// The loads must weigh down: an [`Error::InvalidArgument`](crate::Error::InvalidArgument)
+/// for `loads` when their mean over the non-anchored vertices is 0 (density 0 everywhere
+/// without extra loads: nothing to balance), negative, or beyond what double precision can
+/// carry through the solve ([`MIN_MEAN_LOAD`], [`MAX_MEAN_LOAD`]).
 pub fn analyse(problem: &Problem, settings: &StressSettings) -> Result<StressResult> {
     analyse_at(problem, &problem.mesh.positions, settings)
 }
@@ -312,6 +317,7 @@ pub fn analyse_cached(
     let plan = Plan::new(mesh, positions, &frame);
     let l0 = frame.scale;
     let (load, free, p_bar) = loads_at(problem, positions, settings);
+    check_mean_load(&load, &free)?;
     let unit = p_bar / l0; // natural force density scale
 
     // Frame units: z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄.
@@ -725,8 +731,54 @@ fn force_model(
     })
 }
 
-/// Loads at `positions`, the non-anchored vertices, and their mean load p̄ (1 when zero, so
-/// that weightless problems still have a scale).
+/// Largest mean load on the non-anchored vertices that a stress step accepts. With the plan's
+/// extent L₀ within what [`Mesh::new`] accepts, force densities (of order p̄/L₀), Airy values
+/// (p̄ L₀) and the objective (squared residuals, of order p̄²) stay representable.
+pub const MAX_MEAN_LOAD: f64 = 1e150;
+/// Smallest positive mean load a stress step accepts (see [`MAX_MEAN_LOAD`]).
+pub const MIN_MEAN_LOAD: f64 = 1e-150;
+
+/// A stress step needs weight to balance, of a size double precision can represent: the mean
+/// load p̄ on the non-anchored vertices is the unit of ε∞, of relative q bounds and of the
+/// problem's scaling, so it must be positive and within [`MIN_MEAN_LOAD`], [`MAX_MEAN_LOAD`].
+fn check_mean_load(load: &[f64], free: &[u32]) -> Result<()> {
+    let mean = mean_over(load, free);
+    let reason = if free.is_empty() {
+        // Every vertex is anchored: nothing to balance, and nothing wrong.
+        return Ok(());
+    } else if mean == 0.0 {
+        "the loads on the non-anchored vertices are all 0 (density 0 on every face and no extra \
+         load): there is no weight to balance; give the faces a positive density"
+            .to_string()
+    } else if mean < 0.0 {
+        format!(
+            "the loads on the non-anchored vertices average {mean:e}, upwards: a compression-only \
+             vault stands under a downward load"
+        )
+    } else if mean.is_nan() || mean > MAX_MEAN_LOAD {
+        format!(
+            "the loads on the non-anchored vertices average {mean:e}: beyond {MAX_MEAN_LOAD:e}, \
+             force densities and squared residuals cannot be represented in double precision \
+             (express the model in larger units or lower the density)"
+        )
+    } else if mean < MIN_MEAN_LOAD {
+        format!(
+            "the loads on the non-anchored vertices average {mean:e}: below {MIN_MEAN_LOAD:e}, \
+             force densities and squared residuals cannot be represented in double precision \
+             (express the model in smaller units or raise the density)"
+        )
+    } else {
+        return Ok(());
+    };
+    Err(crate::Error::InvalidArgument {
+        name: "loads",
+        reason,
+    })
+}
+
+/// Loads at `positions`, the non-anchored vertices, and their mean load p̄ (1 when not
+/// positive: a stress step rejects such loads, see [`check_mean_load`], and a certificate at
+/// new heights keeps a scale).
 fn loads_at(
     problem: &Problem,
     positions: &[[f64; 3]],

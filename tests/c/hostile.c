@@ -1,8 +1,8 @@
 /*
  * Hostile input through the installed C library: each case checks the status, a non-empty
  * one-line message naming the argument at fault, and untouched outputs. Built against the
- * installed package by examples/CMakeLists.txt and .ci/cmake-checks.sh; prints one line per
- * failure and exits non-zero if any.
+ * installed package by examples/CMakeLists.txt and .ci/cmake-checks.sh, and against the build
+ * tree by the latter; prints one line per failure and exits non-zero if any.
  */
 #include <math.h>
 #include <stdint.h>
@@ -102,6 +102,19 @@ int main(void) {
            VSR_STATUS_NON_FINITE, "positions");
     EXPECT(vsr_mesh_create(positions, 5, triangles, 4, anchored, 0, &mesh), VSR_STATUS_NO_SUPPORT,
            "anchored");
+    {
+        /* The square twice, the second copy shifted by half its side: stacked in plan. */
+        double stacked[30];
+        uint32_t stacked_triangles[24];
+        const uint32_t stacked_anchors[] = {0, 1, 2, 3, 5, 6, 7, 8};
+        memcpy(stacked, positions, sizeof positions);
+        memcpy(stacked_triangles, triangles, sizeof triangles);
+        for (i = 0; i < 15; ++i) stacked[15 + i] = positions[i] + (i % 3 == 2 ? 1.0 : 0.5);
+        for (i = 0; i < 12; ++i) stacked_triangles[12 + i] = triangles[i] + 5;
+        EXPECT(vsr_mesh_create(stacked, 10, stacked_triangles, 8, stacked_anchors, 8, &mesh),
+               VSR_STATUS_INVALID_PLAN, "positions");
+        TRUE(strstr(vsr_last_error_message(), "overlap") != NULL);
+    }
     TRUE(mesh == sentinel_mesh);
 
     /* A valid mesh; the last error is cleared by success but kept by destroy(NULL). */
@@ -144,6 +157,25 @@ int main(void) {
     EXPECT(vsr_analyse(mesh, NULL, &result), VSR_STATUS_NULL_POINTER, "settings");
     EXPECT(vsr_form_find(mesh, settings, NULL), VSR_STATUS_NULL_POINTER, "out");
     TRUE(result == sentinel_result);
+
+    /* Density 0 everywhere: nothing to balance, so no solve; the density is set back after. */
+    {
+        const double zeros[4] = {0, 0, 0, 0};
+        const double ones[4] = {1, 1, 1, 1};
+        EXPECT(vsr_mesh_set_face_density(mesh, zeros, 4), VSR_STATUS_OK, "");
+        EXPECT(vsr_analyse(mesh, settings, &result), VSR_STATUS_INVALID_ARGUMENT, "loads");
+        EXPECT(vsr_form_find(mesh, settings, &result), VSR_STATUS_INVALID_ARGUMENT, "loads");
+        EXPECT(vsr_mesh_set_face_density(mesh, ones, 4), VSR_STATUS_OK, "");
+    }
+    /* Coordinates whose areas double precision cannot hold. */
+    {
+        double huge[15];
+        VsrMesh *huge_mesh = sentinel_mesh;
+        for (i = 0; i < 15; ++i) huge[i] = positions[i] * 1e200;
+        EXPECT(vsr_mesh_create(huge, 5, triangles, 4, anchored, 4, &huge_mesh),
+               VSR_STATUS_INVALID_ARGUMENT, "positions");
+        TRUE(huge_mesh == sentinel_mesh);
+    }
 
     /* Reuse after the failed calls: the handles still work. */
     EXPECT(vsr_analyse(mesh, settings, &result), VSR_STATUS_OK, "");

@@ -79,6 +79,19 @@ impl Scratch {
     }
 }
 
+impl Scratch {
+    /// Every path below the scratch folder with the content of each file (None for folders).
+    pub fn snapshot(&self) -> Vec<(String, Option<Vec<u8>>)> {
+        self.listing()
+            .into_iter()
+            .map(|name| {
+                let content = fs::read(self.path(&name)).ok();
+                (name, content)
+            })
+            .collect()
+    }
+}
+
 impl Drop for Scratch {
     fn drop(&mut self) {
         let _ = fs::remove_dir_all(&self.0);
