@@ -318,11 +318,12 @@ enum VsrHoleMode
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
   /**
-   * Default: a constant Airy jump per hole (the paper's hole-induced stress).
+   * A constant Airy jump per hole (the paper's hole-induced stress): a net torque only.
    */
   VSR_HOLE_MODE_CONSTANT = 0,
   /**
-   * An affine jump: also a net horizontal force through the hole.
+   * Default: an affine jump, also a net horizontal force through the hole; the reduced
+   * optimum then equals the edge-based one.
    */
   VSR_HOLE_MODE_AFFINE = 1,
 };
@@ -910,7 +911,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
  * | q_max | none (+INFINITY) |
  * | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
- * | hole mode | `VSR_HOLE_MODE_CONSTANT` |
+ * | hole mode | `VSR_HOLE_MODE_AFFINE` |
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
@@ -1006,7 +1007,8 @@ VsrStatus vsr_settings_set_q_max(struct VsrSettings *settings, double value, uin
 VsrStatus vsr_settings_set_tau_mode(struct VsrSettings *settings, uint32_t mode);
 
 /**
- * Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_CONSTANT`.
+ * Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_AFFINE` (the true
+ * optimum); `VSR_HOLE_MODE_CONSTANT` is the paper's hole-induced stress.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

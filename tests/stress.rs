@@ -207,6 +207,25 @@ fn reduced_equals_edge_based_on_every_real_model() {
     }
 }
 
+/// With default settings the reduced stress step of every shared model with holes reaches the
+/// edge-based optimum: the default hole jumps are affine (constant ones miss it where hole rings
+/// are anchored or loaded by τ, as on four_holes).
+#[test]
+fn default_stress_step_of_holed_models_is_the_edge_based_optimum() {
+    let mut holed = Vec::new();
+    for name in MODELS {
+        let Some(mesh) = load_model(name) else { return };
+        if mesh.holes().count() == 0 {
+            continue;
+        }
+        assert_same_optimum(name, &Problem::new(mesh), &StressSettings::default());
+        holed.push(name);
+    }
+    for name in ["four_holes", "hex", "cheese"] {
+        assert!(holed.contains(&name), "{name} has holes");
+    }
+}
+
 /// The structured interior-point solver reaches the optimum of clarabel (the reference) on
 /// every real model, in both formulations, with plain compression and with the form-finding
 /// bound q_min, and answers itself (four_holes' reduced QPs, with free holes of 4–6

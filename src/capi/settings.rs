@@ -44,7 +44,7 @@ pub struct VsrSettings {
 /// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
 /// | q_max | none (+INFINITY) |
 /// | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
-/// | hole mode | `VSR_HOLE_MODE_CONSTANT` |
+/// | hole mode | `VSR_HOLE_MODE_AFFINE` |
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | QP solver | `VSR_QP_SOLVER_NATIVE` |
@@ -269,7 +269,8 @@ pub unsafe extern "C" fn vsr_settings_set_tau_mode(
     })
 }
 
-/// Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_CONSTANT`.
+/// Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_AFFINE` (the true
+/// optimum); `VSR_HOLE_MODE_CONSTANT` is the paper's hole-induced stress.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -600,7 +601,7 @@ mod tests {
         assert_eq!(f.stress.q_min_scope, EdgeScope::All);
         assert_eq!(f.stress.q_max, None);
         assert_eq!(f.stress.tau, TauMode::Optimized);
-        assert_eq!(f.stress.holes, HoleMode::Constant);
+        assert_eq!(f.stress.holes, HoleMode::Affine);
         assert_eq!(f.stress.load_rule, LoadRule::Barycentric);
         assert_eq!(f.stress.formulation, Formulation::Reduced);
         assert_eq!(f.stress.solver, QpSolver::Native);

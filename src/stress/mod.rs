@@ -853,26 +853,27 @@ mod tests {
             .flatten()
             .any(|x| x.is_nan()));
         let (kept, _) = cache.reduced.as_ref().expect("kept after a reduced step");
-        let constant = settings.holes;
-        assert!(kept.fits(mesh, &plan_at(mesh, &lowered), constant));
+        let affine = settings.holes;
+        assert_eq!(affine, airy::HoleMode::Affine);
+        assert!(kept.fits(mesh, &plan_at(mesh, &lowered), affine));
         let moved: Vec<[f64; 3]> = (mesh.positions.iter())
             .map(|p| [p[0] * 1.1, p[1], p[2]])
             .collect();
-        assert!(!kept.fits(mesh, &plan_at(mesh, &moved), constant));
+        assert!(!kept.fits(mesh, &plan_at(mesh, &moved), affine));
         let same = plan_at(mesh, &mesh.positions);
-        assert!(!kept.fits(mesh, &same, airy::HoleMode::Affine));
+        assert!(!kept.fits(mesh, &same, airy::HoleMode::Constant));
         let mut other = mesh.clone();
         let free = (0..other.anchored.len())
             .find(|&v| !other.anchored[v])
             .unwrap();
         other.anchored[free] = true;
-        assert!(!kept.fits(&other, &same, constant));
+        assert!(!kept.fits(&other, &same, affine));
         let mut flipped = mesh.clone();
         flipped
             .loops
             .iter_mut()
             .for_each(|l| l.is_outer = !l.is_outer);
-        assert!(!kept.fits(&flipped, &same, constant));
+        assert!(!kept.fits(&flipped, &same, affine));
         analyse_cached(&problem, &lowered, &settings, None, &mut cache).unwrap();
         assert!(cache.reduced.is_some());
     }

@@ -84,6 +84,7 @@ pub struct StressSettings {
     /// Optional upper bound on force densities (allowable stress × thickness).
     pub q_max: Option<QBound>,
     pub tau: TauMode,
+    /// How the Airy function may jump around a hole (default affine: the true optimum).
     pub holes: HoleMode,
     pub load_rule: LoadRule,
     pub formulation: Formulation,
@@ -110,7 +111,7 @@ impl Default for StressSettings {
             q_min_scope: EdgeScope::Interior,
             q_max: None,
             tau: TauMode::Optimized,
-            holes: HoleMode::Constant,
+            holes: HoleMode::Affine,
             load_rule: LoadRule::Barycentric,
             formulation: Formulation::Reduced,
             dual_length_bounds: None,
