@@ -901,7 +901,8 @@ VsrStatus vsr_result_distances(const struct VsrResult *result, double *hausdorff
 VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seconds, double *shape_seconds, double *total_seconds);
 
 /**
- * Creates settings with the documented defaults (those of the Rust `FormFindSettings`):
+ * Creates settings with the documented defaults (those of the Rust `FormFindSettings`, whose
+ * stress settings are the Rust `StressSettings` defaults):
  *
  * | option | default |
  * |---|---|
@@ -922,8 +923,8 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
  *
- * `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
- * compression). `out` receives a handle owned by the caller (free with
+ * `vsr_analyse` uses the same settings, so it gives the answer of the Rust `analyse` with
+ * default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression). `out` receives a handle owned by the caller (free with
  * `vsr_settings_destroy`); untouched on failure.
  *
  * # Safety

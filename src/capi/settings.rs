@@ -34,7 +34,8 @@ pub struct VsrSettings {
     pub(crate) user: *mut c_void,
 }
 
-/// Creates settings with the documented defaults (those of the Rust `FormFindSettings`):
+/// Creates settings with the documented defaults (those of the Rust `FormFindSettings`, whose
+/// stress settings are the Rust `StressSettings` defaults):
 ///
 /// | option | default |
 /// |---|---|
@@ -55,8 +56,8 @@ pub struct VsrSettings {
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
 ///
-/// `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
-/// compression). `out` receives a handle owned by the caller (free with
+/// `vsr_analyse` uses the same settings, so it gives the answer of the Rust `analyse` with
+/// default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression). `out` receives a handle owned by the caller (free with
 /// `vsr_settings_destroy`); untouched on failure.
 ///
 /// # Safety
