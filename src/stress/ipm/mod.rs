@@ -35,11 +35,11 @@ mod pattern;
 mod polish;
 mod row_groups;
 mod supernodal;
-use kkt::*;
-use newton::*;
+use kkt::{Kkt, Progress};
+use newton::{FactorSpace, Newton, REGULARISATION};
 pub use pattern::PatternCache;
-use pattern::*;
-use polish::*;
+use pattern::{relabel_columns, relabel_vector, stacked, Normal};
+use polish::{active_guess, polish, Corrections, Point, PolishFailure, INEXACT_RETRY};
 pub use row_groups::RowGroups;
 
 /// A QP in the form above.
