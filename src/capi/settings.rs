@@ -57,8 +57,9 @@ pub struct VsrSettings {
 /// | progress callback | none |
 ///
 /// `vsr_analyse` uses the same settings, so it gives the answer of the Rust `analyse` with
-/// default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression). `out` receives a handle owned by the caller (free with
-/// `vsr_settings_destroy`); untouched on failure.
+/// default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression).
+/// `out` receives a handle owned by the caller (free with `vsr_settings_destroy`); untouched
+/// on failure.
 ///
 /// # Safety
 /// `out` must be writable.
