@@ -270,6 +270,12 @@ enum VsrTermination
    * The progress callback returned non-zero.
    */
   VSR_TERMINATION_CANCELLED = 5,
+  /**
+   * The nearest shape that stands lies beyond the height limit
+   * (`vsr_settings_set_max_height_change`); `vsr_result_stalled_vertices` lists the
+   * vertices that reached it and `vsr_result_termination_message` names what blocks.
+   */
+  VSR_TERMINATION_HEIGHT_LIMIT = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -441,6 +447,33 @@ typedef uint32_t VsrEdgeScope;
 #endif // __cplusplus
 
 /**
+ * How form finding moves the shape (`vsr_settings_set_method`).
+ */
+enum VsrMethod
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Default: the nearest self-supporting shape (least area-weighted squared height change,
+   * plus the fairness term, subject to equilibrium).
+   */
+  VSR_METHOD_NEAREST = 0,
+  /**
+   * The paper's loop: height steps pulled towards the current heights with the proximal
+   * schedule (`vsr_settings_set_schedule_*`).
+   */
+  VSR_METHOD_PAPER = 1,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VsrMethod VsrMethod;
+#else
+typedef uint32_t VsrMethod;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Opaque handle: a validated triangle mesh (plan x, y; height z), its supports and its loads.
  * Create with `vsr_mesh_create`, free with `vsr_mesh_destroy`.
  */
@@ -504,6 +537,98 @@ const char *vsr_last_error_message(void);
  * the last error untouched.
  */
 const char *vsr_status_name(uint32_t status);
+
+/**
+ * Creates a mesh from a file: OBJ, OFF, STL (binary or ASCII) or PLY (ASCII or binary),
+ * chosen by the extension of `path` (case-insensitive `.obj`, `.off`, `.stl`, `.ply`);
+ * polygons are split into fans.
+ *
+ * - `path`: the mesh file, a NUL-terminated UTF-8 path.
+ * - `supports_path`: a JSON file of anchored vertex ids (`{"anchored": [ids]}` or `[ids]`),
+ *   or NULL to use `anchored` instead.
+ * - `anchored`: `n_anchored` anchored vertex ids when `supports_path` is NULL (NULL when
+ *   `n_anchored` is 0). Giving both is `VSR_STATUS_INVALID_ARGUMENT`.
+ * - `weld_tolerance`: vertices closer than `weld_tolerance` × (bounding box diagonal) are
+ *   merged into the first of them (0 merges exactly equal positions only; default in the Rust
+ *   API 1e-9); finite and >= 0. STL files, whose triangles never share vertices, need it.
+ * - `repair_tolerance`: faces whose plan area is below `repair_tolerance` × (median plan
+ *   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
+ *   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
+ *   `vsr_mesh_plan_nudges`); 0 mends nothing, so such faces are rejected as by
+ *   `vsr_mesh_create`. Finite and >= 0; the Rust API's default is 1e-4.
+ * - `n_merged`: receives how many of the file's vertices were merged into another; may be
+ *   NULL.
+ * - `out`: receives a new handle on success, owned by the caller (free with
+ *   `vsr_mesh_destroy`); untouched on failure.
+ *
+ * Support ids are the file's own 0-based vertex ids (an STL file has three per triangle:
+ * vertex `3t + k` is corner `k` of triangle `t`). The mesh's vertices are the welded ones,
+ * numbered in the order of their first vertex in the file; `vsr_mesh_welded_ids` maps file
+ * ids onto them. Loads and defaults are those of `vsr_mesh_create`.
+ *
+ * Errors: NULL `path` or `out` (`VSR_STATUS_NULL_POINTER`); an unknown extension, a file
+ * that cannot be read, or a malformed file (`VSR_STATUS_INVALID_ARGUMENT`, the message names
+ * the file and its line, or the element of a binary file); a support id `>=` the file's
+ * vertex count (`VSR_STATUS_INDEX_OUT_OF_RANGE`); then the checks of `vsr_mesh_create`.
+ *
+ * # Safety
+ * `path` and `supports_path` (when non-NULL) must be NUL-terminated strings; `anchored` must
+ * hold `n_anchored` readable ids; `n_merged` must be NULL or writable.
+ */
+VsrStatus vsr_mesh_read(const char *path, const char *supports_path, const uint32_t *anchored, size_t n_anchored, double weld_tolerance, double repair_tolerance, size_t *n_merged, struct VsrMesh **out);
+
+/**
+ * The mesh vertex id of each vertex of the file `vsr_mesh_read` read (several file vertices
+ * share one id where they were welded); for a mesh from `vsr_mesh_create`, `0 .. #V - 1`.
+ * Copy-out as described in the header's introduction: `uint32_t` entries, one per file
+ * vertex.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_welded_ids(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * Writes the result's vertex positions with the mesh's triangles to `path`, in the format of
+ * its extension (`.obj`, `.off`, `.ply` binary little-endian, `.stl` binary), all or nothing:
+ * the file is written beside `path` under a temporary name and renamed over it.
+ *
+ * OBJ, OFF and PLY keep every bit of the positions (the shortest decimal that reads back the
+ * same double, or doubles). STL stores single precision by definition: about 7 significant
+ * digits, enough to view or print a shape but not to keep its equilibrium. Triangles are
+ * written in the orientation they were given (the mesh's internal reversal of a clockwise
+ * plan is undone).
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
+ * the mesh, an unknown extension, or a file that cannot be written
+ * (`VSR_STATUS_INVALID_ARGUMENT`).
+ *
+ * # Safety
+ * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
+ */
+VsrStatus vsr_result_write(const struct VsrResult *result, const struct VsrMesh *mesh, const char *path);
+
+/**
+ * The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:
+ * the two faces (which keep their ids), the two vertices of the removed edge and the two of
+ * the added edge. None for a mesh from `vsr_mesh_create`. Copy-out as described in the
+ * header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_flips(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The plan moves `vsr_mesh_read` made, in order: #nudges by 2 `uint32_t`, row-major: the
+ * moved vertex and the face it mended. The vertex keeps its height; its new plan position is
+ * the mesh's (as `vsr_result_positions` of an analysis gives it). None for a mesh from
+ * `vsr_mesh_create`. Copy-out as described in the header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_plan_nudges(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
 
 /**
  * Creates a mesh from flat arrays and validates it.
@@ -870,14 +995,26 @@ VsrStatus vsr_result_termination(const struct VsrResult *result, VsrTermination 
 VsrStatus vsr_result_termination_message(const struct VsrResult *result, char *out, size_t len, size_t *needed);
 
 /**
- * Vertices listed by a `VSR_TERMINATION_STALLED` form finding, `uint32_t` ids (0 entries for
- * any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
+ * Vertices listed by a `VSR_TERMINATION_STALLED` or `VSR_TERMINATION_HEIGHT_LIMIT` form
+ * finding, `uint32_t` ids (0 entries for any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
  *
  * # Safety
  * `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
  * writable.
  */
 VsrStatus vsr_result_stalled_vertices(const struct VsrResult *result, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The height change of a form finding, over the plan bounding-box diagonal
+ * (dimensionless): `rms` = the RMS change of the non-anchored vertices weighted by their plan
+ * area shares (the nearest method's objective), `max` = the largest change at any vertex.
+ * Both pointers required; written only on success. For an analysis result:
+ * `VSR_STATUS_NOT_AVAILABLE`.
+ *
+ * # Safety
+ * `result`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_result_height_change(const struct VsrResult *result, double *rms, double *max);
 
 /**
  * Distances between the form-found and the input heights, over the plan bounding-box
@@ -906,8 +1043,11 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  *
  * | option | default |
  * |---|---|
+ * | method | `VSR_METHOD_NEAREST` |
+ * | fairness γ (nearest method) | 0.03 |
+ * | max height change (nearest method) | 1 plan diagonal |
  * | tolerance (on ε∞) | 1e-6 |
- * | max iterations | 50 |
+ * | max iterations (stress steps) | 100 |
  * | stall window | 8 iterations |
  * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
  * | q_max | none (+INFINITY) |
@@ -918,7 +1058,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
  * | regularisation ε | 1e-10 |
  * | dual edge length bounds | none |
- * | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.2, 1e-9, 1e-3, 0 |
+ * | schedule μ₀, β, μ_min, η, pull ν (paper method) | 1, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
@@ -1018,6 +1158,35 @@ VsrStatus vsr_settings_set_tau_mode(struct VsrSettings *settings, uint32_t mode)
 VsrStatus vsr_settings_set_hole_mode(struct VsrSettings *settings, uint32_t mode);
 
 /**
+ * Sets how form finding moves the shape: a `VsrMethod`. Default `VSR_METHOD_NEAREST`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_method(struct VsrSettings *settings, uint32_t method);
+
+/**
+ * Sets γ, the weight of the fairness term γ Σ_e c_e (Δz_i − Δz_j)² on the height change of
+ * the nearest method, relative to the area-weighted squared change (dimensionless; c_e is the
+ * plan area beside edge e over its squared length). Finite and >= 0; 0 turns it off. Default
+ * 0.03.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_fairness(struct VsrSettings *settings, double gamma);
+
+/**
+ * Sets the largest height change the nearest method may make at any vertex, in plan
+ * bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
+ * `VSR_TERMINATION_HEIGHT_LIMIT`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_settings_set_max_height_change(struct VsrSettings *settings, double diagonals);
+
+/**
  * Sets how face weights become vertex loads: a `VsrLoadRule`. Default
  * `VSR_LOAD_RULE_BARYCENTRIC`.
  *
@@ -1080,8 +1249,8 @@ VsrStatus vsr_settings_set_dual_length_bounds(struct VsrSettings *settings, doub
 VsrStatus vsr_settings_set_dual_length_smoothing(struct VsrSettings *settings, double mu, double decay);
 
 /**
- * Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
- * of the height system; dimensionless). Finite and >= 0. Default 0.3.
+ * Sets μ₀ of the paper method's proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the
+ * mean diagonal of the height system; dimensionless). Finite and >= 0. Default 1.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.
@@ -1089,7 +1258,8 @@ VsrStatus vsr_settings_set_dual_length_smoothing(struct VsrSettings *settings, d
 VsrStatus vsr_settings_set_schedule_mu0(struct VsrSettings *settings, double mu0);
 
 /**
- * Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.2.
+ * Sets β, the per-iteration decay of the paper method's proximal weight μ. Finite, in
+ * [0, 1]. Default 0.25.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

@@ -59,6 +59,13 @@ pub enum Error {
         line: usize,
         reason: String,
     },
+    /// A binary file (or a part of a file without lines) is malformed: `element` names the
+    /// part at fault, such as `triangle 12` or `vertex 3`.
+    Malformed {
+        path: String,
+        element: String,
+        reason: String,
+    },
 }
 
 fn ids(list: &[usize]) -> String {
@@ -132,6 +139,11 @@ impl fmt::Display for Error {
             Numerical { what } => write!(f, "numerical failure: {what}"),
             Io { path, reason } => write!(f, "{path}: {reason}"),
             Parse { path, line, reason } => write!(f, "{path}:{line}: {reason}"),
+            Malformed {
+                path,
+                element,
+                reason,
+            } => write!(f, "{path}: {element}: {reason}"),
         }
     }
 }

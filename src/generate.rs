@@ -225,3 +225,183 @@ pub fn polar_disk(rings: usize) -> PlanMesh {
     }
     (points, tris)
 }
+
+/// Plans of the known-answer cases ([`self_supporting`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum KnownPlan {
+    /// The unit disk, rim anchored.
+    Disk,
+    /// The square [−1, 1]², all sides anchored.
+    Square,
+    /// The square [−1, 1]² anchored along x = ±1, free along y = ±1 (τ at the free edges).
+    SquareFreeSides,
+    /// The annulus 0.3 ≤ r ≤ 1, both rims anchored.
+    AnchoredAnnulus,
+    /// The unit disk with a free oculus of radius 0.3.
+    Oculus,
+}
+
+impl KnownPlan {
+    pub const ALL: [KnownPlan; 5] = [
+        KnownPlan::Disk,
+        KnownPlan::Square,
+        KnownPlan::SquareFreeSides,
+        KnownPlan::AnchoredAnnulus,
+        KnownPlan::Oculus,
+    ];
+}
+
+/// A mesh of `plan` with about `n` vertices, lifted to a smooth vault of rise about 0.5 that
+/// is close to, but not, self-supporting.
+pub fn vault(plan: KnownPlan, n: usize) -> Result<Mesh> {
+    use std::f64::consts::FRAC_PI_2;
+    let k = (n as f64).sqrt();
+    let ring = |r: f64| circle([0.0, 0.0], r, ((k * 3.5 * r) as usize).max(12));
+    let (domain, area) = match plan {
+        KnownPlan::Disk => (ring(1.0), std::f64::consts::PI),
+        KnownPlan::Oculus | KnownPlan::AnchoredAnnulus => (ring(1.0), 0.91 * std::f64::consts::PI),
+        KnownPlan::Square | KnownPlan::SquareFreeSides => {
+            let s = (k * 0.9) as usize;
+            (rectangle(-1.0, -1.0, 1.0, 1.0, s, s), 4.0)
+        }
+    };
+    let holes = match plan {
+        KnownPlan::Oculus | KnownPlan::AnchoredAnnulus => vec![ring(0.3)],
+        _ => vec![],
+    };
+    let domain = Domain {
+        outer: domain,
+        holes,
+    };
+    let (p, t) = triangulate(&domain, 1.6 * area / (2.0 * n as f64))?;
+    let height = move |u: [f64; 2]| {
+        let r = u[0].hypot(u[1]);
+        match plan {
+            KnownPlan::Disk | KnownPlan::Oculus => spherical_cap(1.0, 0.8, r),
+            KnownPlan::AnchoredAnnulus => 0.4 * (std::f64::consts::PI * (r - 0.3) / 0.7).sin(),
+            KnownPlan::Square => 0.6 * (FRAC_PI_2 * u[0]).cos() * (FRAC_PI_2 * u[1]).cos(),
+            KnownPlan::SquareFreeSides => 0.5 * (FRAC_PI_2 * u[0]).cos(),
+        }
+    };
+    let anchor = move |u: [f64; 2], outer: bool| match plan {
+        KnownPlan::AnchoredAnnulus => u[0].hypot(u[1]) > 0.99 || u[0].hypot(u[1]) < 0.31,
+        KnownPlan::SquareFreeSides => u[0].abs() > 1.0 - 1e-9,
+        _ => outer,
+    };
+    lift(&p, &t, height, anchor)
+}
+
+/// A self-supporting vault over `plan` with about `n` vertices: [`vault`] form-found by the
+/// paper's loop to ε∞ < 1e-9 with `settings`' stress constraints, so that it is a feasible
+/// answer, a known one, for any perturbation of it (see [`perturb`]).
+pub fn self_supporting(
+    plan: KnownPlan,
+    n: usize,
+    settings: &crate::FormFindSettings,
+) -> Result<Mesh> {
+    let mesh = vault(plan, n)?;
+    let problem = crate::Problem::new(mesh.clone());
+    let paper = crate::FormFindSettings {
+        method: crate::FormMethod::Paper,
+        tolerance: 1e-9,
+        max_iterations: 200,
+        stall_window: 30,
+        ..settings.clone()
+    };
+    let r = crate::form_find(&problem, &paper, None)?;
+    if r.termination != crate::Termination::Converged {
+        return Err(Error::Numerical {
+            what: format!("the known-answer vault over {plan:?} did not converge"),
+        });
+    }
+    let mut truth = mesh;
+    truth.positions = r.positions;
+    Ok(truth)
+}
+
+/// Changes of a self-supporting shape that make the known-answer inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Perturbation {
+    /// A smooth concave dent of a third of the rise, off-centre.
+    Dent,
+    /// The crown cut flat at 80% of the rise.
+    Flatten,
+    /// A smooth ridge of 15% of the rise along a line across the plan.
+    Ridge,
+    /// A sum of eight smooth random bumps of up to 5% of the rise.
+    Noise,
+    /// All heights scaled by 1.3.
+    Scale,
+}
+
+impl Perturbation {
+    pub const ALL: [Perturbation; 5] = [
+        Perturbation::Dent,
+        Perturbation::Flatten,
+        Perturbation::Ridge,
+        Perturbation::Noise,
+        Perturbation::Scale,
+    ];
+}
+
+/// `truth` with heights changed by `kind` (anchored vertices keep theirs); `seed` places the
+/// feature.
+pub fn perturb(truth: &Mesh, kind: Perturbation, seed: u64) -> Mesh {
+    let mut rng = SplitMix(seed);
+    let z = |v: usize| truth.positions[v][2];
+    let rise = (0..truth.positions.len())
+        .filter(|&v| truth.referenced[v])
+        .map(z)
+        .fold(0.0f64, |a, b| a.max(b.abs()));
+    let bump = |u: [f64; 3], c: [f64; 2], sigma: f64| {
+        (-((u[0] - c[0]).powi(2) + (u[1] - c[1]).powi(2)) / (2.0 * sigma * sigma)).exp()
+    };
+    let centre = [rng.uniform(-0.4, 0.4), rng.uniform(-0.4, 0.4)];
+    let angle = rng.uniform(0.0, std::f64::consts::PI);
+    let bumps: Vec<([f64; 2], f64)> = (0..8)
+        .map(|_| {
+            let c = [rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8)];
+            (c, rng.uniform(-0.05, 0.05) * rise)
+        })
+        .collect();
+    let mut out = truth.clone();
+    for (v, p) in out.positions.iter_mut().enumerate() {
+        if !truth.is_non_anchored(v) {
+            continue;
+        }
+        let u = *p;
+        p[2] = match kind {
+            Perturbation::Dent => u[2] - rise / 3.0 * bump(u, centre, 0.2),
+            Perturbation::Flatten => u[2].min(0.8 * rise),
+            Perturbation::Ridge => {
+                let d = (u[0] - centre[0]) * angle.sin() - (u[1] - centre[1]) * angle.cos();
+                u[2] + 0.15 * rise * (-d * d / (2.0 * 0.1 * 0.1)).exp()
+            }
+            Perturbation::Noise => {
+                u[2] + bumps
+                    .iter()
+                    .map(|&(c, a)| a * bump(u, c, 0.25))
+                    .sum::<f64>()
+            }
+            Perturbation::Scale => 1.3 * u[2],
+        };
+    }
+    out
+}
+
+/// SplitMix64: a small seeded generator for reproducible cases.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -17,7 +17,7 @@ pub use error::{Error, Result};
 pub use geometry::loads::LoadRule;
 pub use mesh::Mesh;
 pub use problem::Problem;
-pub use solve::{form_find, FormFindResult, FormFindSettings, Termination};
+pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{
     analyse, EdgeScope, Formulation, QBound, QpSolver, StressResult, StressSettings, StressStatus,

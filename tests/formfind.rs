@@ -167,7 +167,7 @@ fn bad_input_gets_one_line_and_no_output() {
     rejects(
         &sq,
         &["sq.obj", "--supports", "s.json", "--anchor-boundary"],
-        "not both",
+        "not several",
     );
     rejects(
         &sq,
@@ -244,7 +244,7 @@ fn bad_input_gets_one_line_and_no_output() {
         &["sq.obj", "other.obj", "--supports", "s.json"],
         "only one mesh",
     );
-    rejects(&sq, &["--supports", "s.json"], "need a MESH.obj");
+    rejects(&sq, &["--supports", "s.json"], "need a MESH");
     rejects(&sq, &["sq.obj", "--supports", "s.json", "--out"], "--out");
 }
 

@@ -3,10 +3,15 @@
 use std::path::PathBuf;
 
 use voussoir::{
-    EdgeScope, FormFindSettings, Formulation, HoleMode, LoadRule, QBound, QpSolver, TauMode,
+    EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
+    TauMode,
 };
 
 /// The choices of the enumerated options, as spelled on the command line.
+pub const METHODS: [(&str, FormMethod); 2] = [
+    ("nearest", FormMethod::Nearest),
+    ("paper", FormMethod::Paper),
+];
 pub const SOLVERS: [(&str, Formulation); 2] = [
     ("reduced", Formulation::Reduced),
     ("edge-based", Formulation::EdgeBased),
@@ -57,21 +62,42 @@ Usage:
   formfind                                   form-find the embedded default vault
   formfind MESH.obj --supports S.json [options]
   formfind MESH.obj --anchor-boundary [options]
+  formfind MESH.off --anchor-lowest 0.01 --out OUT.ply [options]
 
 Inputs:
-  MESH.obj               vertices (x, y plan; z up) and faces; polygons are split into fans
-  --supports S.json      anchored vertex ids, 0-based: {{\"anchored\": [ids]}} or [ids]
+  MESH                   .obj, .off, .stl or .ply: vertices (x, y plan; z up) and faces;
+                         polygons are split into fans
+  --supports S.json      anchored vertex ids, 0-based ids of MESH's own vertices (before
+                         welding): {{\"anchored\": [ids]}} or [ids]
   --anchor-boundary      anchor every boundary vertex (instead of --supports)
+  --anchor-lowest TOL    anchor every vertex within TOL of the lowest height; TOL is
+                         relative to the bounding box diagonal, or TOLabs absolute
+  --weld TOL             merge vertices closer than TOL x the bounding box diagonal; the
+                         mesh is then numbered in first-occurrence order     [{weld:e}]
+  --strict               reject plan slivers (faces of almost no plan area, or slightly
+                         inverted) instead of mending them by edge flips or the smallest
+                         plan move of a non-anchored vertex (listed in the report)
+  --no-weld              keep MESH's vertices as they are (not for STL, whose triangles
+                         never share vertices)
 
 Outputs (all written at the end of a run, or none; existing files are replaced):
-  --out OUT.obj          final positions, same faces    [formfind-out/NAME-formfound.obj]
+  --out OUT              final positions, same faces (after any plan repair), in the
+                         format of the extension: .obj, .off, .ply (every bit kept) or
+                         .stl (single precision)
+                                                        [formfind-out/NAME-formfound.obj]
   --report R.json        everything computed, as JSON   [formfind-out/report.json]
   --pictures DIR         SVG pictures                   [formfind-out/pictures]
-  Without MESH.obj, the embedded input is also written next to OUT, as NAME-input.obj
+  Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
   and NAME-supports.json, to try other options on.
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
+  --method M             nearest | paper: the nearest self-supporting shape
+                         (least area-weighted squared height change), or
+                         the paper's loop                                  [{method}]
+  --fairness G           nearest method: weight of the change's smoothness [{fairness}]
+  --max-height-change H  nearest method: no vertex moves more than H plan
+                         diagonals                                         [{limit}]
   --solver S             reduced | edge-based                              [{solver}]
   --qp Q                 native | clarabel: the QP solver (native falls
                          back to clarabel when it does not converge)       [{qp}]
@@ -98,6 +124,9 @@ Solver:
 Exit status: 0 converged (or --stress-only solved), 3 finished without converging
 (outputs written, the report says why), 2 bad input or options, 1 other failure.
 ",
+        method = name_of(&METHODS, d.method),
+        fairness = d.fairness,
+        limit = d.max_height_change,
         solver = name_of(&SOLVERS, st.formulation),
         qp = name_of(&QP_SOLVERS, st.solver),
         tol = d.tolerance,
@@ -110,6 +139,7 @@ Exit status: 0 converged (or --stress-only solved), 3 finished without convergin
         smooth = st.dual_length_smoothing,
         decay = d.smoothing_decay,
         load = name_of(&LOADS, st.load_rule),
+        weld = voussoir::io::DEFAULT_WELD_TOLERANCE,
     )
 }
 
@@ -119,6 +149,12 @@ pub struct Options {
     pub mesh: Option<PathBuf>,
     pub supports: Option<PathBuf>,
     pub anchor_boundary: bool,
+    /// `--anchor-lowest`: a tolerance and whether it is absolute.
+    pub anchor_lowest: Option<(f64, bool)>,
+    /// Relative welding tolerance; `None` for `--no-weld`.
+    pub weld: Option<f64>,
+    /// `--strict`: no plan repair.
+    pub strict: bool,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -156,6 +192,20 @@ fn bound(flag: &str, text: &str) -> Result<QBound, String> {
     })
 }
 
+/// `TOL` (relative) or `TOLabs` (absolute), at least 0.
+fn tolerance(flag: &str, text: &str) -> Result<(f64, bool), String> {
+    let (value, absolute) = match text.strip_suffix("abs") {
+        Some(v) => (v, true),
+        None => (text, false),
+    };
+    match number(flag, value) {
+        Ok(v) if v >= 0.0 => Ok((v, absolute)),
+        _ => Err(format!(
+            "{flag}: expected a number >= 0 or NUMBERabs, got `{text}`"
+        )),
+    }
+}
+
 fn choice<T: Copy>(flag: &str, text: &str, choices: &[(&str, T)]) -> Result<T, String> {
     choices
         .iter()
@@ -175,6 +225,9 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         mesh: None,
         supports: None,
         anchor_boundary: false,
+        anchor_lowest: None,
+        weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
+        strict: false,
         out: None,
         report: None,
         pictures: None,
@@ -210,10 +263,35 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "-h" | "--help" => return Ok(Parsed::Help),
             "--supports" => o.supports = Some(value()?.into()),
             "--anchor-boundary" => o.anchor_boundary = true,
+            "--anchor-lowest" => o.anchor_lowest = Some(tolerance(&flag, &value()?)?),
+            "--weld" => {
+                let t = number(&flag, &value()?)?;
+                if t < 0.0 {
+                    return Err(format!("{flag}: must be >= 0, got {t}"));
+                }
+                o.weld = Some(t);
+            }
+            "--no-weld" => o.weld = None,
+            "--strict" => o.strict = true,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
             "--stress-only" => o.stress_only = true,
+            "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
+            "--fairness" => {
+                let g = number(&flag, &value()?)?;
+                if g < 0.0 {
+                    return Err(format!("{flag}: must be >= 0, got {g}"));
+                }
+                s.fairness = g;
+            }
+            "--max-height-change" => {
+                let h = number(&flag, &value()?)?;
+                if h <= 0.0 {
+                    return Err(format!("{flag}: must be > 0, got {h}"));
+                }
+                s.max_height_change = h;
+            }
             "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
             "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
             "--tol" => {
@@ -274,17 +352,30 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
 
 /// Combinations of options that cannot work.
 fn check(o: &Options) -> Result<(), String> {
-    match (&o.mesh, &o.supports, o.anchor_boundary) {
-        (None, Some(_), _) | (None, _, true) => {
-            return Err("--supports and --anchor-boundary need a MESH.obj".into())
+    let ways = [
+        o.supports.is_some(),
+        o.anchor_boundary,
+        o.anchor_lowest.is_some(),
+    ];
+    match (&o.mesh, ways.iter().filter(|w| **w).count()) {
+        (None, 0) => {}
+        (None, _) => {
+            return Err("--supports, --anchor-boundary and --anchor-lowest need a MESH".into())
         }
-        (Some(_), None, false) => {
-            return Err("MESH.obj needs --supports S.json or --anchor-boundary".into())
+        (Some(_), 0) => {
+            return Err(
+                "MESH needs --supports S.json, --anchor-boundary or --anchor-lowest TOL".into(),
+            )
         }
-        (Some(_), Some(_), true) => {
-            return Err("give either --supports or --anchor-boundary, not both".into())
+        (Some(_), 1) => {}
+        (Some(_), _) => {
+            return Err(
+                "give one of --supports, --anchor-boundary and --anchor-lowest, not several".into(),
+            )
         }
-        _ => {}
+    }
+    if let Some(out) = &o.out {
+        voussoir::io::MeshFormat::from_path(out).map_err(|e| format!("--out: {e}"))?;
     }
     o.settings.stress.validate().map_err(|e| {
         e.to_string()

@@ -2,11 +2,11 @@
 //!
 //! ```sh
 //! cargo run --release --example formfind                       # the embedded default vault
-//! cargo run --release --example formfind -- MESH.obj --supports S.json [options]
+//! cargo run --release --example formfind -- MESH --supports S.json [options]
 //! cargo run --release --example formfind -- --help             # every option and default
 //! ```
 //!
-//! Writes the form-found mesh (OBJ), a JSON report and SVG pictures, all or nothing: bad input
+//! Reads OBJ, OFF, STL or PLY; writes the form-found mesh (in the format of `--out`), a JSON report and SVG pictures, all or nothing: bad input
 //! gets a one-line message on stderr, a non-zero exit status and no output files.
 
 mod args;
@@ -105,7 +105,7 @@ fn formfind() -> Result<ExitCode, Failure> {
     };
     let model = match &o.mesh {
         None => model::embedded_default(),
-        Some(path) => model::from_files(path, o.supports.as_ref()).map_err(bad_input)?,
+        Some(path) => model::from_files(path, &o).map_err(bad_input)?,
     };
     let dir = PathBuf::from(OUT_DIR);
     let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{}-formfound.obj", model.name)));
@@ -122,7 +122,7 @@ fn formfind() -> Result<ExitCode, Failure> {
     let mut staging = output::Staging::default();
     let mesh = &outcome.model.mesh;
     staging
-        .write_obj(&out, &outcome.positions, &outcome.model.faces)
+        .write_mesh(&out, &outcome.positions, &outcome.model.faces)
         .map_err(failed)?;
     staging
         .write(&report_path, report_text(&report).as_bytes())
@@ -207,6 +207,26 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
         mesh.holes().count(),
         mesh.anchored.iter().filter(|a| **a).count()
     );
+    if let Some(w) = m.weld.as_ref().filter(|w| w.merged > 0) {
+        say!(
+            "welded: {} of {} input vertices merged (closer than {:.3e}), {} faces collapsed",
+            w.merged,
+            w.input_vertices,
+            w.tolerance,
+            w.collapsed_faces.len()
+        );
+    }
+    if !m.repairs.is_empty() {
+        let flips = m
+            .repairs
+            .iter()
+            .filter(|r| matches!(r, voussoir::mesh::repair::PlanRepair::Flip { .. }))
+            .count();
+        say!(
+            "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",
+            m.repairs.len() - flips
+        );
+    }
     let s = &outcome.stress;
     match &outcome.termination {
         None => say!(
@@ -229,7 +249,10 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 say!("  details: {detail}");
             }
             say!(
-                "height change: max {:.3}%, RMS {:.3}% of the plan diagonal",
+                "height change: max {:.3}%, area-weighted RMS {:.3}% of the plan diagonal; \
+                 surface distance: Hausdorff {:.3}%, L2 {:.3}%",
+                100.0 * outcome.max_change,
+                100.0 * outcome.rms_change,
                 100.0 * outcome.hausdorff,
                 100.0 * outcome.l2
             );

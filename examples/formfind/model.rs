@@ -1,9 +1,12 @@
 //! The input of a run: the embedded default vault, or a mesh file with its supports.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use voussoir::generate::{self, Domain};
+use voussoir::mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 use voussoir::{io, Mesh};
+
+use crate::args::Options;
 
 /// A validated mesh, the faces to write back (as read, before any reorientation) and where it
 /// came from.
@@ -15,6 +18,10 @@ pub struct Model {
     pub supports: String,
     pub mesh: Mesh,
     pub faces: Vec<[u32; 3]>,
+    /// The welding of a mesh file (`None` for the embedded default and `--no-weld`).
+    pub weld: Option<WeldSummary>,
+    /// Plan repairs made before validation (none with `--strict`).
+    pub repairs: Vec<PlanRepair>,
 }
 
 /// Plan of the embedded default: a rectangle of half-widths `HALF_X` × `HALF_Y` whose sides bow
@@ -72,33 +79,76 @@ pub fn embedded_default() -> Model {
         supports: "corner pillars".into(),
         mesh,
         faces,
+        weld: None,
+        repairs: Vec::new(),
     }
 }
 
-/// Reads `mesh_path` and anchors the vertices listed in `supports`, or every boundary vertex.
-pub fn from_files(mesh_path: &Path, supports: Option<&PathBuf>) -> voussoir::Result<Model> {
-    let (positions, faces) = io::read_obj(mesh_path)?;
-    let (mesh, supports_label) = match supports {
-        Some(path) => {
-            let anchored = io::read_supports(path)?;
-            (
-                Mesh::new(positions, faces.clone(), &anchored)?,
-                path.display().to_string(),
-            )
+/// How the input's vertices were welded, for the report.
+pub struct WeldSummary {
+    pub input_vertices: usize,
+    pub merged: usize,
+    pub relative_tolerance: f64,
+    pub tolerance: f64,
+    pub collapsed_faces: Vec<usize>,
+}
+
+/// Reads `mesh_path` (any format), welds it unless `--no-weld` (STL always, at the default
+/// tolerance if need be), and anchors the vertices of `--supports` (input ids, mapped onto
+/// welded ones), of `--anchor-lowest` or every boundary vertex.
+pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
+    let (positions, faces) = io::read_mesh(mesh_path)?;
+    let is_stl = io::MeshFormat::from_path(mesh_path)?.is_single_precision();
+    let tolerance = o.weld.or(is_stl.then_some(io::DEFAULT_WELD_TOLERANCE));
+    let (positions, faces, welded) = match tolerance {
+        Some(t) => {
+            let w = io::weld(&positions, &faces, t)?;
+            let summary = WeldSummary {
+                input_vertices: positions.len(),
+                merged: w.merged,
+                relative_tolerance: t,
+                tolerance: w.tolerance,
+                collapsed_faces: w.collapsed_faces.clone(),
+            };
+            (w.positions.clone(), w.faces.clone(), Some((w, summary)))
         }
-        None => {
-            // Validate once with every vertex anchored to learn the boundary, then anchor it.
-            let all: Vec<u32> = (0..positions.len() as u32).collect();
-            let probe = Mesh::new(positions.clone(), faces.clone(), &all)?;
-            let boundary: Vec<u32> = (0..positions.len() as u32)
-                .filter(|&v| probe.on_boundary[v as usize] && probe.referenced[v as usize])
-                .collect();
-            (
-                Mesh::new(positions, faces.clone(), &boundary)?,
-                "every boundary vertex (--anchor-boundary)".into(),
-            )
-        }
+        None => (positions, faces, None),
     };
+    let (anchored, supports_label) = if let Some(path) = &o.supports {
+        let ids = io::read_supports(path)?;
+        let ids = match &welded {
+            Some((w, _)) => w.map_ids(&ids)?,
+            None => ids,
+        };
+        (ids, path.display().to_string())
+    } else if let Some((tol, absolute)) = o.anchor_lowest {
+        let ids = lowest(&positions, &faces, tol, absolute);
+        let unit = if absolute {
+            ""
+        } else {
+            " x the bounding box diagonal"
+        };
+        let label =
+            format!("every vertex within {tol}{unit} of the lowest height (--anchor-lowest)");
+        (ids, label)
+    } else {
+        (
+            boundary_vertices(&faces),
+            "every boundary vertex (--anchor-boundary)".into(),
+        )
+    };
+    let (mut positions, mut faces) = (positions, faces);
+    let repairs = if o.strict {
+        Vec::new()
+    } else {
+        repair_plan(
+            &mut positions,
+            &mut faces,
+            &anchored,
+            DEFAULT_REPAIR_TOLERANCE,
+        )?
+    };
+    let mesh = Mesh::new(positions, faces.clone(), &anchored)?;
     let name = mesh_path
         .file_stem()
         .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
@@ -108,5 +158,52 @@ pub fn from_files(mesh_path: &Path, supports: Option<&PathBuf>) -> voussoir::Res
         supports: supports_label,
         mesh,
         faces,
+        weld: welded.map(|(_, s)| s),
+        repairs,
     })
+}
+
+/// The vertices on an edge of a single face, in id order.
+fn boundary_vertices(faces: &[[u32; 3]]) -> Vec<u32> {
+    let mut uses: std::collections::HashMap<(u32, u32), usize> = Default::default();
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut boundary: Vec<u32> = uses
+        .iter()
+        .filter(|(_, &n)| n == 1)
+        .flat_map(|(&(a, b), _)| [a, b])
+        .collect();
+    boundary.sort_unstable();
+    boundary.dedup();
+    boundary
+}
+
+/// The vertices of some face within `tol` of the lowest such vertex's height; `tol` is
+/// relative to the bounding box diagonal of those vertices unless `absolute`.
+fn lowest(positions: &[[f64; 3]], faces: &[[u32; 3]], tol: f64, absolute: bool) -> Vec<u32> {
+    let mut referenced = vec![false; positions.len()];
+    for &v in faces.iter().flatten() {
+        referenced[v as usize] = true;
+    }
+    let used = || {
+        (0..positions.len())
+            .filter(|&v| referenced[v])
+            .map(|v| positions[v])
+    };
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in used() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let reach = if absolute { tol } else { tol * diagonal };
+    (0..positions.len() as u32)
+        .filter(|&v| referenced[v as usize] && positions[v as usize][2] <= lo[2] + reach)
+        .collect()
 }

@@ -69,6 +69,18 @@ impl Staging {
         voussoir::io::write_obj(&tmp, positions, faces).map_err(|e| describe(target, e))
     }
 
+    /// Stages a mesh for `target` in the format of its extension, written by the library.
+    pub fn write_mesh(
+        &mut self,
+        target: &Path,
+        positions: &[[f64; 3]],
+        faces: &[[u32; 3]],
+    ) -> Result<(), String> {
+        let format = voussoir::io::MeshFormat::from_path(target).map_err(|e| e.to_string())?;
+        let tmp = self.temp_for(target)?;
+        voussoir::io::write_mesh_as(&tmp, format, positions, faces).map_err(|e| describe(target, e))
+    }
+
     /// Renames every staged file into place.
     pub fn commit(mut self) -> Result<(), String> {
         for (tmp, target) in &self.files {

@@ -1,9 +1,10 @@
 //! The JSON report: every number a run computed, in physical units, plus the settings used.
 
 use serde_json::{json, Value};
+use voussoir::mesh::repair::PlanRepair;
 use voussoir::{QBound, StressResult, Termination};
 
-use crate::args::{name_of, Options, LOADS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
+use crate::args::{name_of, Options, LOADS, METHODS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
 use crate::run::Outcome;
 
 /// snake_case name of an enum variant from its `Debug` text (`Stalled { .. }` → `stalled`), so
@@ -30,6 +31,8 @@ pub fn termination(outcome: &Outcome) -> (String, Value) {
     };
     let detail = if let Termination::Stalled { vertices } = t {
         json!({ "vertices": vertices })
+    } else if let Termination::HeightLimit { vertices, hint } = t {
+        json!({ "vertices": vertices, "hint": hint })
     } else if let Termination::Infeasible { constraint } = t {
         json!({ "constraint": constraint })
     } else if let Termination::NumericalError { what } = t {
@@ -47,17 +50,57 @@ fn bound(b: QBound, unit: f64) -> Value {
     }
 }
 
+/// How the input was welded: the output mesh and every vertex id in this report are welded
+/// ids, numbered in the order of their first input vertex.
+fn weld(outcome: &Outcome) -> Value {
+    match &outcome.model.weld {
+        None => Value::Null,
+        Some(w) => json!({
+            "input_vertices": w.input_vertices,
+            "merged": w.merged,
+            "relative_tolerance": w.relative_tolerance,
+            "tolerance": w.tolerance,
+            "collapsed_faces": w.collapsed_faces,
+            "vertex_order": "welded vertices are numbered in the order of their first input vertex",
+        }),
+    }
+}
+
+/// One plan repair as JSON: a flip (faces, removed and added edge) or a nudge (vertex, face,
+/// plan position before and after).
+fn repair(r: &PlanRepair) -> Value {
+    match r {
+        PlanRepair::Flip {
+            faces,
+            removed,
+            added,
+        } => json!({ "flip": { "faces": faces, "removed": removed, "added": added } }),
+        PlanRepair::Nudge {
+            vertex,
+            face,
+            from,
+            to,
+        } => json!({ "nudge": { "vertex": vertex, "face": face, "from": from, "to": to } }),
+        other => json!({ "other": other.to_string() }),
+    }
+}
+
 fn settings(o: &Options, outcome: &Outcome) -> Value {
     let s = &o.settings;
     let st = &s.stress;
     json!({
         "mesh": outcome.model.source,
         "supports": outcome.model.supports,
+        "weld": weld(outcome),
+        "strict": o.strict,
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),
         "qp_solver": name_of(&QP_SOLVERS, st.solver),
         "tolerance": s.tolerance,
         "max_iterations": s.max_iterations,
+        "method": name_of(&METHODS, s.method),
+        "fairness": s.fairness,
+        "max_height_change": s.max_height_change,
         "stall_window": s.stall_window,
         "proximal_weight": s.proximal_weight,
         "q_min": bound(st.q_min, outcome.q_unit),
@@ -126,6 +169,8 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "objective": s.objective,
         "hausdorff": outcome.hausdorff,
         "l2": outcome.l2,
+        "rms_change": outcome.rms_change,
+        "max_change": outcome.max_change,
         "timings_s": {
             "stress": outcome.stress_seconds,
             "shape": outcome.shape_seconds,
@@ -138,6 +183,7 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
             "holes": mesh.holes().count(),
         },
         "anchored": anchored,
+        "plan_repairs": outcome.model.repairs.iter().map(repair).collect::<Vec<_>>(),
         "unreferenced": mesh.unreferenced,
         "units": "input units: lengths as in the OBJ, loads = density x area, force densities = force / length",
         "settings": settings(o, outcome),

@@ -264,7 +264,7 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
         }
         UnsupportedComponent { .. } | NoSupports => (VsrStatus::NoSupport, "anchored"),
         Numerical { .. } => (VsrStatus::Numerical, arg),
-        Io { .. } | Parse { .. } => (VsrStatus::InvalidArgument, arg),
+        Io { .. } | Parse { .. } | Malformed { .. } => (VsrStatus::InvalidArgument, arg),
     };
     Failure::new(status, format!("argument `{arg}`: {e}"))
 }

@@ -12,6 +12,10 @@ use crate::problem::Problem;
 /// Create with `vsr_mesh_create`, free with `vsr_mesh_destroy`.
 pub struct VsrMesh {
     pub(crate) problem: Problem,
+    /// For a mesh read from a file, the mesh vertex of each of the file's vertices.
+    pub(crate) welded_ids: Option<Vec<u32>>,
+    /// For a mesh read from a file, the plan repairs made before validation.
+    pub(crate) repairs: Vec<crate::mesh::repair::PlanRepair>,
 }
 
 /// Largest vertex count (ids are `uint32_t`).
@@ -93,6 +97,8 @@ pub unsafe extern "C" fn vsr_mesh_create(
         let mesh = Mesh::new(pos, tri, anc).map_err(|e| from_error("triangles", e))?;
         let handle = Box::new(VsrMesh {
             problem: Problem::new(mesh),
+            welded_ids: None,
+            repairs: Vec::new(),
         });
         // SAFETY: `out` is non-NULL and writable by the caller's contract.
         unsafe { out.write(Box::into_raw(handle)) };

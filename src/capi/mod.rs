@@ -11,18 +11,20 @@
 #![allow(unsafe_code)]
 
 mod boundary;
+mod files;
 mod mesh;
 mod result;
 mod settings;
 mod solve;
 mod status;
 
+pub use files::*;
 pub use mesh::*;
 pub use result::*;
 pub use settings::*;
 pub use solve::*;
 pub use status::{
-    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrQpSolver,
+    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrQpSolver,
     VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
 };
 

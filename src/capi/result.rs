@@ -46,7 +46,7 @@ impl VsrResult {
         }
     }
 
-    fn positions(&self) -> &[[f64; 3]] {
+    pub(crate) fn positions(&self) -> &[[f64; 3]] {
         match &self.outcome {
             Outcome::Analysis { positions, .. } => positions,
             Outcome::FormFinding(f) => &f.positions,
@@ -697,6 +697,9 @@ pub unsafe extern "C" fn vsr_result_termination_message(
                     }
                     Termination::NumericalError { what } => format!("numerical error: {what}"),
                     Termination::Cancelled => "cancelled by the progress callback".to_string(),
+                    Termination::HeightLimit { vertices, hint } => format!(
+                        "stopped at the height limit: vertices {vertices:?} reached it; {hint}"
+                    ),
                 };
                 let mut bytes: Vec<c_char> = text
                     .bytes()
@@ -710,8 +713,8 @@ pub unsafe extern "C" fn vsr_result_termination_message(
     })
 }
 
-/// Vertices listed by a `VSR_TERMINATION_STALLED` form finding, `uint32_t` ids (0 entries for
-/// any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
+/// Vertices listed by a `VSR_TERMINATION_STALLED` or `VSR_TERMINATION_HEIGHT_LIMIT` form
+/// finding, `uint32_t` ids (0 entries for any other termination). For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
 ///
 /// # Safety
 /// `result`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
@@ -728,9 +731,35 @@ pub unsafe extern "C" fn vsr_result_stalled_vertices(
         unsafe {
             copy(result, out, len, needed, |r| {
                 Ok(match &r.form("the stalled vertices")?.termination {
-                    Termination::Stalled { vertices } => vertices.clone(),
+                    Termination::Stalled { vertices }
+                    | Termination::HeightLimit { vertices, .. } => vertices.clone(),
                     _ => Vec::new(),
                 })
+            })
+        }
+    })
+}
+
+/// The height change of a form finding, over the plan bounding-box diagonal
+/// (dimensionless): `rms` = the RMS change of the non-anchored vertices weighted by their plan
+/// area shares (the nearest method's objective), `max` = the largest change at any vertex.
+/// Both pointers required; written only on success. For an analysis result:
+/// `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_height_change(
+    result: *const VsrResult,
+    rms: *mut f64,
+    max: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(result, [("rms", rms), ("max", max)], |r| {
+                let f = r.form("the height change")?;
+                Ok([f.rms_change, f.max_change])
             })
         }
     })

@@ -39,8 +39,11 @@ pub struct VsrSettings {
 ///
 /// | option | default |
 /// |---|---|
+/// | method | `VSR_METHOD_NEAREST` |
+/// | fairness γ (nearest method) | 0.03 |
+/// | max height change (nearest method) | 1 plan diagonal |
 /// | tolerance (on ε∞) | 1e-6 |
-/// | max iterations | 50 |
+/// | max iterations (stress steps) | 100 |
 /// | stall window | 8 iterations |
 /// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
 /// | q_max | none (+INFINITY) |
@@ -51,7 +54,7 @@ pub struct VsrSettings {
 /// | QP solver | `VSR_QP_SOLVER_NATIVE` |
 /// | regularisation ε | 1e-10 |
 /// | dual edge length bounds | none |
-/// | schedule μ₀, β, μ_min, η, pull ν | 0.3, 0.2, 1e-9, 1e-3, 0 |
+/// | schedule μ₀, β, μ_min, η, pull ν (paper method) | 1, 0.25, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
@@ -288,6 +291,59 @@ pub unsafe extern "C" fn vsr_settings_set_hole_mode(
     })
 }
 
+/// Sets how form finding moves the shape: a `VsrMethod`. Default `VSR_METHOD_NEAREST`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_method(
+    settings: *mut VsrSettings,
+    method: u32,
+) -> VsrStatus {
+    boundary!({
+        let method = status::method("method", method)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.method = method) }
+    })
+}
+
+/// Sets γ, the weight of the fairness term γ Σ_e c_e (Δz_i − Δz_j)² on the height change of
+/// the nearest method, relative to the area-weighted squared change (dimensionless; c_e is the
+/// plan area beside edge e over its squared length). Finite and >= 0; 0 turns it off. Default
+/// 0.03.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_fairness(
+    settings: *mut VsrSettings,
+    gamma: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("gamma", gamma, 0.0, false)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.fairness = v) }
+    })
+}
+
+/// Sets the largest height change the nearest method may make at any vertex, in plan
+/// bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
+/// `VSR_TERMINATION_HEIGHT_LIMIT`.
+///
+/// # Safety
+/// `settings`: a valid handle with exclusive access.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_settings_set_max_height_change(
+    settings: *mut VsrSettings,
+    diagonals: f64,
+) -> VsrStatus {
+    boundary!({
+        let v = at_least("diagonals", diagonals, 0.0, true)?;
+        // SAFETY: forwarded caller's contract.
+        unsafe { update(settings, |f| f.max_height_change = v) }
+    })
+}
+
 /// Sets how face weights become vertex loads: a `VsrLoadRule`. Default
 /// `VSR_LOAD_RULE_BARYCENTRIC`.
 ///
@@ -413,8 +469,8 @@ pub unsafe extern "C" fn vsr_settings_set_dual_length_smoothing(
     })
 }
 
-/// Sets μ₀ of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the mean diagonal
-/// of the height system; dimensionless). Finite and >= 0. Default 0.3.
+/// Sets μ₀ of the paper method's proximal schedule μ_k = max(μ₀ βᵏ, μ_min) (relative to the
+/// mean diagonal of the height system; dimensionless). Finite and >= 0. Default 1.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -430,7 +486,8 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_mu0(
     })
 }
 
-/// Sets β, the per-iteration decay of the proximal weight μ. Finite, in [0, 1]. Default 0.2.
+/// Sets β, the per-iteration decay of the paper method's proximal weight μ. Finite, in
+/// [0, 1]. Default 0.25.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -597,7 +654,10 @@ mod tests {
     fn documented_defaults() {
         let f = FormFindSettings::default();
         assert_eq!(f.tolerance, 1e-6);
-        assert_eq!(f.max_iterations, 50);
+        assert_eq!(f.max_iterations, 100);
+        assert_eq!(f.method, crate::FormMethod::Nearest);
+        assert_eq!(f.fairness, 0.03);
+        assert_eq!(f.max_height_change, 1.0);
         assert_eq!(f.stall_window, 8);
         assert_eq!(f.stress.q_min, QBound::Relative(0.05));
         assert_eq!(f.stress.q_min_scope, EdgeScope::All);
@@ -611,7 +671,7 @@ mod tests {
         let s = f.schedule;
         assert_eq!(
             [s.mu0, s.beta, s.mu_min, s.eta, s.pull],
-            [0.3, 0.2, 1e-9, 1e-3, 0.0]
+            [1.0, 0.25, 1e-9, 1e-3, 0.0]
         );
     }
 }

@@ -8,7 +8,7 @@ use super::boundary::{CResult, Failure};
 use crate::geometry::loads::LoadRule;
 use crate::stress::airy::HoleMode;
 use crate::stress::{EdgeScope, Formulation, QpSolver, StressStatus, TauMode};
-use crate::Termination;
+use crate::{FormMethod, Termination};
 
 /// Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
 /// function wrote no output (except `needed` with `VSR_STATUS_BUFFER_TOO_SMALL`) and
@@ -112,6 +112,10 @@ pub enum VsrTermination {
     NumericalError = 4,
     /// The progress callback returned non-zero.
     Cancelled = 5,
+    /// The nearest shape that stands lies beyond the height limit
+    /// (`vsr_settings_set_max_height_change`); `vsr_result_stalled_vertices` lists the
+    /// vertices that reached it and `vsr_result_termination_message` names what blocks.
+    HeightLimit = 6,
 }
 
 impl VsrTermination {
@@ -123,6 +127,7 @@ impl VsrTermination {
             Termination::Infeasible { .. } => VsrTermination::Infeasible,
             Termination::NumericalError { .. } => VsrTermination::NumericalError,
             Termination::Cancelled => VsrTermination::Cancelled,
+            Termination::HeightLimit { .. } => VsrTermination::HeightLimit,
         }
     }
 }
@@ -256,6 +261,18 @@ pub enum VsrEdgeScope {
     All = 1,
 }
 
+/// How form finding moves the shape (`vsr_settings_set_method`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrMethod {
+    /// Default: the nearest self-supporting shape (least area-weighted squared height change,
+    /// plus the fairness term, subject to equilibrium).
+    Nearest = 0,
+    /// The paper's loop: height steps pulled towards the current heights with the proximal
+    /// schedule (`vsr_settings_set_schedule_*`).
+    Paper = 1,
+}
+
 fn bad_enum(name: &str, value: u32, allowed: &str) -> Failure {
     Failure::new(
         super::VsrStatus::InvalidEnum,
@@ -273,6 +290,20 @@ pub(crate) fn tau_mode(name: &str, v: u32) -> CResult<TauMode> {
                 name,
                 v,
                 "VSR_TAU_MODE_OPTIMIZED (0), VSR_TAU_MODE_ZERO (1), VSR_TAU_MODE_PRESCRIBED (2)",
+            ))
+        }
+    })
+}
+
+pub(crate) fn method(name: &str, v: u32) -> CResult<FormMethod> {
+    Ok(match v {
+        0 => FormMethod::Nearest,
+        1 => FormMethod::Paper,
+        _ => {
+            return Err(bad_enum(
+                name,
+                v,
+                "VSR_METHOD_NEAREST (0), VSR_METHOD_PAPER (1)",
             ))
         }
     })

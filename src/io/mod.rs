@@ -1,5 +1,6 @@
-//! Files for the examples, tests and benchmarks: Wavefront OBJ meshes and a JSON sidecar
-//! listing the anchored (support) vertices.
+//! Mesh files (OBJ, OFF, STL, PLY, chosen by extension through [`read_mesh`] and
+//! [`write_mesh`]), welding of duplicated vertices ([`weld`]), and a JSON sidecar listing the
+//! anchored (support) vertices.
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -11,17 +12,32 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 
+mod atomic;
+mod format;
+#[cfg(test)]
+mod format_tests;
 mod obj;
+mod off;
+mod ply;
+mod stl;
 mod supports;
 #[cfg(test)]
 mod tests;
+mod weld;
+#[cfg(test)]
+mod weld_tests;
 
 use std::path::Path;
 
 use crate::{Mesh, Result};
 
+pub use format::{read_mesh, write_mesh, write_mesh_as, MeshFormat};
 pub use obj::{parse_obj, read_obj, write_obj};
+pub use off::parse_off;
+pub use ply::parse_ply;
+pub use stl::parse_stl;
 pub use supports::{parse_supports, read_supports};
+pub use weld::{weld, Welded, DEFAULT_WELD_TOLERANCE};
 
 /// Vertex positions (x, y plan; z height) and triangles (0-based vertex ids), as read from a
 /// file, before validation by [`Mesh::new`].
@@ -32,6 +48,14 @@ pub fn load_model(obj: &Path, supports: &Path) -> Result<Mesh> {
     let (positions, faces) = read_obj(obj)?;
     let anchored = read_supports(supports)?;
     Mesh::new(positions, faces, &anchored)
+}
+
+/// A crate's error message on one line (some span several, with tabs).
+fn one_line(e: &dyn std::fmt::Display) -> String {
+    e.to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// The `Error::Io` for `path`.

@@ -8,8 +8,11 @@
 mod build;
 mod connectivity;
 mod query;
+pub mod repair;
 pub use build::{ANGLE_TOL, AREA_TOL};
 
+#[cfg(test)]
+mod repair_tests;
 #[cfg(test)]
 mod tests;
 

@@ -1,8 +1,12 @@
-//! Shape optimisation (MATH §9): with the force densities fixed, move the heights of the
-//! non-anchored vertices by a weighted least-squares step. Vertices far from balance get small
-//! proximal weights and move freely; balanced ones barely move.
+//! Height steps (MATH §9): with the force densities fixed, new heights for the non-anchored
+//! vertices from one sparse least-squares system, K = L_q[V_N, V_N], b = p − L_q[V_N, V_A] z_A:
 //!
-//!   (KᵀK + μ Λ + ν I) z = Kᵀ b + μ Λ zᵏ + ν z⁰,   K = L_q[V_N, V_N],  b = p − L_q[V_N, V_A] z_A
+//! - the paper's step, a proximal pull towards the current heights weighted by inverse
+//!   residuals: (KᵀK + μ Λ + ν I) z = Kᵀb + μ Λ zᵏ + ν z⁰;
+//! - the nearest-shape step, a pull towards the input heights weighted by plan area and an
+//!   optional fairness term on the change: (KᵀK + ρ (A + γ L_c)) z = Kᵀb + ρ (A + γ L_c) z⁰.
+//!
+//! Both share KᵀK's pattern (the two-ring of the mesh), analysed once per mesh.
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -11,7 +15,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Mat, Side};
 
-/// Parameters of the proximal schedule μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
+/// Parameters of the paper's proximal schedule ([`crate::FormMethod::Paper`]): μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Schedule {
     pub mu0: f64,
@@ -24,14 +28,11 @@ pub struct Schedule {
 }
 
 impl Default for Schedule {
+    /// The paper's schedule (de Goes et al. 2013, §5.2).
     fn default() -> Self {
-        // μ₀ = 0.3 rather than MATH's 1 and β = 0.2: measured over the nine shared models this
-        // converges on all of them within 20 iterations (β = 0.25: 21 on three_pillar and
-        // vault_pq; μ₀ = 1: 27; counted before height steps were certified, which saves one
-        // stress step on most); smaller μ₀ slows some down (hex: 31 with μ₀ = 0.1).
         Schedule {
-            mu0: 0.3,
-            beta: 0.2,
+            mu0: 1.0,
+            beta: 0.25,
             mu_min: 1e-9,
             eta: 1e-3,
             pull: 0.0,
@@ -53,7 +54,20 @@ pub struct ShapeStep {
     /// (u32: tens of products per vertex, 31 MB at 100k vertices).
     product_slot: Vec<u32>,
     diag_slot: Vec<usize>,
+    /// Both ends of every edge at a non-anchored vertex, for the fairness term.
+    fair_edges: Vec<FairEnd>,
     symbolic: SymbolicLlt<usize>,
+}
+
+/// One end of an edge in the fairness term Σ_e c_e (Δ_i − Δ_j)², seen from row `row`.
+struct FairEnd {
+    edge: u32,
+    row: usize,
+    own: u32,
+    other: u32,
+    /// None: the other end is anchored; Some(slot): it is free, and the entry's off-diagonal
+    /// slot is listed at one of the two ends only (None at the other).
+    other_row: Option<Option<usize>>,
 }
 
 impl ShapeStep {
@@ -111,6 +125,21 @@ impl ShapeStep {
             }
         }
         let diag_slot = (0..m).map(|i| slot_of(i, i)).collect();
+        let mut fair_edges = Vec::new();
+        for (e, edge) in mesh.edges.iter().enumerate() {
+            let [a, b] = edge.v;
+            let (ra, rb) = (row[a as usize], row[b as usize]);
+            for (own, other, r_own, r_other) in [(a, b, ra, rb), (b, a, rb, ra)] {
+                let Some(r) = r_own else { continue };
+                fair_edges.push(FairEnd {
+                    edge: e as u32,
+                    row: r,
+                    own,
+                    other,
+                    other_row: r_other.map(|o| (r > o).then(|| slot_of(r, o))),
+                });
+            }
+        }
         let structure = SymbolicSparseColMatRef::new_checked(m, m, &col_ptr, None, &row_idx);
         let symbolic =
             SymbolicLlt::try_new(structure, Side::Lower).map_err(|e| Error::Numerical {
@@ -123,13 +152,19 @@ impl ShapeStep {
             row_idx,
             product_slot,
             diag_slot,
+            fair_edges,
             symbolic,
         })
     }
 
+    /// The non-anchored vertices, in the order of the system's rows.
+    pub fn vertices(&self) -> &[u32] {
+        &self.vertices
+    }
+
     /// New heights for the non-anchored vertices of the mesh given to `new` (anchored ones
     /// are copied), given force densities `q` per edge, loads `p`, current heights `z`, input
-    /// heights `z0`, iteration k.
+    /// heights `z0`, iteration k: the inverse-residual proximal step of the paper's loop.
     pub fn step(
         &self,
         q: &[f64],
@@ -139,8 +174,48 @@ impl ShapeStep {
         k: usize,
         schedule: &Schedule,
     ) -> Result<Vec<f64>> {
+        let normal = self.normal_equations(q, p, z);
+        let r_inf = normal.r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let mu = (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * normal.scale;
+        let nu = schedule.pull * normal.scale;
+        let pull: Vec<(f64, f64)> = (normal.r.iter().zip(&self.vertices))
+            .map(|(ri, &v)| {
+                let lambda = if r_inf > 0.0 {
+                    r_inf / (ri.abs() + schedule.eta * r_inf)
+                } else {
+                    1.0
+                };
+                let v = v as usize;
+                (mu * lambda + nu, mu * lambda * z[v] + nu * z0[v])
+            })
+            .collect();
+        self.solve(normal, &pull, None, z)
+    }
+
+    /// The heights minimising ‖K z − b‖² + ρ Σ_i a_i (z_i − z⁰_i)² + ρ γ Σ_e c_e (Δ_i − Δ_j)²
+    /// (Δ = z − z⁰; `fair` = (γ, c_e per mesh edge)): the height step of the nearest-shape
+    /// method, whose normal equations are those of the paper's step with another diagonal.
+    pub fn nearest(
+        &self,
+        q: &[f64],
+        p: &[f64],
+        z: &[f64],
+        z0: &[f64],
+        rho: f64,
+        area: &[f64],
+        fair: Option<(f64, &[f64])>,
+    ) -> Result<Vec<f64>> {
+        let normal = self.normal_equations(q, p, z);
+        let pull: Vec<(f64, f64)> = (area.iter().zip(&self.vertices))
+            .map(|(&a, &v)| (rho * a, rho * a * z0[v as usize]))
+            .collect();
+        let fair = fair.map(|(gamma, c)| (rho * gamma, c, z0));
+        self.solve(normal, &pull, fair, z)
+    }
+
+    /// K's values, b, the residual r = K z − b, KᵀK on the fixed pattern and Kᵀb.
+    fn normal_equations(&self, q: &[f64], p: &[f64], z: &[f64]) -> Normal {
         let m = self.vertices.len();
-        // K's values (one per entry of its structure), b, and r = K z − b.
         let k_val: Vec<f64> = (self.k.edge.iter().zip(&self.k.negative))
             .map(|(&e, &negative)| {
                 if negative {
@@ -169,8 +244,6 @@ impl ShapeStep {
                     - bi
             })
             .collect();
-        let r_inf = r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        // KᵀK values on the fixed pattern, Kᵀb.
         let mut ktk = vec![0.0; self.row_idx.len()];
         let mut ktb = vec![0.0; m];
         let mut slots = self.product_slot.iter();
@@ -185,36 +258,55 @@ impl ShapeStep {
             }
         }
         let mean_diag = self.diag_slot.iter().map(|&k| ktk[k]).sum::<f64>() / m.max(1) as f64;
-        let scale = if mean_diag > 0.0 { mean_diag } else { 1.0 };
-        let mu = (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * scale;
-        let nu = schedule.pull * scale;
-        let lambda: Vec<f64> = r
-            .iter()
-            .map(|ri| {
-                if r_inf > 0.0 {
-                    r_inf / (ri.abs() + schedule.eta * r_inf)
-                } else {
-                    1.0
-                }
-            })
-            .collect();
+        Normal {
+            ktk,
+            ktb,
+            r,
+            scale: if mean_diag > 0.0 { mean_diag } else { 1.0 },
+        }
+    }
+
+    /// Solves (KᵀK + D + G) z = Kᵀb + d + g, where `pull` holds (D_ii, d_i) per row and
+    /// `fair` = (weight, c_e, centre) adds G, the weighted graph Laplacian of the edges, and
+    /// g = G centre (anchored neighbours count at their centre height).
+    fn solve(
+        &self,
+        normal: Normal,
+        pull: &[(f64, f64)],
+        fair: Option<(f64, &[f64], &[f64])>,
+        z: &[f64],
+    ) -> Result<Vec<f64>> {
+        let m = self.vertices.len();
+        let Normal { mut ktk, ktb, .. } = normal;
+        let mut rhs = Mat::from_fn(m, 1, |i, _| ktb[i] + pull[i].1);
         for (i, &k) in self.diag_slot.iter().enumerate() {
-            ktk[k] += mu * lambda[i] + nu;
+            ktk[k] += pull[i].0;
+        }
+        if let Some((weight, c, centre)) = fair {
+            for f in &self.fair_edges {
+                let w = weight * c[f.edge as usize];
+                let (ci, cj) = (centre[f.own as usize], centre[f.other as usize]);
+                ktk[self.diag_slot[f.row]] += w;
+                rhs[(f.row, 0)] += w * (ci - cj);
+                match f.other_row {
+                    None => rhs[(f.row, 0)] += w * cj,
+                    Some(Some(slot)) => ktk[slot] -= w,
+                    Some(None) => {}
+                }
+            }
         }
         let mat = SparseColMatRef::new(
             SymbolicSparseColMatRef::new_checked(m, m, &self.col_ptr, None, &self.row_idx),
             &ktk[..],
         );
         let llt =
-            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).map_err(|e| {
+            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).map_err(|_| {
                 Error::Numerical {
-                    what: format!("shape system is not positive definite: {e:?}"),
+                    what: "the height system is not positive definite (a vertex carries no \
+                           stress and nothing pulls it)"
+                        .into(),
                 }
             })?;
-        let mut rhs = Mat::from_fn(m, 1, |i, _| {
-            let v = self.vertices[i] as usize;
-            ktb[i] + mu * lambda[i] * z[v] + nu * z0[v]
-        });
         llt.solve_in_place(rhs.as_mut());
         let mut out = z.to_vec();
         for (i, &v) in self.vertices.iter().enumerate() {
@@ -227,6 +319,16 @@ impl ShapeStep {
         }
         Ok(out)
     }
+}
+
+/// The normal equations of one height step before any pull is added.
+struct Normal {
+    ktk: Vec<f64>,
+    ktb: Vec<f64>,
+    /// r = K z − b at the current heights, per row.
+    r: Vec<f64>,
+    /// Mean diagonal of KᵀK (1 when zero): the unit of the proximal weights.
+    scale: f64,
 }
 
 /// K = L_q[V_N, V_N] as a structure fixed by the mesh: per row, one diagonal entry +q_e per
@@ -283,5 +385,124 @@ impl KStructure {
 
     fn columns(&self, i: usize) -> &[usize] {
         &self.col[self.start[i]..self.start[i + 1]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// J(z) = ‖K z − b‖² + ρ Σ a_i Δ_i² + ρ γ Σ_e c_e (Δ_i − Δ_j)² and its gradient, computed
+    /// from the mesh's edges directly (Δ = z − z⁰, zero at anchored vertices).
+    fn objective(
+        mesh: &Mesh,
+        q: &[f64],
+        p: &[f64],
+        z: &[f64],
+        z0: &[f64],
+        (rho, area, gamma, c): (f64, &[f64], f64, &[f64]),
+    ) -> (f64, Vec<f64>) {
+        let n = z.len();
+        let mut r = vec![0.0; n];
+        for (v, rv) in r
+            .iter_mut()
+            .enumerate()
+            .filter(|(v, _)| mesh.is_non_anchored(*v))
+        {
+            *rv = -p[v];
+        }
+        for (e, edge) in mesh.edges.iter().enumerate() {
+            let [i, j] = edge.v.map(|v| v as usize);
+            r[i] += q[e] * (z[i] - z[j]);
+            r[j] += q[e] * (z[j] - z[i]);
+        }
+        let free = |v: usize| mesh.is_non_anchored(v);
+        let mut grad = vec![0.0; n];
+        let mut j_val = 0.0;
+        for v in (0..n).filter(|&v| free(v)) {
+            j_val += r[v] * r[v] + rho * area[v] * (z[v] - z0[v]).powi(2);
+            grad[v] += 2.0 * rho * area[v] * (z[v] - z0[v]);
+        }
+        for (e, edge) in mesh.edges.iter().enumerate() {
+            let [i, j] = edge.v.map(|v| v as usize);
+            // d r_i / d z_i = q, d r_i / d z_j = −q, for the free rows.
+            for (a, b) in [(i, j), (j, i)] {
+                if free(a) {
+                    grad[a] += 2.0 * r[a] * q[e];
+                    grad[b] -= 2.0 * r[a] * q[e];
+                }
+            }
+            let d = (z[i] - z0[i]) - (z[j] - z0[j]);
+            j_val += rho * gamma * c[e] * d * d;
+            grad[i] += 2.0 * rho * gamma * c[e] * d;
+            grad[j] -= 2.0 * rho * gamma * c[e] * d;
+        }
+        for (v, g) in grad.iter_mut().enumerate() {
+            if !free(v) {
+                *g = 0.0;
+            }
+        }
+        (j_val, grad)
+    }
+
+    #[test]
+    fn the_nearest_step_minimises_its_objective() {
+        let mesh = crate::generate::cap_dome(0.9, 300).unwrap();
+        let n = mesh.positions.len();
+        let wave = |k: usize, f: f64| ((k as f64 * f).sin() + 1.5) / 2.5;
+        let q: Vec<f64> = (0..mesh.edges.len()).map(|e| 50.0 * wave(e, 0.7)).collect();
+        let c: Vec<f64> = (0..mesh.edges.len()).map(|e| wave(e, 1.3)).collect();
+        let p: Vec<f64> = (0..n).map(|v| 0.01 * wave(v, 0.3)).collect();
+        let z0: Vec<f64> = mesh.positions.iter().map(|x| x[2]).collect();
+        // Anchored vertices stay at their input heights, as in form finding.
+        let z: Vec<f64> = (0..n)
+            .map(|v| {
+                z0[v]
+                    + if mesh.is_non_anchored(v) {
+                        0.01 * wave(v, 2.1)
+                    } else {
+                        0.0
+                    }
+            })
+            .collect();
+        let area: Vec<f64> = (0..n).map(|v| wave(v, 0.9) / n as f64).collect();
+        let step = ShapeStep::new(&mesh).unwrap();
+        let rows: Vec<f64> = step.vertices().iter().map(|&v| area[v as usize]).collect();
+        for (rho, gamma) in [(1e3, 0.0), (1e3, 0.5), (1e-2, 2.0)] {
+            let terms = (rho, &area[..], gamma, &c[..]);
+            let fair = (gamma > 0.0).then_some((gamma, &c[..]));
+            let zs = step.nearest(&q, &p, &z, &z0, rho, &rows, fair).unwrap();
+            let (_, g0) = objective(&mesh, &q, &p, &z, &z0, terms);
+            let (j, g) = objective(&mesh, &q, &p, &zs, &z0, terms);
+            let norm = |g: &[f64]| g.iter().map(|x| x * x).sum::<f64>().sqrt();
+            assert!(
+                norm(&g) < 1e-8 * norm(&g0),
+                "ρ {rho} γ {gamma}: |∇J| {:e}",
+                norm(&g)
+            );
+            // A minimum, not only a stationary point: every nearby point is worse.
+            for k in 0..5 {
+                let dz: Vec<f64> = (0..n)
+                    .map(|v| 1e-4 * (wave(v + 7 * k, 1.7) - 0.5))
+                    .collect();
+                for sign in [1.0, -1.0] {
+                    let moved: Vec<f64> = (0..n)
+                        .map(|v| {
+                            zs[v]
+                                + if mesh.is_non_anchored(v) {
+                                    sign * dz[v]
+                                } else {
+                                    0.0
+                                }
+                        })
+                        .collect();
+                    assert!(objective(&mesh, &q, &p, &moved, &z0, terms).0 >= j);
+                }
+            }
+            // Anchored heights are kept.
+            for v in (0..n).filter(|&v| !mesh.is_non_anchored(v)) {
+                assert_eq!(zs[v], z[v]);
+            }
+        }
     }
 }

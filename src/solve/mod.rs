@@ -1,14 +1,14 @@
-//! Form finding (MATH §11): stress step → stop if ε∞ < tol → shape step → stop if the same
-//! forces certify ε∞ < tol at the new heights, repeated. The result always carries the best
-//! state reached and an honest termination status.
+//! Form finding (MATH §11): the nearest self-supporting shape to the input
+//! ([`FormMethod::Nearest`], the default) or the paper's loop ([`FormMethod::Paper`]). Either
+//! way the result carries the best certified state reached and an honest termination status.
 
-use crate::error::Result;
+mod nearest;
+mod paper;
+
+use crate::error::{Error, Result};
 use crate::problem::Problem;
-use crate::shape::{Schedule, ShapeStep};
-use crate::stress::{
-    analyse_cached, EdgeScope, Prior, QBound, QpSolver, StressCache, StressResult, StressSettings,
-    StressStatus,
-};
+use crate::shape::Schedule;
+use crate::stress::{EdgeScope, QBound, QpSolver, StressResult, StressSettings, StressStatus};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -32,20 +32,54 @@ pub enum Termination {
     },
     /// The progress callback asked to stop.
     Cancelled,
+    /// The nearest shape that stands lies beyond the height limit
+    /// ([`FormFindSettings::max_height_change`]): the listed vertices reached it. `hint` names
+    /// the setting that holds the forces down (q_max) or says that the limit blocks.
+    HeightLimit {
+        vertices: Vec<u32>,
+        hint: String,
+    },
+}
+
+/// How form finding moves the shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FormMethod {
+    /// The nearest self-supporting shape: minimise the area-weighted squared height change
+    /// (plus an optional fairness term) subject to equilibrium, by a penalty continuation
+    /// whose merit every accepted step decreases (see `docs/method.md`).
+    #[default]
+    Nearest,
+    /// The paper's loop: height steps pulled towards the current heights with
+    /// inverse-residual weights and the geometric schedule of [`FormFindSettings::schedule`].
+    Paper,
 }
 
 /// Settings of the whole loop.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FormFindSettings {
     pub stress: StressSettings,
+    /// Default [`FormMethod::Nearest`].
+    pub method: FormMethod,
+    /// γ of the fairness term on the height change, γ Σ_e c_e (Δz_i − Δz_j)² with c_e the
+    /// plan area around edge e over its squared length, relative to the area-weighted squared
+    /// change (nearest method only; frame units, so γ is dimensionless). 0: the plain nearest
+    /// shape; larger values spread a change over a wider, smoother patch. Default 0.03.
+    pub fairness: f64,
+    /// Largest height change allowed at any vertex, in plan bounding-box diagonals (nearest
+    /// method only). A shape that cannot stand within it ends `HeightLimit`. Default 1.
+    pub max_height_change: f64,
     /// Stop when ε∞ = max|r_i| / mean p_i < tolerance. Default 1e-6.
     pub tolerance: f64,
+    /// Stress steps at most. Default 100.
     pub max_iterations: usize,
+    /// The paper method's height-step schedule (unused by the nearest method).
     pub schedule: Schedule,
     /// Stalled when the best ε∞ has not improved by 1% over this many iterations.
     pub stall_window: usize,
-    /// Optimal Delaunay Triangulation sweeps of the plan: one before each of the first
-    /// `odt_iterations` stress steps (0: the plan never moves). Default 0.
+    /// Optimal Delaunay Triangulation sweeps of the plan (0: the plan never moves). The paper
+    /// method runs one before each of its first `odt_iterations` stress steps; the nearest
+    /// method runs them all on the input, resampling its heights, and takes the result as
+    /// the shape to stay near. Default 0.
     pub odt_iterations: usize,
     /// Let ODT move free boundary vertices too (it favours concave free edges, which is what a
     /// free edge needs to carry compression). Default false: on the shared models it made the
@@ -55,10 +89,8 @@ pub struct FormFindSettings {
     /// the first. Default 1e-6.
     pub proximal_weight: f64,
     /// The dual-length smoothing weight of stress step k is
-    /// `stress.dual_length_smoothing` × decayᵏ. Slower decay (closer to 1): a smoother force
-    /// diagram, a shape further from the input and more iterations (lilium, μ = 1, counted
-    /// before height steps were certified: decay 0.2 gave 17 iterations, 0.5 gave 26, 0.7
-    /// gave 42). In [0, 1). Default 0.5.
+    /// `stress.dual_length_smoothing` × decayᵏ: slower decay (closer to 1) gives a smoother
+    /// force diagram at the price of a shape further from the input. In [0, 1). Default 0.5.
     pub smoothing_decay: f64,
 }
 
@@ -75,8 +107,11 @@ impl Default for FormFindSettings {
                 q_min_scope: EdgeScope::All,
                 ..Default::default()
             },
+            method: FormMethod::Nearest,
+            fairness: 0.03,
+            max_height_change: 1.0,
             tolerance: 1e-6,
-            max_iterations: 50,
+            max_iterations: 100,
             schedule: Schedule::default(),
             stall_window: 8,
             proximal_weight: 1e-6,
@@ -117,6 +152,11 @@ pub struct FormFindResult {
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
     pub l2: f64,
+    /// The nearest method's objective: the RMS height change of the non-anchored vertices
+    /// weighted by their plan area shares, over the plan bounding-box diagonal.
+    pub rms_change: f64,
+    /// The largest height change at any vertex, over the plan bounding-box diagonal.
+    pub max_change: f64,
     /// Seconds summed over iterations.
     pub stress_seconds: f64,
     pub shape_seconds: f64,
@@ -127,178 +167,110 @@ pub struct FormFindResult {
 /// previous active set (see `StressCache::far_from_balance`).
 const FAR_FROM_BALANCE: f64 = 0.1;
 
-/// Finds the nearest self-supporting shape to `problem`'s mesh.
+/// Finds a self-supporting shape near `problem`'s mesh with `settings.method`.
 pub fn form_find(
     problem: &Problem,
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
 ) -> Result<FormFindResult> {
+    validate(settings)?;
+    match settings.method {
+        FormMethod::Nearest => nearest::nearest(problem, settings, progress),
+        FormMethod::Paper => paper::paper(problem, settings, progress),
+    }
+}
+
+fn validate(settings: &FormFindSettings) -> Result<()> {
     settings.stress.validate()?;
+    let bad = |name, reason: &str| {
+        Err(Error::InvalidArgument {
+            name,
+            reason: reason.into(),
+        })
+    };
     if !(settings.tolerance > 0.0 && settings.tolerance.is_finite()) {
-        return Err(crate::Error::InvalidArgument {
-            name: "tolerance",
-            reason: "must be finite and > 0".into(),
-        });
+        return bad("tolerance", "must be finite and > 0");
     }
     if !(0.0..1.0).contains(&settings.smoothing_decay) {
-        return Err(crate::Error::InvalidArgument {
-            name: "smoothing_decay",
-            reason: "must be in [0, 1)".into(),
-        });
+        return bad("smoothing_decay", "must be in [0, 1)");
     }
-    let start = Instant::now();
-    let mesh = &problem.mesh;
-    let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
-    let mut positions = mesh.positions.clone();
-    let shape = ShapeStep::new(mesh)?;
-    let mut progress = progress;
-    let (mut history, mut stress_s, mut shape_s) = (Vec::new(), 0.0, 0.0);
-    let mut best = f64::INFINITY;
-    let mut best_at = 0;
-    let mut last: Option<StressResult> = None;
-    let mut termination = Termination::MaxIterations;
-    let fans = crate::smooth::vertex_faces(mesh);
-    // The mesh keeps its connectivity: the steps share one ordering and symbolic analysis.
-    // Large QPs are solved to coarse optimality: the loop's answer is certified by its own
-    // residuals, not by the QPs' optimality (see `StressCache::for_form_finding`).
-    let mut cache = StressCache::for_form_finding();
-    let mut stress_steps = 0;
-    let mut solvers = Vec::new();
-    for k in 0..settings.max_iterations.max(1) {
-        if k < settings.odt_iterations {
-            let t = Instant::now();
-            crate::smooth::odt_sweep(mesh, &fans, &mut positions, settings.odt_free_boundary);
-            shape_s += t.elapsed().as_secs_f64();
-        }
-        let t = Instant::now();
-        let prior = last
-            .as_ref()
-            .filter(|s| s.status.is_solved())
-            .map(|s| Prior {
-                force_densities: &s.force_densities,
-                weight: settings.proximal_weight,
-                lifted_first: s.lifted,
-            });
-        // A fixed smoothing weight would keep trading residual for smoothness, so the loop
-        // could not reach ε∞ → 0: the weight fades (and is dropped once negligible), the shape
-        // adapts to the smoother stress of the early steps and the proximal term keeps it.
-        let faded;
-        let stress_settings = if settings.stress.dual_length_smoothing > 0.0 {
-            let factor = settings.smoothing_decay.powi(k as i32);
-            faded = StressSettings {
-                dual_length_smoothing: settings.stress.dual_length_smoothing
-                    * if factor > 1e-12 { factor } else { 0.0 },
-                ..settings.stress.clone()
-            };
-            &faded
-        } else {
-            &settings.stress
-        };
-        cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
-        let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
-        solvers.push(stress.solver);
-        // A step that stopped short of its optimum may balance the shape worse than the forces
-        // at hand (the previous ones, certified at these heights): those are kept instead,
-        // unless ODT has just moved the plan under them.
-        let stress = match last.take() {
-            // A smoothed step trades residual for smoothness on purpose: only once the
-            // smoothing has faded is a coarse one judged by its residual.
-            Some(held)
-                if k >= settings.odt_iterations
-                    && falls_short(
-                        &stress,
-                        cache.last_was_coarse() && stress_settings.dual_length_smoothing == 0.0,
-                        &held,
-                    ) =>
-            {
-                held
-            }
-            _ => stress,
-        };
-        stress_s += t.elapsed().as_secs_f64();
-        stress_steps += 1;
-        history.push(stress.eps_inf);
-        let status = stress.status;
-        let eps = stress.eps_inf;
-        last = Some(stress);
-        if let Some(cb) = progress.as_mut() {
-            if !cb(k, eps) {
-                termination = Termination::Cancelled;
-                break;
-            }
-        }
-        match status {
-            StressStatus::Infeasible => {
-                termination = Termination::Infeasible {
-                    constraint: infeasibility_hint(&settings.stress),
-                };
-                break;
-            }
-            StressStatus::NumericalError => {
-                termination = Termination::NumericalError {
-                    what: "stress QP failed".into(),
-                };
-                break;
-            }
-            _ => {}
-        }
-        if eps < settings.tolerance {
-            termination = Termination::Converged;
-            break;
-        }
-        if eps < best * 0.99 {
-            best = eps;
-            best_at = k;
-        } else if k - best_at >= settings.stall_window {
-            termination = Termination::Stalled {
-                vertices: blocking_vertices(problem, last.as_ref().unwrap()),
-            };
-            break;
-        }
-        if k + 1 >= settings.max_iterations {
-            break;
-        }
-        let t = Instant::now();
-        let s = last.as_ref().unwrap();
-        let z: Vec<f64> = positions.iter().map(|p| p[2]).collect();
-        match shape.step(&s.force_densities, &s.loads, &z, &z0, k, &settings.schedule) {
-            Ok(z_new) => positions.iter_mut().zip(z_new).for_each(|(p, z)| p[2] = z),
-            Err(e) => {
-                termination = Termination::NumericalError {
-                    what: e.to_string(),
-                };
-                break;
-            }
-        }
-        // Late shape steps balance the given forces almost exactly: when these forces already
-        // balance the new shape, the next stress step (the most expensive one: its optimum is
-        // nearly degenerate) would only confirm it. The certificate is recomputed from the
-        // forces and the new heights, as for a stress step.
-        let certified = s.at_heights(problem, &positions, stress_settings);
-        shape_s += t.elapsed().as_secs_f64();
-        let certified_eps = certified.eps_inf;
-        last = Some(certified);
-        if certified_eps < settings.tolerance {
-            history.push(certified_eps);
-            termination = Termination::Converged;
-            break;
-        }
+    if !(settings.fairness >= 0.0 && settings.fairness.is_finite()) {
+        return bad("fairness", "must be finite and >= 0");
     }
-    let stress = last.expect("at least one iteration");
-    let (hausdorff, l2) = distances(problem, &positions);
-    Ok(FormFindResult {
-        termination,
-        iterations: stress_steps,
-        solvers,
-        positions,
-        stress,
-        history,
+    if !(settings.max_height_change > 0.0) {
+        return bad("max_height_change", "must be > 0");
+    }
+    Ok(())
+}
+
+/// What a loop hands to [`finish`].
+struct Run {
+    termination: Termination,
+    iterations: usize,
+    solvers: Vec<QpSolver>,
+    positions: Vec<[f64; 3]>,
+    stress: StressResult,
+    history: Vec<f64>,
+    stress_seconds: f64,
+    shape_seconds: f64,
+}
+
+/// The result of a loop, with the distances to the input measured.
+fn finish(problem: &Problem, run: Run, start: Instant) -> FormFindResult {
+    let (hausdorff, l2) = distances(problem, &run.positions);
+    let (rms_change, max_change) = height_change(problem, &run.positions);
+    FormFindResult {
+        termination: run.termination,
+        iterations: run.iterations,
+        solvers: run.solvers,
+        positions: run.positions,
+        stress: run.stress,
+        history: run.history,
         hausdorff,
         l2,
-        stress_seconds: stress_s,
-        shape_seconds: shape_s,
+        rms_change,
+        max_change,
+        stress_seconds: run.stress_seconds,
+        shape_seconds: run.shape_seconds,
         total_seconds: start.elapsed().as_secs_f64(),
-    })
+    }
+}
+
+/// Plan area share of every non-anchored vertex (a third of each incident face's plan area),
+/// normalised to sum to 1; 0 elsewhere.
+pub(crate) fn area_shares(problem: &Problem) -> Vec<f64> {
+    let mesh = &problem.mesh;
+    let mut share = vec![0.0; mesh.positions.len()];
+    for f in &mesh.faces {
+        let [a, b, c] = f.map(|v| mesh.positions[v as usize]);
+        let area = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() / 6.0;
+        for &v in f {
+            if mesh.is_non_anchored(v as usize) {
+                share[v as usize] += area;
+            }
+        }
+    }
+    let total: f64 = share.iter().sum();
+    if total > 0.0 {
+        share.iter_mut().for_each(|s| *s /= total);
+    }
+    share
+}
+
+/// (area-weighted RMS, max) of the height change over the plan bounding-box diagonal.
+fn height_change(problem: &Problem, positions: &[[f64; 3]]) -> (f64, f64) {
+    let mesh = &problem.mesh;
+    let diag = 2.0 * crate::geometry::Frame::of(mesh, &mesh.positions).scale;
+    let share = area_shares(problem);
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for (v, (p, q)) in mesh.positions.iter().zip(positions).enumerate() {
+        if mesh.referenced[v] {
+            let d = (q[2] - p[2]) / diag;
+            sum += share[v] * d * d;
+            max = max.max(d.abs());
+        }
+    }
+    (sum.sqrt(), max)
 }
 
 /// Whether a stress step's answer `new`, which stopped short of its optimum (at the

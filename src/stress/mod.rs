@@ -212,6 +212,9 @@ pub struct StressCache {
     coarse: bool,
     /// Whether the last step's answer was solved to coarse optimality.
     last_coarse: bool,
+    /// Physical vertical loads added to those the QP balances (the nearest-shape method's
+    /// multiplier shift); the result's residuals are still those of the true loads.
+    load_offset: Option<Vec<f64>>,
 }
 
 impl StressCache {
@@ -234,6 +237,12 @@ impl StressCache {
     /// set is wrong in hundreds of rows and the failed attempt costs several factorisations.
     pub fn far_from_balance(&mut self, far: bool) {
         self.normal.far_from_balance(far);
+    }
+
+    /// Loads (physical, per vertex) the next steps add to the true loads in the QP's target;
+    /// `None`: the true loads.
+    pub(crate) fn set_load_offset(&mut self, offset: Option<Vec<f64>>) {
+        self.load_offset = offset;
     }
 
     /// Whether the last step's answer is a native QP's solved to coarse optimality: short of
@@ -300,7 +309,7 @@ pub fn analyse_cached(
     let start = Instant::now();
     let mesh = &problem.mesh;
     let n = positions.len();
-    let step = FramedStep::new(problem, positions, settings);
+    let step = FramedStep::new(problem, positions, settings, cache.load_offset.as_deref());
     let (frame, plan, p_bar, unit) = (&step.frame, &step.plan, step.p_bar, step.unit);
     let l0 = frame.scale;
     let Attempts {
@@ -410,7 +419,14 @@ struct FramedStep {
 }
 
 impl FramedStep {
-    fn new(problem: &Problem, positions: &[[f64; 3]], settings: &StressSettings) -> FramedStep {
+    /// `load_offset`: physical loads added to the true ones in the QP's target (see
+    /// `StressCache::set_load_offset`).
+    fn new(
+        problem: &Problem,
+        positions: &[[f64; 3]],
+        settings: &StressSettings,
+        load_offset: Option<&[f64]>,
+    ) -> FramedStep {
         let mesh = &problem.mesh;
         let frame = Frame::of(mesh, positions);
         let plan = Plan::new(mesh, positions, &frame);
@@ -418,7 +434,12 @@ impl FramedStep {
         let (load, free, p_bar) = loads_at(problem, positions, settings);
         let unit = p_bar / l0;
         let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
-        let p: Vec<f64> = load.iter().map(|x| x / p_bar).collect();
+        let p: Vec<f64> = match load_offset {
+            Some(offset) => (load.iter().zip(offset))
+                .map(|(x, o)| (x + o) / p_bar)
+                .collect(),
+            None => load.iter().map(|x| x / p_bar).collect(),
+        };
         let normal = boundary_normals(mesh, &plan.u);
         let (external, tau_normal) = horizontal_terms(problem, settings, &normal, p_bar);
         let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();

@@ -180,6 +180,78 @@ int main(void) {
         TRUE(status == VSR_STRESS_STATUS_SOLVED);
     }
 
+    /* Mesh files: bad paths and bad files leave `out` and `n_merged` untouched. */
+    {
+        static const char bad_off[] = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+        static const char good_off[] =
+            "OFF\n5 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 0.3\n"
+            "3 0 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n";
+        static const unsigned char short_stl[90] = {0};
+        VsrMesh *read = sentinel_mesh;
+        size_t merged = 77;
+        FILE *f;
+        f = fopen("vsr_hostile_bad.off", "w");
+        TRUE(f != NULL);
+        if (f) {
+            fputs(bad_off, f);
+            fclose(f);
+        }
+        f = fopen("vsr_hostile_short.stl", "wb");
+        TRUE(f != NULL);
+        if (f) {
+            fwrite(short_stl, 1, sizeof short_stl, f);
+            fclose(f);
+        }
+        f = fopen("vsr_hostile_good.off", "w");
+        TRUE(f != NULL);
+        if (f) {
+            fputs(good_off, f);
+            fclose(f);
+        }
+        EXPECT(vsr_mesh_read(NULL, NULL, anchored, 4, 1e-9, 1e-4, &merged, &read),
+               VSR_STATUS_NULL_POINTER, "path");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             NULL),
+               VSR_STATUS_NULL_POINTER, "out");
+        EXPECT(vsr_mesh_read("vsr_hostile_missing.obj", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "path");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.xyz", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "path");
+        EXPECT(vsr_mesh_read("vsr_hostile_bad.off", NULL, anchored, 3, 1e-9, 1e-4, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "path");
+        TRUE(strstr(vsr_last_error_message(), "vsr_hostile_bad.off:6:") != NULL);
+        EXPECT(vsr_mesh_read("vsr_hostile_short.stl", NULL, anchored, 4, 1e-9, 1e-4, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "path");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", "vsr_hostile_missing.json", NULL, 0, 1e-9,
+                             1e-4, &merged, &read),
+               VSR_STATUS_INVALID_ARGUMENT, "supports_path");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, NAN, 1e-4, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "weld_tolerance");
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, -1.0, &merged,
+                             &read),
+               VSR_STATUS_INVALID_ARGUMENT, "repair_tolerance");
+        TRUE(read == sentinel_mesh && merged == 77);
+        EXPECT(vsr_mesh_read("vsr_hostile_good.off", NULL, anchored, 4, 1e-9, 1e-4, NULL, &read),
+               VSR_STATUS_OK, "");
+        EXPECT(vsr_result_write(result, read, NULL), VSR_STATUS_NULL_POINTER, "path");
+        EXPECT(vsr_result_write(result, read, "vsr_hostile_no_such_dir/out.off"),
+               VSR_STATUS_INVALID_ARGUMENT, "path");
+        EXPECT(vsr_result_write(result, read, "vsr_hostile_out.off"), VSR_STATUS_OK, "");
+        f = fopen("vsr_hostile_out.off", "r");
+        TRUE(f != NULL);
+        if (f) fclose(f);
+        vsr_mesh_destroy(read);
+        remove("vsr_hostile_bad.off");
+        remove("vsr_hostile_short.stl");
+        remove("vsr_hostile_good.off");
+        remove("vsr_hostile_out.off");
+    }
+
     /* Names and versions. */
     TRUE(strcmp(vsr_status_name(VSR_STATUS_OK), "VSR_STATUS_OK") == 0);
     TRUE(strcmp(vsr_status_name(VSR_STATUS_BUFFER_TOO_SMALL), "VSR_STATUS_BUFFER_TOO_SMALL") == 0);

@@ -1,0 +1,193 @@
+//! Form finding, nearest-shape method against the paper's loop. Prints tables; asserts nothing.
+//!
+//!     cargo bench --bench formfind                  # known-answer cases and the shared models
+//!     cargo bench --bench formfind -- --known       # known-answer cases only
+//!     cargo bench --bench formfind -- --models      # shared models only
+//!     cargo bench --bench formfind -- --seeds 5     # more seeds per known-answer case
+//!
+//! Known-answer cases: a self-supporting vault (the truth, `generate::self_supporting`) is
+//! perturbed (`generate::perturb`); the truth is a feasible answer for the perturbed input, so
+//! the nearest self-supporting shape is at least as near the input as the truth is. The table
+//! gives the area-weighted RMS and the largest height change of the result over the truth's.
+
+use std::path::PathBuf;
+use std::time::Instant;
+use voussoir::generate::{self, KnownPlan, Perturbation};
+use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem};
+
+/// Area-weighted RMS and largest height difference between two position sets of `mesh`,
+/// non-anchored vertices only (plan area shares as weights), computed here independently of
+/// the library.
+fn height_difference(mesh: &Mesh, a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
+    let mut share = vec![0.0; a.len()];
+    for f in &mesh.faces {
+        let [p, q, r] = f.map(|v| mesh.positions[v as usize]);
+        let area = ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs() / 6.0;
+        f.iter().for_each(|&v| share[v as usize] += area);
+    }
+    let (mut sum, mut total, mut max) = (0.0, 0.0, 0.0f64);
+    for v in (0..a.len()).filter(|&v| mesh.is_non_anchored(v)) {
+        let d = a[v][2] - b[v][2];
+        sum += share[v] * d * d;
+        total += share[v];
+        max = max.max(d.abs());
+    }
+    ((sum / total).sqrt(), max)
+}
+
+fn method_name(m: FormMethod) -> &'static str {
+    match m {
+        FormMethod::Nearest => "nearest",
+        FormMethod::Paper => "paper",
+    }
+}
+
+fn outcome(r: &FormFindResult) -> String {
+    let t = format!("{:?}", r.termination);
+    t.split([' ', '{']).next().unwrap_or("").to_string()
+}
+
+fn known(seeds: u64, sizes: &[usize]) {
+    println!("\nKnown-answer cases: result-to-input over truth-to-input (RMS, largest change)\n");
+    println!(
+        "| plan | n | change | seed | method | end | steps | s | RMS ratio | max ratio | truth RMS/diag |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let settings = FormFindSettings::default();
+    let mut worst = [(0.0f64, 0.0f64); 2];
+    for &n in sizes {
+        for plan in KnownPlan::ALL {
+            let truth = match generate::self_supporting(plan, n, &settings) {
+                Ok(t) => t,
+                Err(e) => {
+                    println!("| {plan:?} | {n} | – | – | – | truth failed: {e} |");
+                    continue;
+                }
+            };
+            let diag = plan_diagonal(&truth);
+            for kind in Perturbation::ALL {
+                for seed in 0..seeds {
+                    let input = generate::perturb(&truth, kind, seed);
+                    let (truth_rms, truth_max) =
+                        height_difference(&input, &truth.positions, &input.positions);
+                    for (k, method) in [FormMethod::Nearest, FormMethod::Paper]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        let s = FormFindSettings {
+                            method,
+                            ..settings.clone()
+                        };
+                        let t = Instant::now();
+                        let problem = Problem::new(input.clone());
+                        let r = form_find(&problem, &s, None).expect("form finding");
+                        let secs = t.elapsed().as_secs_f64();
+                        let (rms, max) = height_difference(&input, &r.positions, &input.positions);
+                        let (ra, rm) = (rms / truth_rms, max / truth_max);
+                        if outcome(&r) == "Converged" {
+                            worst[k] = (worst[k].0.max(ra), worst[k].1.max(rm));
+                        }
+                        println!(
+                            "| {plan:?} | {} | {kind:?} | {seed} | {} | {} | {} | {secs:.2} | {ra:.3} | {rm:.3} | {:.4} |",
+                            input.positions.len(),
+                            method_name(method),
+                            outcome(&r),
+                            r.iterations,
+                            truth_rms / diag,
+                        );
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "\nworst converged ratios: nearest RMS {:.3}, max {:.3}; paper RMS {:.3}, max {:.3}",
+        worst[0].0, worst[0].1, worst[1].0, worst[1].1
+    );
+}
+
+fn plan_diagonal(mesh: &Mesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for (p, _) in mesh
+        .positions
+        .iter()
+        .zip(&mesh.referenced)
+        .filter(|(_, r)| **r)
+    {
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+fn models() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
+    if !dir.is_dir() {
+        println!("\nshared models: {} not found", dir.display());
+        return;
+    }
+    println!("\nShared models, default settings (distances over the plan diagonal)\n");
+    println!("| model | V | method | end | steps | s | Hausdorff | L2 | RMS change | max change |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for name in [
+        "free_vault",
+        "dome_with_doors",
+        "lilium",
+        "cheese",
+        "four_holes",
+        "neumunster",
+        "hex",
+        "three_pillar",
+        "vault_pq",
+    ] {
+        let mesh = voussoir::io::load_model(
+            &dir.join(format!("{name}.obj")),
+            &dir.join(format!("{name}.json")),
+        )
+        .expect("model");
+        let problem = Problem::new(mesh);
+        for method in [FormMethod::Nearest, FormMethod::Paper] {
+            let s = FormFindSettings {
+                method,
+                ..Default::default()
+            };
+            let t = Instant::now();
+            let r = form_find(&problem, &s, None).expect("form finding");
+            println!(
+                "| {name} | {} | {} | {} | {} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                problem.mesh.positions.len(),
+                method_name(method),
+                outcome(&r),
+                r.iterations,
+                t.elapsed().as_secs_f64(),
+                r.hausdorff,
+                r.l2,
+                r.rms_change,
+                r.max_change,
+            );
+            if name == "lilium" {
+                println!("|   lilium | | | normalised Hausdorff {:.4} (the paper: 0.04975) | | | | | | |", r.hausdorff);
+            }
+        }
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let has = |f: &str| args.iter().any(|a| a == f);
+    let seeds = args
+        .iter()
+        .position(|a| a == "--seeds")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
+    let (only_known, only_models) = (has("--known"), has("--models"));
+    if !only_models {
+        known(seeds, &[400, 1500]);
+    }
+    if !only_known {
+        models();
+    }
+}

@@ -1,0 +1,290 @@
+//! Mesh files through the C ABI: `vsr_mesh_read` and `vsr_result_write`.
+
+use std::ffi::{c_char, CStr};
+use std::path::PathBuf;
+
+use super::boundary::{boundary, checked_len, copy_out, from_error, handle, input, out_ptr};
+use super::boundary::{CResult, Failure};
+use super::mesh::VsrMesh;
+use super::result::VsrResult;
+use super::status::VsrStatus;
+use crate::io;
+use crate::mesh::repair::{repair_plan, PlanRepair};
+use crate::mesh::Mesh;
+use crate::problem::Problem;
+
+/// A path argument: non-NULL, NUL-terminated UTF-8.
+///
+/// # Safety
+/// When non-NULL, `ptr` must point to a NUL-terminated string.
+unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
+    if ptr.is_null() {
+        return Err(Failure::null(name));
+    }
+    // SAFETY: non-NULL and NUL-terminated by the caller's contract.
+    let text = unsafe { CStr::from_ptr(ptr) };
+    text.to_str()
+        .map(PathBuf::from)
+        .map_err(|_| Failure::invalid(name, "is not UTF-8"))
+}
+
+/// Creates a mesh from a file: OBJ, OFF, STL (binary or ASCII) or PLY (ASCII or binary),
+/// chosen by the extension of `path` (case-insensitive `.obj`, `.off`, `.stl`, `.ply`);
+/// polygons are split into fans.
+///
+/// - `path`: the mesh file, a NUL-terminated UTF-8 path.
+/// - `supports_path`: a JSON file of anchored vertex ids (`{"anchored": [ids]}` or `[ids]`),
+///   or NULL to use `anchored` instead.
+/// - `anchored`: `n_anchored` anchored vertex ids when `supports_path` is NULL (NULL when
+///   `n_anchored` is 0). Giving both is `VSR_STATUS_INVALID_ARGUMENT`.
+/// - `weld_tolerance`: vertices closer than `weld_tolerance` × (bounding box diagonal) are
+///   merged into the first of them (0 merges exactly equal positions only; default in the Rust
+///   API 1e-9); finite and >= 0. STL files, whose triangles never share vertices, need it.
+/// - `repair_tolerance`: faces whose plan area is below `repair_tolerance` × (median plan
+///   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
+///   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
+///   `vsr_mesh_plan_nudges`); 0 mends nothing, so such faces are rejected as by
+///   `vsr_mesh_create`. Finite and >= 0; the Rust API's default is 1e-4.
+/// - `n_merged`: receives how many of the file's vertices were merged into another; may be
+///   NULL.
+/// - `out`: receives a new handle on success, owned by the caller (free with
+///   `vsr_mesh_destroy`); untouched on failure.
+///
+/// Support ids are the file's own 0-based vertex ids (an STL file has three per triangle:
+/// vertex `3t + k` is corner `k` of triangle `t`). The mesh's vertices are the welded ones,
+/// numbered in the order of their first vertex in the file; `vsr_mesh_welded_ids` maps file
+/// ids onto them. Loads and defaults are those of `vsr_mesh_create`.
+///
+/// Errors: NULL `path` or `out` (`VSR_STATUS_NULL_POINTER`); an unknown extension, a file
+/// that cannot be read, or a malformed file (`VSR_STATUS_INVALID_ARGUMENT`, the message names
+/// the file and its line, or the element of a binary file); a support id `>=` the file's
+/// vertex count (`VSR_STATUS_INDEX_OUT_OF_RANGE`); then the checks of `vsr_mesh_create`.
+///
+/// # Safety
+/// `path` and `supports_path` (when non-NULL) must be NUL-terminated strings; `anchored` must
+/// hold `n_anchored` readable ids; `n_merged` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_read(
+    path: *const c_char,
+    supports_path: *const c_char,
+    anchored: *const u32,
+    n_anchored: usize,
+    weld_tolerance: f64,
+    repair_tolerance: f64,
+    n_merged: *mut usize,
+    out: *mut *mut VsrMesh,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let path = unsafe { path_arg("path", path)? };
+        let out = out_ptr("out", out)?;
+        if n_anchored > 0 && anchored.is_null() {
+            return Err(Failure::null("anchored"));
+        }
+        let n = checked_len::<u32>("anchored", "n_anchored", n_anchored, 1)?;
+        // SAFETY: length checked; readability is the caller's contract.
+        let ids = unsafe { input("anchored", anchored, n)? };
+        let supports_path = if supports_path.is_null() {
+            None
+        } else {
+            if n_anchored > 0 {
+                return Err(Failure::invalid(
+                    "anchored",
+                    "give either `supports_path` or `anchored`, not both",
+                ));
+            }
+            // SAFETY: non-NULL; NUL-terminated by the caller's contract.
+            Some(unsafe { path_arg("supports_path", supports_path)? })
+        };
+        for (name, value) in [
+            ("weld_tolerance", weld_tolerance),
+            ("repair_tolerance", repair_tolerance),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Failure::invalid(
+                    name,
+                    format!("{value} is not a finite number >= 0"),
+                ));
+            }
+        }
+        let (positions, faces) = io::read_mesh(&path).map_err(|e| from_error("path", e))?;
+        let ids = match &supports_path {
+            Some(p) => io::read_supports(p).map_err(|e| from_error("supports_path", e))?,
+            None => ids.to_vec(),
+        };
+        let welded =
+            io::weld(&positions, &faces, weld_tolerance).map_err(|e| from_error("path", e))?;
+        let anchored = welded
+            .map_ids(&ids)
+            .map_err(|e| from_error("anchored", e))?;
+        let (mut positions, mut faces) = (welded.positions, welded.faces);
+        let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
+            .map_err(|e| from_error("path", e))?;
+        let mesh = Mesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
+        let handle = Box::new(VsrMesh {
+            problem: Problem::new(mesh),
+            welded_ids: Some(welded.welded_id),
+            repairs,
+        });
+        if !n_merged.is_null() {
+            // SAFETY: non-NULL; writable by the caller's contract.
+            unsafe { n_merged.write(welded.merged) };
+        }
+        // SAFETY: `out` is non-NULL and writable by the caller's contract.
+        unsafe { out.write(Box::into_raw(handle)) };
+        Ok(())
+    })
+}
+
+/// The mesh vertex id of each vertex of the file `vsr_mesh_read` read (several file vertices
+/// share one id where they were welded); for a mesh from `vsr_mesh_create`, `0 .. #V - 1`.
+/// Copy-out as described in the header's introduction: `uint32_t` entries, one per file
+/// vertex.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_welded_ids(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let identity: Vec<u32>;
+        let ids = match &mesh.welded_ids {
+            Some(ids) => ids.as_slice(),
+            None => {
+                identity = (0..mesh.problem.mesh.n_vertices() as u32).collect();
+                identity.as_slice()
+            }
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy_out(ids, out, len, needed) }
+    })
+}
+
+/// Writes the result's vertex positions with the mesh's triangles to `path`, in the format of
+/// its extension (`.obj`, `.off`, `.ply` binary little-endian, `.stl` binary), all or nothing:
+/// the file is written beside `path` under a temporary name and renamed over it.
+///
+/// OBJ, OFF and PLY keep every bit of the positions (the shortest decimal that reads back the
+/// same double, or doubles). STL stores single precision by definition: about 7 significant
+/// digits, enough to view or print a shape but not to keep its equilibrium. Triangles are
+/// written in the orientation they were given (the mesh's internal reversal of a clockwise
+/// plan is undone).
+///
+/// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
+/// the mesh, an unknown extension, or a file that cannot be written
+/// (`VSR_STATUS_INVALID_ARGUMENT`).
+///
+/// # Safety
+/// `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_write(
+    result: *const VsrResult,
+    mesh: *const VsrMesh,
+    path: *const c_char,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let (result, mesh, path) = unsafe {
+            (
+                handle("result", result)?,
+                handle("mesh", mesh)?,
+                path_arg("path", path)?,
+            )
+        };
+        let m = &mesh.problem.mesh;
+        let positions = result.positions();
+        if positions.len() != m.n_vertices() {
+            return Err(Failure::invalid(
+                "mesh",
+                format!(
+                    "has {} vertices, the result {}: they do not belong together",
+                    m.n_vertices(),
+                    positions.len()
+                ),
+            ));
+        }
+        let faces: Vec<[u32; 3]> = if m.reversed {
+            m.faces.iter().map(|&[a, b, c]| [a, c, b]).collect()
+        } else {
+            m.faces.clone()
+        };
+        io::write_mesh(&path, positions, &faces).map_err(|e| from_error("path", e))
+    })
+}
+
+/// The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:
+/// the two faces (which keep their ids), the two vertices of the removed edge and the two of
+/// the added edge. None for a mesh from `vsr_mesh_create`. Copy-out as described in the
+/// header's introduction.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_plan_flips(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let rows: Vec<u32> = mesh
+            .repairs
+            .iter()
+            .flat_map(|r| match r {
+                PlanRepair::Flip {
+                    faces,
+                    removed,
+                    added,
+                } => vec![
+                    faces[0] as u32,
+                    faces[1] as u32,
+                    removed[0],
+                    removed[1],
+                    added[0],
+                    added[1],
+                ],
+                _ => Vec::new(),
+            })
+            .collect();
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy_out(&rows, out, len, needed) }
+    })
+}
+
+/// The plan moves `vsr_mesh_read` made, in order: #nudges by 2 `uint32_t`, row-major: the
+/// moved vertex and the face it mended. The vertex keeps its height; its new plan position is
+/// the mesh's (as `vsr_result_positions` of an analysis gives it). None for a mesh from
+/// `vsr_mesh_create`. Copy-out as described in the header's introduction.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_plan_nudges(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let rows: Vec<u32> = mesh
+            .repairs
+            .iter()
+            .flat_map(|r| match r {
+                PlanRepair::Nudge { vertex, face, .. } => vec![*vertex, *face as u32],
+                _ => Vec::new(),
+            })
+            .collect();
+        // SAFETY: forwarded caller's contract.
+        unsafe { copy_out(&rows, out, len, needed) }
+    })
+}

@@ -1,0 +1,124 @@
+//! One entry point for every mesh format, chosen by the file name's extension.
+
+use std::fs;
+use std::path::Path;
+
+use super::{io_error, off, ply, read_obj, stl, write_obj, RawMesh};
+use crate::{Error, Result};
+
+/// A mesh file format. [`MeshFormat::from_path`] picks it from the extension
+/// (case-insensitive): `.obj`, `.off`, `.stl`, `.ply`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum MeshFormat {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// Object File Format, ASCII, as CGAL and Geomview read and write it.
+    Off,
+    /// STL, binary (the default for writing) or ASCII. Single precision by definition.
+    Stl {
+        /// Binary (`true`) or ASCII (`false`); detected when reading.
+        binary: bool,
+    },
+    /// Stanford PLY, binary little-endian (the default for writing) or ASCII, positions as
+    /// `double`.
+    Ply {
+        /// Binary little-endian (`true`) or ASCII (`false`); any encoding is read.
+        binary: bool,
+    },
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension, with the binary encoding for STL and PLY. An
+    /// unknown or missing extension is an [`Error::InvalidArgument`] naming it.
+    pub fn from_path(path: &Path) -> Result<MeshFormat> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("obj") => Ok(MeshFormat::Obj),
+            Some("off") => Ok(MeshFormat::Off),
+            Some("stl") => Ok(MeshFormat::Stl { binary: true }),
+            Some("ply") => Ok(MeshFormat::Ply { binary: true }),
+            other => Err(Error::InvalidArgument {
+                name: "path",
+                reason: format!(
+                    "{}: {}; the mesh formats are .obj, .off, .stl and .ply",
+                    path.display(),
+                    match other {
+                        Some(e) => format!("unknown extension `.{e}`"),
+                        None => "no extension".to_string(),
+                    }
+                ),
+            }),
+        }
+    }
+
+    /// The same format with ASCII text instead of binary (STL and PLY; OBJ and OFF are text).
+    pub fn ascii(self) -> MeshFormat {
+        match self {
+            MeshFormat::Stl { .. } => MeshFormat::Stl { binary: false },
+            MeshFormat::Ply { .. } => MeshFormat::Ply { binary: false },
+            other => other,
+        }
+    }
+
+    /// Whether the format stores positions in single precision (STL), so that a written
+    /// mesh reads back rounded to `f32`.
+    pub fn is_single_precision(self) -> bool {
+        matches!(self, MeshFormat::Stl { .. })
+    }
+}
+
+/// Reads the vertices and triangles of a mesh file in the format of its extension (see
+/// [`MeshFormat::from_path`]); polygons are split into fans `(p0, p[i], p[i+1])`.
+///
+/// The vertices are those of the file, in its order: an STL file has three per triangle
+/// (vertex `3t + k` is corner `k` of triangle `t`), so STL input needs [`super::weld`]
+/// before it makes a mesh. Errors name the line (text) or the element (binary) at fault:
+/// truncated files, garbage, counts that disagree with the content, indices out of range,
+/// NaN or infinite coordinates.
+pub fn read_mesh(path: &Path) -> Result<RawMesh> {
+    let format = MeshFormat::from_path(path)?;
+    if format == MeshFormat::Obj {
+        return read_obj(path);
+    }
+    let bytes = fs::read(path).map_err(|e| io_error(path, &e))?;
+    let label = path.display().to_string();
+    match format {
+        MeshFormat::Off => off::parse_off(&bytes, &label),
+        MeshFormat::Stl { .. } => stl::parse_stl(&bytes, &label),
+        _ => ply::parse_ply(&bytes, &label),
+    }
+}
+
+/// Writes `positions` and `faces` (0-based) in the format of `path`'s extension (see
+/// [`MeshFormat::from_path`]; STL and PLY binary), all or nothing, as [`write_mesh_as`].
+pub fn write_mesh(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Result<()> {
+    write_mesh_as(path, MeshFormat::from_path(path)?, positions, faces)
+}
+
+/// Writes `positions` and `faces` (0-based) to `path` in `format`, whatever its extension.
+///
+/// Text formats write each coordinate as the shortest decimal that reads back to the same
+/// `f64` (at most 17 significant digits), and PLY binary as `double`, so OBJ, OFF and PLY
+/// keep positions bit for bit. STL stores `f32` by definition: positions are rounded to
+/// single precision (about 7 significant digits), enough to look at or print a shape but
+/// not to keep its equilibrium. The file is written to a temporary file in the same folder
+/// and renamed over `path`, so a failure never leaves a half-written file. A face index
+/// `>= positions.len()` or a non-finite coordinate is an [`Error::InvalidArgument`].
+pub fn write_mesh_as(
+    path: &Path,
+    format: MeshFormat,
+    positions: &[[f64; 3]],
+    faces: &[[u32; 3]],
+) -> Result<()> {
+    super::atomic::check_face_indices(positions.len(), faces)?;
+    super::atomic::check_positions_finite(positions)?;
+    match format {
+        MeshFormat::Obj => write_obj(path, positions, faces),
+        MeshFormat::Off => off::write_off(path, positions, faces),
+        MeshFormat::Stl { binary } => stl::write_stl(path, positions, faces, binary),
+        MeshFormat::Ply { binary } => ply::write_ply(path, positions, faces, binary),
+    }
+}

@@ -1,0 +1,764 @@
+//! The nearest self-supporting shape (docs/method.md, "Form finding"): minimise
+//!
+//!   E(z) = Σ_i a_i (Δz_i / L₀)² + γ Σ_e c_e ((Δz_i − Δz_j) / L₀)²,   Δz = z − z⁰,
+//!
+//! over the heights of the non-anchored vertices, subject to equilibrium r(z, y) = 0 under the
+//! stress constraints, by a penalty continuation on the merit F_w = E + w R, R the mean
+//! squared residual over the mean load. For fixed forces F_w is a convex quadratic in z
+//! (loads lagged), for fixed heights the stress QP minimises R exactly; each step minimises
+//! one block, so F_w never increases: height steps are checked against F_w with the loads
+//! recomputed and shortened until it decreases, and a stress answer that balances worse than
+//! the forces at hand is not taken. w grows when a round of both steps no longer lowers F_w
+//! by a fixed fraction; as w grows the height step tends to the exact solve K z = b and the
+//! loop ends on a certificate, ε∞ < tolerance.
+
+use super::{
+    area_shares, blocking_vertices, finish, infeasibility_hint, FormFindResult, FormFindSettings,
+    Progress, Run, Termination, FAR_FROM_BALANCE,
+};
+use crate::error::Result;
+use crate::geometry::Frame;
+use crate::problem::Problem;
+use crate::shape::ShapeStep;
+use crate::stress::{
+    analyse_cached, Prior, QpSolver, StressCache, StressResult, StressSettings, StressStatus,
+};
+use std::time::Instant;
+
+/// A round of a height and a stress step that lowers F_w by less than this fraction ends the
+/// round's penalty stage.
+const STAGE_DECREASE: f64 = 0.02;
+/// Rounds at most per penalty stage.
+const STAGE_ROUNDS: usize = 6;
+/// Factor on w between stages.
+const GROWTH: f64 = 10.0;
+/// Halvings of a height step before it is given up.
+const BACKTRACKS: usize = 6;
+/// The grid of the starting weight: w × factorᵏ, k < trials.
+const INITIAL_WEIGHT_FACTOR: f64 = 3.0;
+const INITIAL_WEIGHT_TRIALS: usize = 40;
+const INITIAL_DECREASE: f64 = 0.1;
+/// w grows at a multiplier update unless ‖r̂‖ has fallen below this fraction of its value at
+/// the update before.
+const RESIDUAL_FACTOR: f64 = 0.5;
+/// A state in equilibrium that is no nearer than the nearest one before it by this fraction
+/// of E ends the search.
+const SETTLED: f64 = 1e-3;
+/// Stalling is judged only once w has grown by this factor from its start: before, the pull
+/// to the input may hold ε∞ up on purpose.
+const STALL_AFTER_GROWTH: f64 = 1e3;
+
+pub(super) fn nearest(
+    problem: &Problem,
+    settings: &FormFindSettings,
+    progress: Option<&mut Progress>,
+) -> Result<FormFindResult> {
+    let start = Instant::now();
+    let mut state = Nearest::new(problem, settings, progress)?;
+    let ended = state.run()?;
+    // A certified state in equilibrium is the answer whatever stopped the search for a nearer
+    // one; without one, the lowest-ε∞ state is.
+    let (termination, best) = match state.feasible.take() {
+        Some(f) if ended != Termination::Cancelled => (Termination::Converged, f),
+        Some(f) => (ended, f),
+        None => (ended, state.best.clone()),
+    };
+    let Best {
+        positions, stress, ..
+    } = best;
+    Ok(finish(
+        problem,
+        Run {
+            termination,
+            iterations: state.iterations,
+            solvers: state.solvers,
+            positions,
+            stress,
+            history: state.history,
+            stress_seconds: state.stress_seconds,
+            shape_seconds: state.shape_seconds,
+        },
+        start,
+    ))
+}
+
+/// A certified state: heights with the forces that certify them.
+#[derive(Clone)]
+struct Best {
+    eps: f64,
+    /// E, the nearness objective.
+    energy: f64,
+    positions: Vec<[f64; 3]>,
+    stress: StressResult,
+}
+
+struct Nearest<'a, 'p> {
+    problem: &'a Problem,
+    settings: &'a FormFindSettings,
+    progress: Option<&'a mut Progress<'p>>,
+    shape: ShapeStep,
+    /// Input heights (after ODT, when asked for), the shape to stay near.
+    z0: Vec<f64>,
+    /// Plan area share per row of `shape`.
+    area: Vec<f64>,
+    /// c_e per mesh edge when the fairness term is on.
+    fair: Option<Vec<f64>>,
+    l0: f64,
+    /// Largest height change allowed, physical.
+    limit: f64,
+    cache: StressCache,
+    positions: Vec<[f64; 3]>,
+    /// The forces in use, certified at `positions`.
+    held: StressResult,
+    w: f64,
+    /// The lowest-E state in equilibrium (ε∞ < tolerance) reached.
+    feasible: Option<Best>,
+    /// Multipliers of the equilibrium rows (units of r̂), per row of `shape`.
+    lambda: Vec<f64>,
+    /// −p̄ √n λ / 2w per vertex, physical: the loads' shift in both steps.
+    load_offset: Vec<f64>,
+    best: Best,
+    history: Vec<f64>,
+    solvers: Vec<QpSolver>,
+    iterations: usize,
+    stress_seconds: f64,
+    shape_seconds: f64,
+}
+
+impl<'a, 'p> Nearest<'a, 'p> {
+    fn new(
+        problem: &'a Problem,
+        settings: &'a FormFindSettings,
+        progress: Option<&'a mut Progress<'p>>,
+    ) -> Result<Nearest<'a, 'p>> {
+        let mesh = &problem.mesh;
+        let mut positions = mesh.positions.clone();
+        let t = Instant::now();
+        if settings.odt_iterations > 0 {
+            let fans = crate::smooth::vertex_faces(mesh);
+            for _ in 0..settings.odt_iterations {
+                crate::smooth::odt_sweep(mesh, &fans, &mut positions, settings.odt_free_boundary);
+            }
+        }
+        let shape = ShapeStep::new(mesh)?;
+        let share = area_shares(problem);
+        let area: Vec<f64> = shape
+            .vertices()
+            .iter()
+            .map(|&v| share[v as usize])
+            .collect();
+        let n_rows = area.len();
+        let frame = Frame::of(mesh, &positions);
+        let fair =
+            (settings.fairness > 0.0).then(|| fairness_weights(problem, &positions, frame.scale));
+        let shape_seconds = t.elapsed().as_secs_f64();
+        Ok(Nearest {
+            problem,
+            settings,
+            progress,
+            shape,
+            z0: positions.iter().map(|p| p[2]).collect(),
+            area,
+            fair,
+            l0: frame.scale,
+            limit: settings.max_height_change * 2.0 * frame.scale,
+            cache: StressCache::for_form_finding(),
+            held: placeholder(),
+            w: 0.0,
+            feasible: None,
+            lambda: vec![0.0; n_rows],
+            load_offset: vec![0.0; positions.len()],
+            best: Best {
+                eps: f64::INFINITY,
+                energy: 0.0,
+                positions: positions.clone(),
+                stress: placeholder(),
+            },
+            positions,
+            history: Vec::new(),
+            solvers: Vec::new(),
+            iterations: 0,
+            stress_seconds: 0.0,
+            shape_seconds,
+        })
+    }
+
+    /// The loop; the state it ends in is read by the caller.
+    fn run(&mut self) -> Result<Termination> {
+        let first = self.stress_step(None)?;
+        self.held = first;
+        if let Some(t) = self.after_stress_step() {
+            return Ok(t);
+        }
+        if self.record() {
+            return Ok(Termination::Converged);
+        }
+        self.w = match self.initial_weight() {
+            Ok(w) => w,
+            Err(e) => return Ok(numerical(e)),
+        };
+        let w_start = self.w;
+        let mut last_norm = residual_term(&self.held, self.shape.vertices()).sqrt();
+        let (mut stage_rounds, mut stall_best, mut stall_at) = (0, self.best.eps, 0);
+        loop {
+            let before = self.merit(&self.positions, &self.held);
+            let moved = match self.height_step() {
+                Ok(moved) => moved,
+                Err(e) => return Ok(numerical(e)),
+            };
+            if moved && self.held.eps_inf < self.settings.tolerance {
+                self.history.push(self.held.eps_inf);
+            }
+            if self.record() {
+                return Ok(Termination::Converged);
+            }
+            let prior = self.held.clone();
+            let answer = self.stress_step(Some(&prior))?;
+            self.held = answer;
+            if let Some(t) = self.after_stress_step() {
+                return Ok(t);
+            }
+            if self.record() {
+                return Ok(Termination::Converged);
+            }
+            stage_rounds += 1;
+            let after = self.merit(&self.positions, &self.held);
+            if std::env::var_os("VSR_TRACE").is_some() {
+                eprintln!(
+                    "k {} w {:.3e} E {:.3e} R {:.3e} F {:.3e} -> {:.3e} eps {:.3e} moved {moved} limit {}",
+                    self.iterations, self.w, self.energy(&self.positions),
+                    residual_term(&self.held, self.shape.vertices()), before, after,
+                    self.held.eps_inf, self.at_limit().len()
+                );
+            }
+            let progressed = moved && after <= (1.0 - tune::stage_decrease()) * before;
+            if !progressed || stage_rounds >= tune::stage_rounds() {
+                self.update_multipliers(&mut last_norm);
+                stage_rounds = 0;
+            }
+            // Rounds that still lower the merit are progress towards a nearer shape even where
+            // ε∞ waits on them.
+            if progressed
+                || self.best.eps < 0.99 * stall_best
+                || self.w < STALL_AFTER_GROWTH * w_start
+            {
+                (stall_best, stall_at) = (self.best.eps, self.iterations);
+            } else if self.iterations - stall_at >= self.settings.stall_window {
+                return Ok(self.stalled());
+            }
+        }
+    }
+
+    /// Records the current state as the best so far where it is; true when it is in
+    /// equilibrium and no nearer, by more than `SETTLED`, than the nearest such state before
+    /// it: the search for a nearer one has settled.
+    fn record(&mut self) -> bool {
+        let usable = !matches!(
+            self.held.status,
+            StressStatus::Infeasible | StressStatus::NumericalError
+        );
+        let current = Best {
+            eps: self.held.eps_inf,
+            energy: self.energy(&self.positions),
+            positions: self.positions.clone(),
+            stress: self.held.clone(),
+        };
+        let first = self.best.stress.force_densities.is_empty();
+        if first || (usable && self.held.eps_inf < self.best.eps) {
+            self.best = current.clone();
+        }
+        if !(usable && self.held.eps_inf < self.settings.tolerance) {
+            return false;
+        }
+        let settled = match &self.feasible {
+            None => current.energy == 0.0,
+            Some(f) => current.energy > (1.0 - tune::settled()) * f.energy,
+        };
+        if self
+            .feasible
+            .as_ref()
+            .is_none_or(|f| current.energy < f.energy)
+        {
+            self.feasible = Some(current);
+        }
+        settled
+    }
+
+    /// One stress QP at the current heights, with the held forces as proximal centre. An
+    /// answer that balances the shape worse than the held forces (a QP stopped short of its
+    /// optimum) gives way to them once the dual-length smoothing has faded.
+    fn stress_step(&mut self, held: Option<&StressResult>) -> Result<StressResult> {
+        let t = Instant::now();
+        let settings = self.step_settings();
+        let prior = held.filter(|s| s.status.is_solved()).map(|s| Prior {
+            force_densities: &s.force_densities,
+            weight: self.settings.proximal_weight,
+            lifted_first: s.lifted,
+        });
+        self.cache
+            .far_from_balance(held.is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
+        let answer = analyse_cached(
+            self.problem,
+            &self.positions,
+            &settings,
+            prior,
+            &mut self.cache,
+        )?;
+        self.solvers.push(answer.solver);
+        let answer = match held {
+            Some(h)
+                if settings.dual_length_smoothing == 0.0
+                    && answer.status != StressStatus::Infeasible
+                    && self.merit(&self.positions, h) < self.merit(&self.positions, &answer) =>
+            {
+                h.clone()
+            }
+            _ => answer,
+        };
+        self.iterations += 1;
+        self.history.push(answer.eps_inf);
+        self.stress_seconds += t.elapsed().as_secs_f64();
+        Ok(answer)
+    }
+
+    /// The stress settings of the next step: the dual-length smoothing fades geometrically.
+    fn step_settings(&self) -> StressSettings {
+        let s = &self.settings.stress;
+        let factor = self.settings.smoothing_decay.powi(self.iterations as i32);
+        StressSettings {
+            dual_length_smoothing: if factor > 1e-12 {
+                s.dual_length_smoothing * factor
+            } else {
+                0.0
+            },
+            ..s.clone()
+        }
+    }
+
+    /// Bookkeeping after a stress step: best state, progress callback, and the terminations
+    /// a stress step decides.
+    fn after_stress_step(&mut self) -> Option<Termination> {
+        let (k, eps) = (self.iterations - 1, self.held.eps_inf);
+        if let Some(cb) = self.progress.as_mut() {
+            if !cb(k, eps) {
+                return Some(Termination::Cancelled);
+            }
+        }
+        match self.held.status {
+            StressStatus::Infeasible => {
+                return Some(Termination::Infeasible {
+                    constraint: infeasibility_hint(&self.settings.stress),
+                })
+            }
+            StressStatus::NumericalError => {
+                return Some(Termination::NumericalError {
+                    what: "the stress QP failed".into(),
+                })
+            }
+            _ => {}
+        }
+        (self.iterations >= self.settings.max_iterations.max(1))
+            .then_some(Termination::MaxIterations)
+    }
+
+    /// The starting w: the least, on a geometric grid from the weight that balances the
+    /// diagonals of both terms' Hessians, whose height step (held forces) lowers the residual
+    /// term R by `tune::initial_decrease()`. Smaller weights spend stress steps on a shape the pull
+    /// holds in place; larger ones start the continuation where little of the input is kept.
+    fn initial_weight(&self) -> Result<f64> {
+        let kappa = self.mean_ktk_diagonal(&self.held.force_densities);
+        let p_bar = mean_load(&self.held, self.shape.vertices());
+        let r0 = residual_term(&self.held, self.shape.vertices());
+        let start = if kappa > 0.0 {
+            p_bar * p_bar / (self.l0 * self.l0 * kappa)
+        } else {
+            1.0
+        };
+        let mut w = start;
+        let settings = self.step_settings();
+        for _ in 0..INITIAL_WEIGHT_TRIALS {
+            let target = self.height_target(w)?;
+            let trial = self.with_heights(&target);
+            let r = residual_term(
+                &self.held.at_heights(self.problem, &trial, &settings),
+                self.shape.vertices(),
+            );
+            if std::env::var_os("VSR_TRACE").is_some() {
+                eprintln!("w0 trial {w:.3e}: R {r:.3e} of {r0:.3e}");
+            }
+            if r <= (1.0 - tune::initial_decrease()) * r0 {
+                return Ok(w);
+            }
+            w *= INITIAL_WEIGHT_FACTOR;
+        }
+        Ok(start)
+    }
+
+    /// Mean diagonal of KᵀK, K = L_q[V_N, V_N]: (Σ_e q_e)² at the vertex plus q_e² per free
+    /// neighbour.
+    fn mean_ktk_diagonal(&self, q: &[f64]) -> f64 {
+        let mesh = &self.problem.mesh;
+        let rows = self.shape.vertices();
+        let sum: f64 = rows
+            .iter()
+            .map(|&v| {
+                let edges = mesh.edges_at(v as usize);
+                let total: f64 = edges.iter().map(|&e| q[e as usize]).sum();
+                let free: f64 = edges
+                    .iter()
+                    .filter(|&&e| mesh.is_non_anchored(mesh.other_end(e as usize, v) as usize))
+                    .map(|&e| q[e as usize].powi(2))
+                    .sum();
+                total * total + free
+            })
+            .sum();
+        sum / rows.len().max(1) as f64
+    }
+
+    /// The augmented Lagrangian E + λᵀr̂ + w ‖r̂‖² (up to a constant: E + w ‖r̂ + λ/2w‖²) at
+    /// heights `positions` with forces `s` certified there, r̂ = r / (p̄ √n).
+    fn merit(&self, positions: &[[f64; 3]], s: &StressResult) -> f64 {
+        let rows = self.shape.vertices();
+        let scale = mean_load(s, rows) * (rows.len() as f64).sqrt();
+        let shifted: f64 = (rows.iter().zip(&self.lambda))
+            .map(|(&v, l)| (s.residuals[v as usize] / scale + l / (2.0 * self.w)).powi(2))
+            .sum();
+        self.energy(positions) + self.w * shifted
+    }
+
+    /// λ ← λ + 2w r̂ at the current state; w grows when ‖r̂‖ has not fallen to a quarter of its
+    /// value at the last update (the method of multipliers' penalty rule).
+    fn update_multipliers(&mut self, last_norm: &mut f64) {
+        let rows = self.shape.vertices();
+        let scale = mean_load(&self.held, rows) * (rows.len() as f64).sqrt();
+        let mut norm = 0.0;
+        for (l, &v) in self.lambda.iter_mut().zip(rows) {
+            let r = self.held.residuals[v as usize] / scale;
+            *l += 2.0 * self.w * r;
+            norm += r * r;
+        }
+        let norm = norm.sqrt();
+        if norm > tune::residual_factor() * *last_norm {
+            self.w *= tune::growth();
+        }
+        *last_norm = norm;
+        self.shift_loads();
+    }
+
+    /// The load offset −p̄ √n λ / 2w per vertex that makes the stress and height steps minimise
+    /// ‖r̂ + λ/2w‖²; handed to the stress steps through the cache.
+    fn shift_loads(&mut self) {
+        let rows = self.shape.vertices();
+        let scale = mean_load(&self.held, rows) * (rows.len() as f64).sqrt();
+        let mut offset = vec![0.0; self.positions.len()];
+        for (l, &v) in self.lambda.iter().zip(rows) {
+            offset[v as usize] = -scale * l / (2.0 * self.w);
+        }
+        self.load_offset = offset.clone();
+        self.cache.set_load_offset(Some(offset));
+    }
+
+    /// E: the area-weighted squared change plus the fairness term, in frame units.
+    fn energy(&self, positions: &[[f64; 3]]) -> f64 {
+        let d = |v: u32| (positions[v as usize][2] - self.z0[v as usize]) / self.l0;
+        let rows = self.shape.vertices();
+        let mut e: f64 = rows
+            .iter()
+            .zip(&self.area)
+            .map(|(&v, a)| a * d(v).powi(2))
+            .sum();
+        if let Some(c) = &self.fair {
+            let mesh = &self.problem.mesh;
+            let gamma = self.settings.fairness;
+            for (edge, ce) in mesh.edges.iter().zip(c) {
+                let [i, j] = edge.v;
+                e += gamma * ce * (d(i) - d(j)).powi(2);
+            }
+        }
+        e
+    }
+
+    /// A height step for the held forces: the minimiser of F_w with the loads lagged, shortened
+    /// to the height limit and until F_w (loads recomputed) decreases. Returns whether the
+    /// heights moved; `held` is then certified at the new heights.
+    fn height_step(&mut self) -> Result<bool> {
+        let t = Instant::now();
+        let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
+        let target = self.height_target(self.w)?;
+        let relax = std::env::var("VSR_RELAX")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1.0f64);
+        let target: Vec<f64> = (z.iter().zip(&target))
+            .map(|(a, b)| a + relax * (b - a))
+            .collect();
+        let mut step = self.limit_step(&z, &target);
+        let settings = self.step_settings();
+        let current = self.merit(&self.positions, &self.held);
+        let mut moved = false;
+        for _ in 0..=BACKTRACKS {
+            let partial: Vec<f64> = (z.iter().zip(&target))
+                .map(|(a, b)| a + step * (b - a))
+                .collect();
+            let trial = self.with_heights(&partial);
+            let certified = self.held.at_heights(self.problem, &trial, &settings);
+            if self.merit(&trial, &certified) < current {
+                self.positions = trial;
+                self.held = certified;
+                moved = true;
+                break;
+            }
+            step *= 0.5;
+        }
+        self.shape_seconds += t.elapsed().as_secs_f64();
+        Ok(moved)
+    }
+
+    /// The minimiser over z of F_w for the held forces, loads lagged.
+    fn height_target(&self, w: f64) -> Result<Vec<f64>> {
+        let rows = self.shape.vertices();
+        let p_bar = mean_load(&self.held, rows);
+        let rho = rows.len() as f64 * p_bar * p_bar / (w * self.l0 * self.l0);
+        let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
+        let fair = self.fair.as_deref().map(|c| (self.settings.fairness, c));
+        let loads: Vec<f64> = (self.held.loads.iter().zip(&self.load_offset))
+            .map(|(p, o)| p + o)
+            .collect();
+        self.shape.nearest(
+            &self.held.force_densities,
+            &loads,
+            &z,
+            &self.z0,
+            rho,
+            &self.area,
+            fair,
+        )
+    }
+
+    /// The current positions with heights `z`.
+    fn with_heights(&self, z: &[f64]) -> Vec<[f64; 3]> {
+        (self.positions.iter().zip(z))
+            .map(|(p, &h)| [p[0], p[1], h])
+            .collect()
+    }
+
+    /// The largest fraction of the step from `z` to `target` (at most 1) that keeps every
+    /// height within the limit of the input.
+    fn limit_step(&self, z: &[f64], target: &[f64]) -> f64 {
+        let mut step = 1.0f64;
+        for &v in self.shape.vertices() {
+            let v = v as usize;
+            let (from, to) = (z[v] - self.z0[v], target[v] - self.z0[v]);
+            if to.abs() > self.limit {
+                let edge = self.limit.copysign(to);
+                step = step.min(((edge - from) / (to - from)).clamp(0.0, 1.0));
+            }
+        }
+        step
+    }
+
+    /// The vertices whose height change is at the limit (within a millionth of it).
+    fn at_limit(&self) -> Vec<u32> {
+        (self.shape.vertices().iter().copied())
+            .filter(|&v| {
+                let v = v as usize;
+                (self.positions[v][2] - self.z0[v]).abs() >= self.limit * (1.0 - 1e-6)
+            })
+            .collect()
+    }
+
+    /// The termination of a loop whose best ε∞ stopped improving.
+    fn stalled(&self) -> Termination {
+        let at_limit = self.at_limit();
+        if !at_limit.is_empty() {
+            let hint = if self.settings.stress.q_max.is_some() {
+                "q_max holds the force densities down, so standing needs heights beyond the \
+                 limit (raise q_max or max_height_change)"
+            } else {
+                "the shape cannot stand within the height limit (raise max_height_change)"
+            };
+            return Termination::HeightLimit {
+                vertices: at_limit,
+                hint: hint.into(),
+            };
+        }
+        Termination::Stalled {
+            vertices: blocking_vertices(self.problem, &self.held),
+        }
+    }
+}
+
+fn numerical(e: crate::Error) -> Termination {
+    Termination::NumericalError {
+        what: e.to_string(),
+    }
+}
+
+/// Mean load over the rows (1 when zero, as the stress step's scale).
+fn mean_load(s: &StressResult, rows: &[u32]) -> f64 {
+    let sum: f64 = rows.iter().map(|&v| s.loads[v as usize]).sum();
+    let mean = sum / rows.len().max(1) as f64;
+    if mean > 0.0 {
+        mean
+    } else {
+        1.0
+    }
+}
+
+/// R: the mean over the rows of (r_i / p̄)².
+fn residual_term(s: &StressResult, rows: &[u32]) -> f64 {
+    let p_bar = mean_load(s, rows);
+    let sum: f64 = rows
+        .iter()
+        .map(|&v| (s.residuals[v as usize] / p_bar).powi(2))
+        .sum();
+    sum / rows.len().max(1) as f64
+}
+
+/// c_e = (plan area of the faces beside e) / (3 l_e²) over the plan area of the mesh, in frame
+/// units (lengths over `l0`): Σ_e c_e (Δ_i − Δ_j)² approximates the mean squared gradient of Δ
+/// over the plan.
+fn fairness_weights(problem: &Problem, positions: &[[f64; 3]], l0: f64) -> Vec<f64> {
+    let mesh = &problem.mesh;
+    let face_area: Vec<f64> = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| positions[v as usize]);
+            ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs() / 2.0
+        })
+        .collect();
+    let total: f64 = face_area.iter().sum();
+    mesh.edges
+        .iter()
+        .map(|e| {
+            let beside: f64 = [e.left, e.right]
+                .iter()
+                .flatten()
+                .map(|s| face_area[s.face as usize])
+                .sum();
+            let [a, b] = e.v.map(|v| positions[v as usize]);
+            let l2 = (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2);
+            if l2 > 0.0 && total > 0.0 {
+                beside * l0 * l0 / (3.0 * l2 * total)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// A stand-in result before the first stress step.
+fn placeholder() -> StressResult {
+    StressResult {
+        status: StressStatus::NumericalError,
+        force_densities: Vec::new(),
+        airy: Vec::new(),
+        weights: Vec::new(),
+        hole_coefficients: Vec::new(),
+        tau: Vec::new(),
+        external_horizontal: Vec::new(),
+        loads: Vec::new(),
+        residuals: Vec::new(),
+        horizontal_imbalance: Vec::new(),
+        eps_inf: f64::INFINITY,
+        objective: f64::INFINITY,
+        force_diagram: Default::default(),
+        iterations: 0,
+        solver: QpSolver::Native,
+        formulation: Default::default(),
+        lifted: false,
+        regularisation: 0.0,
+        seconds: 0.0,
+    }
+}
+
+mod tune {
+    fn get(name: &str, default: f64) -> f64 {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    }
+    pub fn stage_decrease() -> f64 {
+        get("VSR_DECREASE", super::STAGE_DECREASE)
+    }
+    pub fn stage_rounds() -> usize {
+        get("VSR_ROUNDS", super::STAGE_ROUNDS as f64) as usize
+    }
+    pub fn growth() -> f64 {
+        get("VSR_GROWTH", super::GROWTH)
+    }
+    pub fn residual_factor() -> f64 {
+        get("VSR_RFAC", super::RESIDUAL_FACTOR)
+    }
+    pub fn settled() -> f64 {
+        get("VSR_SETTLED", super::SETTLED)
+    }
+    pub fn initial_decrease() -> f64 {
+        get("VSR_INIT", super::INITIAL_DECREASE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::{self, KnownPlan, Perturbation};
+
+    #[test]
+    fn every_accepted_step_lowers_the_merit() {
+        let settings = FormFindSettings::default();
+        let truth = generate::self_supporting(KnownPlan::Disk, 300, &settings).unwrap();
+        let problem = Problem::new(generate::perturb(&truth, Perturbation::Dent, 1));
+        let mut s = Nearest::new(&problem, &settings, None).unwrap();
+        s.held = s.stress_step(None).unwrap();
+        s.w = s.initial_weight().unwrap();
+        let mut last_norm = residual_term(&s.held, s.shape.vertices()).sqrt();
+        let mut merit = s.merit(&s.positions, &s.held);
+        let mut moves = 0;
+        for round in 0..12 {
+            moves += s.height_step().unwrap() as usize;
+            let after_height = s.merit(&s.positions, &s.held);
+            assert!(
+                after_height <= merit,
+                "round {round}: {merit:e} -> {after_height:e}"
+            );
+            let prior = s.held.clone();
+            s.held = s.stress_step(Some(&prior)).unwrap();
+            let after_stress = s.merit(&s.positions, &s.held);
+            assert!(
+                after_stress <= after_height,
+                "round {round}: stress step raised it"
+            );
+            merit = after_stress;
+            if round % 3 == 2 {
+                // A new multiplier estimate is a new merit function.
+                s.update_multipliers(&mut last_norm);
+                merit = s.merit(&s.positions, &s.held);
+            }
+        }
+        assert!(moves >= 10, "only {moves} height steps were taken");
+    }
+
+    #[test]
+    fn a_height_step_stops_at_the_limit() {
+        let settings = FormFindSettings {
+            max_height_change: 0.01,
+            ..Default::default()
+        };
+        let problem = Problem::new(generate::cap_dome(1.4, 300).unwrap());
+        let mut s = Nearest::new(&problem, &settings, None).unwrap();
+        s.held = s.stress_step(None).unwrap();
+        s.w = 1e6 * s.initial_weight().unwrap();
+        for _ in 0..3 {
+            s.height_step().unwrap();
+        }
+        let diag = 2.0 * s.l0;
+        let moved = (problem.mesh.positions.iter().zip(&s.positions))
+            .map(|(a, b)| (a[2] - b[2]).abs())
+            .fold(0.0, f64::max);
+        assert!(moved <= 0.01 * diag * (1.0 + 1e-9), "moved {moved}");
+        assert!(moved > 0.005 * diag, "moved only {moved}");
+        assert!(moved < 0.01 * diag * (1.0 - 1e-6) || !s.at_limit().is_empty());
+    }
+}

@@ -1,0 +1,109 @@
+//! Round trips of the nine shared models through every format: OBJ → OFF → PLY (binary and
+//! ASCII) → OBJ keeps positions bit for bit; STL, after welding, keeps the vertex set rounded
+//! to single precision and the connectivity. Skipped when ../shared/data/models is absent.
+
+use std::path::{Path, PathBuf};
+
+use voussoir::io::{self, MeshFormat};
+
+const MODELS: [&str; 9] = [
+    "free_vault",
+    "dome_with_doors",
+    "lilium",
+    "cheese",
+    "four_holes",
+    "neumunster",
+    "hex",
+    "three_pillar",
+    "vault_pq",
+];
+
+fn models_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
+    dir.is_dir().then_some(dir)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("voussoir-formats-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn bits(positions: &[[f64; 3]]) -> Vec<[u64; 3]> {
+    positions.iter().map(|p| p.map(f64::to_bits)).collect()
+}
+
+fn through(dir: &Path, name: &str, format: Option<MeshFormat>, mesh: &io::RawMesh) -> io::RawMesh {
+    let path = dir.join(name);
+    match format {
+        Some(f) => io::write_mesh_as(&path, f, &mesh.0, &mesh.1).unwrap(),
+        None => io::write_mesh(&path, &mesh.0, &mesh.1).unwrap(),
+    }
+    io::read_mesh(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn obj_off_ply_obj_keeps_every_bit() {
+    let Some(models) = models_dir() else {
+        println!("skipped: ../shared/data/models not found");
+        return;
+    };
+    for model in MODELS {
+        let dir = scratch(model);
+        let original = io::read_mesh(&models.join(format!("{model}.obj"))).unwrap();
+        let off = through(&dir, "m.off", None, &original);
+        let ply = through(&dir, "m.ply", None, &off);
+        let ascii = through(&dir, "a.ply", Some(MeshFormat::Ply { binary: false }), &ply);
+        let obj = through(&dir, "m.obj", None, &ascii);
+        assert_eq!(bits(&obj.0), bits(&original.0), "{model}: positions");
+        assert_eq!(obj.1, original.1, "{model}: faces");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn stl_after_welding_keeps_vertices_in_single_precision_and_connectivity() {
+    let Some(models) = models_dir() else {
+        println!("skipped: ../shared/data/models not found");
+        return;
+    };
+    for model in MODELS {
+        let dir = scratch(&format!("{model}-stl"));
+        let (positions, faces) = io::read_mesh(&models.join(format!("{model}.obj"))).unwrap();
+        for (name, format) in [
+            ("m.stl", MeshFormat::Stl { binary: true }),
+            ("a.stl", MeshFormat::Stl { binary: false }),
+        ] {
+            let soup = through(
+                &dir,
+                name,
+                Some(format),
+                &(positions.clone(), faces.clone()),
+            );
+            assert_eq!(soup.0.len(), 3 * faces.len());
+            let welded = io::weld(&soup.0, &soup.1, io::DEFAULT_WELD_TOLERANCE).unwrap();
+            // A one-to-one map between welded and original vertices through the faces.
+            let mut original_of = vec![u32::MAX; welded.positions.len()];
+            for (w, f) in welded.faces.iter().zip(&faces) {
+                for k in 0..3 {
+                    let slot = &mut original_of[w[k] as usize];
+                    assert!(
+                        *slot == u32::MAX || *slot == f[k],
+                        "{model}: {name} merges vertices"
+                    );
+                    *slot = f[k];
+                }
+            }
+            let referenced: std::collections::BTreeSet<u32> =
+                faces.iter().flatten().copied().collect();
+            assert_eq!(welded.positions.len(), referenced.len(), "{model}: {name}");
+            assert!(welded.collapsed_faces.is_empty());
+            for (w, &o) in original_of.iter().enumerate() {
+                let single = positions[o as usize].map(|c| f64::from(c as f32));
+                assert_eq!(welded.positions[w], single, "{model}: {name} vertex {o}");
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
