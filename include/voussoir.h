@@ -326,11 +326,12 @@ enum VsrHoleMode
 #endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
  {
   /**
-   * Default: a constant Airy jump per hole (the paper's hole-induced stress).
+   * A constant Airy jump per hole (the paper's hole-induced stress): a net torque only.
    */
   VSR_HOLE_MODE_CONSTANT = 0,
   /**
-   * An affine jump: also a net horizontal force through the hole.
+   * Default: an affine jump, also a net horizontal force through the hole; the reduced
+   * optimum then equals the edge-based one.
    */
   VSR_HOLE_MODE_AFFINE = 1,
 };
@@ -1047,7 +1048,8 @@ VsrStatus vsr_result_distances(const struct VsrResult *result, double *hausdorff
 VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seconds, double *shape_seconds, double *total_seconds);
 
 /**
- * Creates settings with the documented defaults (those of the Rust `FormFindSettings`):
+ * Creates settings with the documented defaults (those of the Rust `FormFindSettings`, whose
+ * stress settings are the Rust `StressSettings` defaults):
  *
  * | option | default |
  * |---|---|
@@ -1060,7 +1062,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
  * | q_max | none (+INFINITY) |
  * | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
- * | hole mode | `VSR_HOLE_MODE_CONSTANT` |
+ * | hole mode | `VSR_HOLE_MODE_AFFINE` |
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
@@ -1071,9 +1073,10 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
  * | progress callback | none |
  *
- * `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
- * compression). `out` receives a handle owned by the caller (free with
- * `vsr_settings_destroy`); untouched on failure.
+ * `vsr_analyse` uses the same settings, so it gives the answer of the Rust `analyse` with
+ * default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression).
+ * `out` receives a handle owned by the caller (free with `vsr_settings_destroy`); untouched
+ * on failure.
  *
  * # Safety
  * `out` must be writable.
@@ -1156,7 +1159,8 @@ VsrStatus vsr_settings_set_q_max(struct VsrSettings *settings, double value, uin
 VsrStatus vsr_settings_set_tau_mode(struct VsrSettings *settings, uint32_t mode);
 
 /**
- * Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_CONSTANT`.
+ * Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_AFFINE` (the true
+ * optimum); `VSR_HOLE_MODE_CONSTANT` is the paper's hole-induced stress.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

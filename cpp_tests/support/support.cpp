@@ -117,6 +117,10 @@ Solution solve(const MeshData &mesh, Solve how, std::size_t max_iterations) {
     SettingsPtr settings = make_settings();
     check(vsr_settings_set_max_iterations(settings.get(), max_iterations),
           "vsr_settings_set_max_iterations");
+    // reference_check explains the faces along hole cuts and the force diagram's closure
+    // around holes by constant Airy jumps only (no net force through a hole).
+    check(vsr_settings_set_hole_mode(settings.get(), VSR_HOLE_MODE_CONSTANT),
+          "vsr_settings_set_hole_mode");
     VsrResult *raw = nullptr;
     if (how == Solve::Analysis)
         check(vsr_analyse(vmesh.get(), settings.get(), &raw), "vsr_analyse");

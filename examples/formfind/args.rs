@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 
 use voussoir::{
-    EdgeScope, FormFindSettings, FormMethod, Formulation, LoadRule, QBound, QpSolver, TauMode,
+    EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
+    TauMode,
 };
 
 /// The choices of the enumerated options, as spelled on the command line.
@@ -22,6 +23,10 @@ pub const QP_SOLVERS: [(&str, QpSolver); 2] = [
 pub const SCOPES: [(&str, EdgeScope); 2] =
     [("interior", EdgeScope::Interior), ("all", EdgeScope::All)];
 pub const TAUS: [(&str, TauMode); 2] = [("optimize", TauMode::Optimized), ("zero", TauMode::Zero)];
+pub const HOLES: [(&str, HoleMode); 2] = [
+    ("affine", HoleMode::Affine),
+    ("constant", HoleMode::Constant),
+];
 pub const LOADS: [(&str, LoadRule); 3] = [
     ("barycentric", LoadRule::Barycentric),
     ("voronoi", LoadRule::Voronoi),
@@ -105,6 +110,9 @@ Solver:
   --qmin-scope S         interior | all: the edges --qmin applies to       [{scope}]
   --qmax X               upper bound on force densities, as --qmin, or none [{qmax}]
   --tau M                optimize | zero: normal push at free edges        [{tau}]
+  --holes H              affine | constant: how the Airy function jumps
+                         around a hole (constant: the paper's, a torque
+                         only; its optimum can be worse)                   [{holes}]
   --dual-smoothing MU    penalty MU on differences of force-diagram edge
                          lengths at each face (a smoother force diagram)   [{smooth}]
   --smoothing-decay D    form finding fades MU as MU D^k, 0 <= D < 1;
@@ -129,6 +137,7 @@ written), 1 other failure (nothing written).
         scope = name_of(&SCOPES, st.q_min_scope),
         qmax = bound_text(st.q_max),
         tau = name_of(&TAUS, st.tau),
+        holes = name_of(&HOLES, st.holes),
         smooth = st.dual_length_smoothing,
         decay = d.smoothing_decay,
         load = name_of(&LOADS, st.load_rule),
@@ -311,6 +320,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 };
             }
             "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
+            "--holes" => s.stress.holes = choice(&flag, &value()?, &HOLES)?,
             "--dual-smoothing" => s.stress.dual_length_smoothing = number(&flag, &value()?)?,
             "--smoothing-decay" => {
                 let d = number(&flag, &value()?)?;

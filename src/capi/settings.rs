@@ -34,7 +34,8 @@ pub struct VsrSettings {
     pub(crate) user: *mut c_void,
 }
 
-/// Creates settings with the documented defaults (those of the Rust `FormFindSettings`):
+/// Creates settings with the documented defaults (those of the Rust `FormFindSettings`, whose
+/// stress settings are the Rust `StressSettings` defaults):
 ///
 /// | option | default |
 /// |---|---|
@@ -47,7 +48,7 @@ pub struct VsrSettings {
 /// | q_min | 0.05, `VSR_BOUND_KIND_RELATIVE` (× p̄ / L₀), scope `VSR_EDGE_SCOPE_ALL` |
 /// | q_max | none (+INFINITY) |
 /// | τ mode | `VSR_TAU_MODE_OPTIMIZED` |
-/// | hole mode | `VSR_HOLE_MODE_CONSTANT` |
+/// | hole mode | `VSR_HOLE_MODE_AFFINE` |
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | QP solver | `VSR_QP_SOLVER_NATIVE` |
@@ -58,9 +59,10 @@ pub struct VsrSettings {
 /// | ODT sweeps, ODT moves free boundary | 0 (plan never moves), 0 (no) |
 /// | progress callback | none |
 ///
-/// `vsr_analyse` uses the same settings (q_min 0.05 relative by default; set 0 for plain
-/// compression). `out` receives a handle owned by the caller (free with
-/// `vsr_settings_destroy`); untouched on failure.
+/// `vsr_analyse` uses the same settings, so it gives the answer of the Rust `analyse` with
+/// default settings (q_min 0.05 relative by default; set q_min to 0 for plain compression).
+/// `out` receives a handle owned by the caller (free with `vsr_settings_destroy`); untouched
+/// on failure.
 ///
 /// # Safety
 /// `out` must be writable.
@@ -272,7 +274,8 @@ pub unsafe extern "C" fn vsr_settings_set_tau_mode(
     })
 }
 
-/// Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_CONSTANT`.
+/// Sets how holes carry stress: a `VsrHoleMode`. Default `VSR_HOLE_MODE_AFFINE` (the true
+/// optimum); `VSR_HOLE_MODE_CONSTANT` is the paper's hole-induced stress.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -660,7 +663,7 @@ mod tests {
         assert_eq!(f.stress.q_min_scope, EdgeScope::All);
         assert_eq!(f.stress.q_max, None);
         assert_eq!(f.stress.tau, TauMode::Optimized);
-        assert_eq!(f.stress.holes, HoleMode::Constant);
+        assert_eq!(f.stress.holes, HoleMode::Affine);
         assert_eq!(f.stress.load_rule, LoadRule::Barycentric);
         assert_eq!(f.stress.formulation, Formulation::Reduced);
         assert_eq!(f.stress.solver, QpSolver::Native);

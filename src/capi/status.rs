@@ -188,9 +188,10 @@ pub enum VsrTauMode {
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VsrHoleMode {
-    /// Default: a constant Airy jump per hole (the paper's hole-induced stress).
+    /// A constant Airy jump per hole (the paper's hole-induced stress): a net torque only.
     Constant = 0,
-    /// An affine jump: also a net horizontal force through the hole.
+    /// Default: an affine jump, also a net horizontal force through the hole; the reduced
+    /// optimum then equals the edge-based one.
     Affine = 1,
 }
 

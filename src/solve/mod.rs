@@ -8,7 +8,7 @@ mod paper;
 use crate::error::{Error, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
-use crate::stress::{EdgeScope, QBound, QpSolver, StressResult, StressSettings, StressStatus};
+use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -103,11 +103,7 @@ impl Default for FormFindSettings {
     /// edge needs a tie or buttress there).
     fn default() -> Self {
         FormFindSettings {
-            stress: StressSettings {
-                q_min: QBound::Relative(0.05),
-                q_min_scope: EdgeScope::All,
-                ..Default::default()
-            },
+            stress: StressSettings::default(),
             method: FormMethod::Nearest,
             fairness: 0.03,
             max_height_change: 1.0,

@@ -11,11 +11,14 @@ use crate::mesh::{Mesh, Side};
 /// How the Airy function may jump around a hole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HoleMode {
-    /// A constant jump c_h per hole (the paper's hole-induced stress): a net torque.
-    #[default]
+    /// A constant jump c_h per hole (the paper's hole-induced stress): a net torque only, so
+    /// on holes whose rings are anchored or loaded by τ the optimum can lie above the
+    /// edge-based one.
     Constant,
     /// An affine jump c_h + a_h·u: also a net horizontal force through the hole. With it the
-    /// reduced feasible set equals the edge-based one on every domain.
+    /// reduced feasible set equals the edge-based one on every domain, so the reduced optimum
+    /// is the true optimum.
+    #[default]
     Affine,
 }
 

@@ -89,42 +89,71 @@ fn smoothing_rows<'a>(
     })
 }
 
-/// The reference path: clarabel on the (optionally lifted) QP.
-pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
-    let n_y = inp.s.ncols;
-    let n_vertices = inp.u.len();
-    // `force` maps the QP variables to q: S itself, or a selection of lifted q variables.
-    let lifted;
-    let force = if inp.lift_forces {
-        let mut sel = Csr::new(n_y + inp.bounds.iter().flatten().count());
-        let mut c = n_y;
-        for b in inp.bounds {
-            sel.push_row(if b.is_some() {
-                vec![(c, 1.0)]
-            } else {
-                Vec::new()
-            });
-            c += b.is_some() as usize;
-        }
-        lifted = sel;
-        &lifted
-    } else {
-        inp.s
-    };
-    let n_base = force.ncols;
-    let mut tau_col = vec![None; n_vertices];
+/// Per vertex, the column of its optimised τ (numbered from `first`, in vertex order), and
+/// how many there are.
+fn tau_columns(inp: &QpInput, first: usize) -> (Vec<Option<usize>>, usize) {
+    let mut tau_col = vec![None; inp.u.len()];
     let mut n_tau = 0;
     for (v, nrm) in inp.tau_normal.iter().enumerate() {
         if nrm.is_some() {
-            tau_col[v] = Some(n_base + n_tau);
+            tau_col[v] = Some(first + n_tau);
             n_tau += 1;
         }
     }
-    let r_start = n_base + n_tau;
-    let n = r_start + inp.residual_vertices.len();
+    (tau_col, n_tau)
+}
 
-    // Objective: ½ xᵀ P x with P = 2 (ε Sᵀ D S + μ Σ_pairs a aᵀ ⊕ 0 ⊕ I), upper triangle
-    // (a: the smoothing row l_a S_a − l_b S_b).
+/// Per vertex, its incident edges that carry a force (those with bounds).
+fn incident_edges(inp: &QpInput) -> Vec<Vec<usize>> {
+    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); inp.u.len()];
+    for (e, ev) in inp.edges.iter().enumerate() {
+        if inp.bounds[e].is_some() {
+            incident[ev[0] as usize].push(e);
+            incident[ev[1] as usize].push(e);
+        }
+    }
+    incident
+}
+
+/// The end of edge `e` that is not `v`.
+fn other_end(inp: &QpInput, e: usize, v: usize) -> usize {
+    let ev = inp.edges[e];
+    if ev[0] as usize == v {
+        ev[1] as usize
+    } else {
+        ev[0] as usize
+    }
+}
+
+/// The selection of lifted force-density variables (columns after y) per edge with a force.
+fn lifted_selection(inp: &QpInput) -> Csr {
+    let n_y = inp.s.ncols;
+    let mut sel = Csr::new(n_y + inp.bounds.iter().flatten().count());
+    let mut c = n_y;
+    for b in inp.bounds {
+        sel.push_row(if b.is_some() {
+            vec![(c, 1.0)]
+        } else {
+            Vec::new()
+        });
+        c += b.is_some() as usize;
+    }
+    sel
+}
+
+/// The variables of clarabel's QP: the map `force` from them to q, and the columns of τ and
+/// of the residuals r after it.
+struct ClarabelColumns<'a> {
+    force: &'a Csr,
+    tau_col: Vec<Option<usize>>,
+    r_start: usize,
+    n: usize,
+}
+
+/// clarabel's objective ½ xᵀ P x with P = 2 (ε Sᵀ D S + μ Σ_pairs a aᵀ ⊕ 0 ⊕ I), upper
+/// triangle (a: the smoothing row l_a S_a − l_b S_b).
+fn clarabel_objective(inp: &QpInput, cols: &ClarabelColumns) -> Triplets {
+    let force = cols.force;
     let mut p = Triplets {
         i: vec![],
         j: vec![],
@@ -152,26 +181,30 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
         }
     }
     for k in 0..inp.residual_vertices.len() {
-        p.push(r_start + k, r_start + k, 2.0);
+        p.push(cols.r_start + k, cols.r_start + k, 2.0);
     }
+    p
+}
 
-    // Vertex → incident edges, for the G S and H S rows.
-    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
-    for (e, ev) in inp.edges.iter().enumerate() {
-        if inp.bounds[e].is_some() {
-            incident[ev[0] as usize].push(e);
-            incident[ev[1] as usize].push(e);
-        }
+/// clarabel's constraint rows A x + s = b, s in the cones, in the order the cones take them.
+struct ClarabelRows {
+    a: Triplets,
+    b: Vec<f64>,
+    /// Rows in the zero cone (the first ones); the others are non-negative.
+    n_zero: usize,
+}
+
+impl ClarabelRows {
+    fn count(&self) -> usize {
+        self.b.len()
     }
-    let other = |e: usize, v: u32| {
-        let ev = inp.edges[e];
-        if ev[0] == v {
-            ev[1]
-        } else {
-            ev[0]
-        }
-    };
+}
 
+/// The equality rows of clarabel's QP: vertical residuals, horizontal balance and, lifted,
+/// q_e − S_e y = 0.
+fn clarabel_equalities(inp: &QpInput, cols: &ClarabelColumns) -> ClarabelRows {
+    let (force, tau_col, r_start) = (cols.force, &cols.tau_col, cols.r_start);
+    let incident = incident_edges(inp);
     let mut a = Triplets {
         i: vec![],
         j: vec![],
@@ -182,7 +215,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     // Vertical residuals: Σ_e (z_i − z_j) q_e − r_i = p_i.
     for (k, &i) in inp.residual_vertices.iter().enumerate() {
         for &e in &incident[i as usize] {
-            let dz = inp.z[i as usize] - inp.z[other(e, i) as usize];
+            let dz = inp.z[i as usize] - inp.z[other_end(inp, e, i as usize)];
             for (c, s) in force.row(e) {
                 a.push(row, c, dz * s);
             }
@@ -195,7 +228,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     for &i in inp.balance_vertices {
         for d in 0..2 {
             for &e in &incident[i as usize] {
-                let du = inp.u[i as usize][d] - inp.u[other(e, i) as usize][d];
+                let du = inp.u[i as usize][d] - inp.u[other_end(inp, e, i as usize)][d];
                 for (c, s) in force.row(e) {
                     a.push(row, c, du * s);
                 }
@@ -220,8 +253,14 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
             }
         }
     }
-    let n_zero = row;
-    // Bounds: q_e − lower ≥ 0, upper − q_e ≥ 0, τ ≥ 0.
+    ClarabelRows { a, b, n_zero: row }
+}
+
+/// Appends the inequality rows: q_e − lower ≥ 0, upper − q_e ≥ 0, τ ≥ 0.
+fn clarabel_bounds(inp: &QpInput, cols: &ClarabelColumns, rows: &mut ClarabelRows) {
+    let force = cols.force;
+    let (a, b) = (&mut rows.a, &mut rows.b);
+    let mut row = b.len();
     for (e, bound) in inp.bounds.iter().enumerate() {
         if let Some((lower, _)) = bound {
             for (c, s) in force.row(e) {
@@ -240,27 +279,54 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
             row += 1;
         }
     }
-    for c in tau_col.iter().flatten() {
+    for c in cols.tau_col.iter().flatten() {
         a.push(row, *c, -1.0);
         b.push(0.0);
         row += 1;
     }
+}
 
-    let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
-    let am = CscMatrix::new_from_triplets(row, n, a.i, a.j, a.v);
-    // Linear part of the regulariser around the prior: −2 ε l² q̂ on each q_e.
-    let mut q = vec![0.0; n];
+/// Linear part of the regulariser around the prior: −2 ε l² q̂ on each q_e.
+fn clarabel_linear_term(inp: &QpInput, cols: &ClarabelColumns) -> Vec<f64> {
+    let mut q = vec![0.0; cols.n];
     if let Some(prior) = inp.prior {
         for (e, centre) in prior.iter().enumerate() {
             let w = -2.0 * inp.regularisation * inp.length[e] * inp.length[e] * centre;
-            for (c, v) in force.row(e) {
+            for (c, v) in cols.force.row(e) {
                 q[c] += w * v;
             }
         }
     }
+    q
+}
+
+/// The reference path: clarabel on the (optionally lifted) QP.
+pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
+    let n_y = inp.s.ncols;
+    let n_vertices = inp.u.len();
+    // `force` maps the QP variables to q: S itself, or a selection of lifted q variables.
+    let lifted = inp.lift_forces.then(|| lifted_selection(inp));
+    let force = lifted.as_ref().unwrap_or(inp.s);
+    let n_base = force.ncols;
+    let (tau_col, n_tau) = tau_columns(inp, n_base);
+    let r_start = n_base + n_tau;
+    let cols = ClarabelColumns {
+        force,
+        tau_col,
+        r_start,
+        n: r_start + inp.residual_vertices.len(),
+    };
+    let n = cols.n;
+    let p = clarabel_objective(inp, &cols);
+    let mut rows = clarabel_equalities(inp, &cols);
+    clarabel_bounds(inp, &cols, &mut rows);
+    let row = rows.count();
+    let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
+    let am = CscMatrix::new_from_triplets(row, n, rows.a.i, rows.a.j, rows.a.v);
+    let q = clarabel_linear_term(inp, &cols);
     let cones = [
-        SupportedConeT::ZeroConeT(n_zero),
-        SupportedConeT::NonnegativeConeT(row - n_zero),
+        SupportedConeT::ZeroConeT(rows.n_zero),
+        SupportedConeT::NonnegativeConeT(row - rows.n_zero),
     ];
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
@@ -272,7 +338,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
         .tol_feas(1e-10)
         .build()
         .expect("static clarabel settings are valid");
-    let mut solver = match DefaultSolver::new(&pm, &q, &am, &b, &cones, settings) {
+    let mut solver = match DefaultSolver::new(&pm, &q, &am, &rows.b, &cones, settings) {
         Ok(s) => s,
         Err(_) => {
             return QpOutput {
@@ -286,7 +352,11 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     };
     solver.solve();
     let x = &solver.solution.x;
-    let tau = tau_col.iter().map(|c| c.map_or(0.0, |c| x[c])).collect();
+    let tau = cols
+        .tau_col
+        .iter()
+        .map(|c| c.map_or(0.0, |c| x[c]))
+        .collect();
     QpOutput {
         y: x[..n_y].to_vec(),
         tau,
@@ -296,38 +366,17 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
     }
 }
 
-/// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
-/// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
-/// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
-/// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns).
-pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) -> QpOutput {
-    let n_y = inp.s.ncols;
-    let n_vertices = inp.u.len();
-    let mut tau_col = vec![None; n_vertices];
-    let mut n = n_y;
-    for (v, nrm) in inp.tau_normal.iter().enumerate() {
-        if nrm.is_some() {
-            tau_col[v] = Some(n);
-            n += 1;
-        }
-    }
-    let mut incident: Vec<Vec<usize>> = vec![Vec::new(); n_vertices];
-    for (e, ev) in inp.edges.iter().enumerate() {
-        if inp.bounds[e].is_some() {
-            incident[ev[0] as usize].push(e);
-            incident[ev[1] as usize].push(e);
-        }
-    }
-    let other = |e: usize, v: usize| {
-        let ev = inp.edges[e];
-        if ev[0] as usize == v {
-            ev[1] as usize
-        } else {
-            ev[0] as usize
-        }
-    };
-    // ‖B y − p‖² with B = G S (one row per residual vertex), ε Σ l² (S_e y − q̂_e)² and the
-    // smoothing rows μ (l_a S_a y − l_b S_b y)².
+/// The native QP's objective ½ xᵀ P x + cᵀ x + constant, P = Σ_k w_k a_kᵀ a_k with the rows
+/// a_k of `quad` and weights w_k: ‖B y − p‖² with B = G S (one row per residual vertex),
+/// ε Σ l² (S_e y − q̂_e)² and the smoothing rows μ (l_a S_a y − l_b S_b y)².
+struct NativeObjective {
+    quad: Csr,
+    weight: Vec<f64>,
+    c: Vec<f64>,
+    constant: f64,
+}
+
+fn native_objective(inp: &QpInput, incident: &[Vec<usize>], n: usize) -> NativeObjective {
     let mut quad = Csr::new(n);
     let mut weight = Vec::new();
     let mut c = vec![0.0; n];
@@ -336,7 +385,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         let i = i as usize;
         let mut row = Vec::new();
         for &e in &incident[i] {
-            let dz = inp.z[i] - inp.z[other(e, i)];
+            let dz = inp.z[i] - inp.z[other_end(inp, e, i)];
             row.extend(inp.s.row(e).map(|(col, v)| (col, dz * v)));
         }
         quad.push_row(row);
@@ -370,7 +419,21 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             weight.push(2.0 * inp.smoothing);
         }
     }
-    // Horizontal balance rows: Σ_e (u_i − u_j) S_e y − τ_i ν_i = −P_i.
+    NativeObjective {
+        quad,
+        weight,
+        c,
+        constant,
+    }
+}
+
+/// Horizontal balance rows of the native QP: Σ_e (u_i − u_j) S_e y − τ_i ν_i = −P_i.
+fn native_balance_rows(
+    inp: &QpInput,
+    incident: &[Vec<usize>],
+    tau_col: &[Option<usize>],
+    n: usize,
+) -> (Csr, Vec<f64>) {
     let mut eq = Csr::new(n);
     let mut f = Vec::new();
     for &i in inp.balance_vertices {
@@ -378,7 +441,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         for d in 0..2 {
             let mut row = Vec::new();
             for &e in &incident[i] {
-                let du = inp.u[i][d] - inp.u[other(e, i)][d];
+                let du = inp.u[i][d] - inp.u[other_end(inp, e, i)][d];
                 row.extend(inp.s.row(e).map(|(col, v)| (col, du * v)));
             }
             if let (Some(col), Some(nrm)) = (tau_col[i], inp.tau_normal[i]) {
@@ -388,7 +451,16 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             f.push(-inp.external[i][d]);
         }
     }
-    // S_e y ≥ lower, −S_e y ≥ −upper, τ ≥ 0.
+    (eq, f)
+}
+
+/// Inequality rows of the native QP: S_e y ≥ lower, −S_e y ≥ −upper, τ ≥ 0, with their right
+/// sides and the row of each edge's lower bound (`usize::MAX` for edges without one).
+fn native_bound_rows(
+    inp: &QpInput,
+    tau_col: &[Option<usize>],
+    n: usize,
+) -> (Csr, Vec<f64>, Vec<usize>) {
     let mut ineq = Csr::new(n);
     let mut h = Vec::new();
     let mut lower_row = vec![usize::MAX; inp.edges.len()];
@@ -407,14 +479,29 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         ineq.push_row(vec![(*col, 1.0)]);
         h.push(0.0);
     }
+    (ineq, h, lower_row)
+}
+
+/// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
+/// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
+/// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
+/// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns).
+pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) -> QpOutput {
+    let n_y = inp.s.ncols;
+    let (tau_col, n_tau) = tau_columns(inp, n_y);
+    let n = n_y + n_tau;
+    let incident = incident_edges(inp);
+    let objective = native_objective(inp, &incident, n);
+    let (eq, f) = native_balance_rows(inp, &incident, &tau_col, n);
+    let (ineq, h, lower_row) = native_bound_rows(inp, &tau_col, n);
     let groups = balanced_stars(inp, &incident, &lower_row);
     let positions = unknown_positions(inp, &tau_col, n);
     let out = ipm::solve(
         &ipm::Qp {
-            quad: &quad,
-            quad_weight: &weight,
-            c: &c,
-            constant,
+            quad: &objective.quad,
+            quad_weight: &objective.weight,
+            c: &objective.c,
+            constant: objective.constant,
             eq: &eq,
             f: &f,
             ineq: &ineq,

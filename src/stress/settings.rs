@@ -8,9 +8,9 @@ use crate::geometry::loads::LoadRule;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum EdgeScope {
     /// Interior edges only; boundary creases stay merely q ≥ 0.
-    #[default]
     Interior,
-    /// Interior and boundary edges.
+    /// Interior and boundary edges (default).
+    #[default]
     All,
 }
 
@@ -75,15 +75,20 @@ pub enum QpSolver {
     Clarabel,
 }
 
-/// Settings of one stress step.
+/// Settings of one stress step. The defaults are those of form finding
+/// (`FormFindSettings::default().stress`) and of the C API's `vsr_settings_create`, so that
+/// `analyse` and `vsr_analyse` give the same answer.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StressSettings {
-    /// Lower bound on force densities (default: absolute 0, plain compression).
+    /// Lower bound on force densities (default: 0.05 p̄/L₀, `QBound::Relative(0.05)`, on all
+    /// edges). Set q_min to 0 (`QBound::Absolute(0.0)`) for plain compression.
     pub q_min: QBound,
+    /// The edges q_min applies to (default: all).
     pub q_min_scope: EdgeScope,
     /// Optional upper bound on force densities (allowable stress × thickness).
     pub q_max: Option<QBound>,
     pub tau: TauMode,
+    /// How the Airy function may jump around a hole (default affine: the true optimum).
     pub holes: HoleMode,
     pub load_rule: LoadRule,
     pub formulation: Formulation,
@@ -106,11 +111,11 @@ pub struct StressSettings {
 impl Default for StressSettings {
     fn default() -> Self {
         StressSettings {
-            q_min: QBound::Absolute(0.0),
-            q_min_scope: EdgeScope::Interior,
+            q_min: QBound::Relative(0.05),
+            q_min_scope: EdgeScope::All,
             q_max: None,
             tau: TauMode::Optimized,
-            holes: HoleMode::Constant,
+            holes: HoleMode::Affine,
             load_rule: LoadRule::Barycentric,
             formulation: Formulation::Reduced,
             dual_length_bounds: None,

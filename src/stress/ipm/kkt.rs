@@ -1,7 +1,9 @@
 //! The KKT residuals of an iterate, with the sizes of their terms, and the test of whether the
 //! iterations still make progress.
 
-use super::*;
+use super::pattern::Normal;
+use super::polish::{POLISH_FEAS, POLISH_GAP};
+use super::{abs_mul_t, abs_row_norm, dot, inf_norm, mul_t, Qp, Tolerances};
 
 /// The residuals of the KKT conditions at a point, each with the size of the terms that make
 /// it up (a backward error: at the optimum E x ≈ f is often 0 while its terms are not).

@@ -35,11 +35,11 @@ mod pattern;
 mod polish;
 mod row_groups;
 mod supernodal;
-use kkt::*;
-use newton::*;
+use kkt::{Kkt, Progress};
+use newton::{FactorSpace, Newton, REGULARISATION};
 pub use pattern::PatternCache;
-use pattern::*;
-use polish::*;
+use pattern::{relabel_columns, relabel_vector, stacked, Normal};
+use polish::{active_guess, polish, Corrections, Point, PolishFailure, INEXACT_RETRY};
 pub use row_groups::RowGroups;
 
 /// A QP in the form above.
@@ -420,11 +420,74 @@ fn iterate(
     warm: Option<(&[f64], &[bool])>,
 ) -> IpmOutput {
     let n = qp.c.len();
-    let m_eq = qp.eq.nrows();
-    let m = qp.ineq.nrows();
+    // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
+    let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
+        return stopped(vec![0.0; n], 0, None);
+    };
+    if let Some(out) = warm.and_then(|w| warm_start(qp, normal, cons, w, tol, &mut space)) {
+        return out;
+    }
+    let Some(mut it) = starting_point(qp, normal, cons, start_units, &mut space) else {
+        return stopped(vec![0.0; n], 0, None);
+    };
     // The last iterate that met the relaxed tolerances, returned if the method stops early.
     let mut almost: Option<Vec<f64>> = None;
-    let fail = |x: Vec<f64>, iterations, almost: Option<Vec<f64>>| match almost {
+    let mut polishing = Polishing {
+        below: f64::INFINITY,
+        failed_guess: None,
+    };
+    let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
+    let mut iterations = tol.max_iter;
+    for iteration in 0..tol.max_iter {
+        let kkt = Kkt::new(qp, normal, &it.x, &it.lambda, &it.s, &it.z);
+        if !kkt.objective.is_finite() || inf_norm(&it.x) > 1e15 {
+            return stopped(it.x, iteration, almost);
+        }
+        if kkt.within(tol, tol.almost) {
+            almost = Some(it.x.clone());
+        }
+        if kkt.within(tol, 1.0) {
+            return IpmOutput {
+                active: active_guess(&it.s, &it.z),
+                x: it.x,
+                status: IpmStatus::Solved,
+                iterations: iteration,
+            };
+        }
+        if progress.stalled(iteration, kkt.excess(tol)) && stall_exits {
+            iterations = iteration;
+            break;
+        }
+        let polished = polishing.attempt((qp, normal, cons), &it, &kkt, tol, &mut space);
+        if let Some((x, active)) = polished {
+            return IpmOutput {
+                x,
+                status: IpmStatus::Solved,
+                iterations: iteration + 1,
+                active,
+            };
+        }
+        let Some(dir) = direction(qp, normal, cons, &it, kkt, tol, &mut space) else {
+            return stopped(it.x, iteration, almost);
+        };
+        it.advance(&dir);
+    }
+    IpmOutput {
+        status: if almost.is_some() {
+            IpmStatus::AlmostSolved
+        } else {
+            IpmStatus::MaxIterations
+        },
+        x: almost.unwrap_or(it.x),
+        iterations,
+        active: Vec::new(),
+    }
+}
+
+/// The answer of iterations that stopped early: the last iterate that met the relaxed
+/// tolerances as `AlmostSolved`, else `x` as `NumericalError`.
+fn stopped(x: Vec<f64>, iterations: u32, almost: Option<Vec<f64>>) -> IpmOutput {
+    match almost {
         Some(x) => IpmOutput {
             x,
             status: IpmStatus::AlmostSolved,
@@ -437,64 +500,98 @@ fn iterate(
             iterations,
             active: Vec::new(),
         },
-    };
-    let with_eq_zeros = |d: &[f64]| -> Vec<f64> {
-        let mut out = vec![0.0; m_eq];
-        out.extend_from_slice(d);
-        out
-    };
+    }
+}
 
-    // Starting point (as CVXOPT, with the constraint term weighted down by START_PENALTY):
-    // minimise ½xᵀPx + cᵀx + ½‖U(Gx − h)‖² / START_PENALTY subject to Ex = f, take the slacks
-    // s = Gx − h and the duals z = −s, then shift both into the positive orthant; all in the
-    // caller's units (U = diag(start_units)), converted back at the end.
+/// `d` after `m_eq` zeros (the equality rows' entries).
+fn with_eq_zeros(m_eq: usize, d: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; m_eq];
+    out.extend_from_slice(d);
+    out
+}
+
+/// A form-finding step first tries the previous step's active set: where it is nearly right,
+/// a few active-set corrections reach the optimum for a fraction of the iterations' cost.
+/// Only x and the active set are carried over: the step computes the multipliers afresh,
+/// from zero.
+fn warm_start(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    (x0, guess): (&[f64], &[bool]),
+    tol: &Tolerances,
+    space: &mut FactorSpace,
+) -> Option<IpmOutput> {
+    let (lambda0, z0) = (vec![0.0; qp.eq.nrows()], vec![0.0; qp.ineq.nrows()]);
+    let point = Point {
+        x: x0,
+        lambda: &lambda0,
+        z: &z0,
+    };
+    let warm = polish(
+        qp,
+        normal,
+        cons,
+        &point,
+        (guess, Corrections::AllWhileFewer),
+        tol,
+        space,
+    );
+    warm.ok().map(|(x, active)| IpmOutput {
+        x,
+        status: IpmStatus::Solved,
+        iterations: 0,
+        active,
+    })
+}
+
+/// A primal–dual iterate: x, the equality multipliers λ, the slacks s and their multipliers z.
+struct Iterate {
+    x: Vec<f64>,
+    lambda: Vec<f64>,
+    s: Vec<f64>,
+    z: Vec<f64>,
+}
+
+/// A Newton direction (dx, dλ, ds, dz).
+type Direction = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
+impl Iterate {
+    /// Moves along `dir` 0.99 of the way to the boundary of the positive orthant, at most 1.
+    fn advance(&mut self, (dx, dl, ds, dz): &Direction) {
+        let alpha = (STEP_FRACTION * max_step(&self.s, ds).min(max_step(&self.z, dz))).min(1.0);
+        self.x.iter_mut().zip(dx).for_each(|(a, d)| *a += alpha * d);
+        (self.lambda.iter_mut())
+            .zip(dl)
+            .for_each(|(a, d)| *a += alpha * d);
+        self.s.iter_mut().zip(ds).for_each(|(a, d)| *a += alpha * d);
+        self.z.iter_mut().zip(dz).for_each(|(a, d)| *a += alpha * d);
+    }
+}
+
+/// The starting point, as CVXOPT's with the constraint term weighted down by START_PENALTY:
+/// minimise ½xᵀPx + cᵀx + ½‖U(Gx − h)‖² / START_PENALTY subject to Ex = f, take the slacks
+/// s = Gx − h and the duals z = −s, then shift both into the positive orthant; all in the
+/// caller's units (U = diag(start_units)), converted back at the end.
+fn starting_point(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    start_units: &[f64],
+    space: &mut FactorSpace,
+) -> Option<Iterate> {
+    let m_eq = qp.eq.nrows();
     let minus_c: Vec<f64> = qp.c.iter().map(|c| -c).collect();
     let mut rhs = qp.f.to_vec();
     rhs.extend_from_slice(qp.h);
-    // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
-    let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
-        return fail(vec![0.0; n], 0, None);
-    };
-    // A form-finding step first tries the previous step's active set: where it is nearly
-    // right, a few active-set corrections reach the optimum for a fraction of the
-    // iterations' cost. Only x and the active set are carried over: the step computes the
-    // multipliers afresh, from zero.
-    if let Some((x0, guess)) = warm {
-        let (lambda0, z0) = (vec![0.0; m_eq], vec![0.0; m]);
-        let point = Point {
-            x: x0,
-            lambda: &lambda0,
-            z: &z0,
-        };
-        let warm = polish(
-            qp,
-            normal,
-            cons,
-            &point,
-            (guess, Corrections::AllWhileFewer),
-            tol,
-            &mut space,
-        );
-        if let Ok((x, active)) = warm {
-            return IpmOutput {
-                x,
-                status: IpmStatus::Solved,
-                iterations: 0,
-                active,
-            };
-        }
-    }
     let penalty: Vec<f64> = start_units
         .iter()
         .map(|u| START_PENALTY / (u * u))
         .collect();
-    let start = REGULARISATION.iter().find_map(|&reg| {
-        Newton::new(normal, cons, with_eq_zeros(&penalty), reg, &mut space)?
+    let [x, mut w] = REGULARISATION.iter().find_map(|&reg| {
+        Newton::new(normal, cons, with_eq_zeros(m_eq, &penalty), reg, space)?
             .solve(&minus_c, &rhs, 1e-8, false)
-    });
-    let Some([mut x, mut w]) = start else {
-        return fail(vec![0.0; n], 0, None);
-    };
+    })?;
     // The solve returns w = (Gx − h) / penalty on the inequality rows.
     let s_hat: Vec<f64> = w
         .split_off(m_eq)
@@ -503,7 +600,7 @@ fn iterate(
         .zip(start_units)
         .map(|((w, p), u)| w * p * u)
         .collect();
-    let mut lambda: Vec<f64> = w.iter().map(|v| -v).collect();
+    let lambda: Vec<f64> = w.iter().map(|v| -v).collect();
     // Mehrotra's shift: into the positive orthant, then balanced so that s ∘ z starts centred.
     let mut z: Vec<f64> = s_hat.iter().map(|v| -v).collect();
     let mut s = s_hat;
@@ -522,197 +619,240 @@ fn iterate(
     z.iter_mut()
         .zip(start_units)
         .for_each(|(v, u)| *v = (*v + dz.max(1e-8)) * u);
+    Some(Iterate { x, lambda, s, z })
+}
 
-    // Polishing is attempted only while the gap is below this (see `PolishFailure`).
-    let mut polish_below = f64::INFINITY;
-    // The guess of the last attempt that failed with an early guess: the same guess from
-    // another iterate leads to the same step (a QP's Newton step lands on the optimum for its
-    // active set wherever it starts), so it would fail again.
-    let mut failed_guess: Option<Vec<bool>> = None;
-    let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
-    let mut iterations = tol.max_iter;
-    for iteration in 0..tol.max_iter {
-        let kkt = Kkt::new(qp, normal, &x, &lambda, &s, &z);
-        if !kkt.objective.is_finite() || inf_norm(&x) > 1e15 {
-            return fail(x, iteration, almost);
+/// When the iterations try to solve for the active set directly (see `PolishFailure`).
+struct Polishing {
+    /// Polishing is attempted only while the gap is below this.
+    below: f64,
+    /// The guess of the last attempt that failed with an early guess: the same guess from
+    /// another iterate leads to the same step (a QP's Newton step lands on the optimum for
+    /// its active set wherever it starts), so it would fail again.
+    failed_guess: Option<Vec<bool>>,
+}
+
+impl Polishing {
+    /// Close to the optimum the active set is plain to see: solving for it directly ends the
+    /// iterations the gap would otherwise need to creep down to the tolerance, which near a
+    /// zero objective is at the edge of double precision. The optimum and its active set, if
+    /// this iterate's guess reaches them.
+    fn attempt(
+        &mut self,
+        (qp, normal, cons): (&Qp, &Normal, &Csr),
+        it: &Iterate,
+        kkt: &Kkt,
+        tol: &Tolerances,
+        space: &mut FactorSpace,
+    ) -> Option<(Vec<f64>, Vec<bool>)> {
+        let guess = (kkt.near(tol) && kkt.gap <= self.below).then(|| active_guess(&it.s, &it.z));
+        let guess = guess.filter(|g| self.failed_guess.as_ref() != Some(g))?;
+        let point = Point {
+            x: &it.x,
+            lambda: &it.lambda,
+            z: &it.z,
+        };
+        match polish(
+            qp,
+            normal,
+            cons,
+            &point,
+            (&guess, Corrections::Few),
+            tol,
+            space,
+        ) {
+            Ok(answer) => return Some(answer),
+            Err(PolishFailure::EarlyGuess) => {
+                self.below = f64::INFINITY;
+                self.failed_guess = Some(guess);
+            }
+            Err(PolishFailure::Inexact) => {
+                self.below = INEXACT_RETRY * kkt.gap;
+                self.failed_guess = None;
+            }
         }
-        if kkt.within(tol, tol.almost) {
-            almost = Some(x.clone());
+        None
+    }
+}
+
+/// The right-hand sides of an iteration's Newton systems and the recovery of (ds, dz) from
+/// their solutions.
+struct NewtonSides<'a> {
+    qp: &'a Qp<'a>,
+    s: &'a [f64],
+    z: &'a [f64],
+    r_e: &'a [f64],
+    r_i: &'a [f64],
+}
+
+impl NewtonSides<'_> {
+    /// The constraint rows' right side for a complementarity target r_c (Z ds + S dz = r_c):
+    /// in augmented form P dx + Eᵀ(−dλ) + Gᵀ(−dz) = −r_d,  E dx = −r_e,
+    /// G dx − (s/z)(−dz) = r_c/z − r_i.
+    fn rhs(&self, r_c: &[f64]) -> Vec<f64> {
+        let (z, m) = (self.z, self.s.len());
+        let mut b2: Vec<f64> = self.r_e.iter().map(|v| -v).collect();
+        b2.extend((0..m).map(|i| r_c[i] / z[i] - self.r_i[i]));
+        b2
+    }
+
+    /// The direction from a solution (dx, w) of the augmented system for target `r_c`.
+    fn split(&self, [dx, mut w]: [Vec<f64>; 2], r_c: &[f64]) -> Direction {
+        let (s, z, m) = (self.s, self.z, self.s.len());
+        let w_in = w.split_off(self.qp.eq.nrows());
+        let dl: Vec<f64> = w.iter().map(|w| -w).collect();
+        // Of ds and dz, the one of the larger variable comes from the linear system, the
+        // other from complementarity: dividing by the tiny one would amplify errors.
+        let gdx = self.qp.ineq.mul(&dx);
+        let (mut ds, mut dz) = (vec![0.0; m], vec![0.0; m]);
+        for i in 0..m {
+            if s[i] >= z[i] {
+                ds[i] = gdx[i] + self.r_i[i];
+                dz[i] = (r_c[i] - z[i] * ds[i]) / s[i];
+            } else {
+                dz[i] = -w_in[i];
+                ds[i] = (r_c[i] - s[i] * dz[i]) / z[i];
+            }
         }
-        if kkt.within(tol, 1.0) {
-            return IpmOutput {
-                x,
-                status: IpmStatus::Solved,
-                iterations: iteration,
-                active: active_guess(&s, &z),
-            };
-        }
-        if progress.stalled(iteration, kkt.excess(tol)) && stall_exits {
-            iterations = iteration;
+        (dx, dl, ds, dz)
+    }
+
+    /// The longest step ≤ 1 along (ds, dz) that keeps s and z non-negative.
+    fn step_length(&self, ds: &[f64], dz: &[f64]) -> f64 {
+        max_step(self.s, ds).min(max_step(self.z, dz))
+    }
+}
+
+/// What the corrector of one iteration aims at, besides the sides of its systems.
+struct Aims<'a> {
+    minus_rd: &'a [f64],
+    mu: f64,
+    /// The accuracy the refined direction needs, and the error worth Krylov cycles.
+    precision: f64,
+    krylov_goal: Option<f64>,
+}
+
+/// An iteration's direction: the predictor (affine scaling), then the centred, second-order
+/// corrected step, with the least regularisation whose factor is sound.
+fn direction(
+    qp: &Qp,
+    normal: &Normal,
+    cons: &Csr,
+    it: &Iterate,
+    kkt: Kkt,
+    tol: &Tolerances,
+    space: &mut FactorSpace,
+) -> Option<Direction> {
+    let n = qp.c.len();
+    let m = qp.ineq.nrows();
+    let (s, z) = (&it.s, &it.z);
+    let dual_tolerance = (tol.dual_feas * kkt.dual_scale).max(kkt.dual_floor);
+    let Kkt {
+        r_d,
+        r_e,
+        r_i,
+        gap,
+        dual_scale,
+        ..
+    } = kkt;
+    let mu = if m > 0 { gap / m as f64 } else { 0.0 };
+    let minus_rd: Vec<f64> = r_d.iter().map(|v| -v).collect();
+    let sides = NewtonSides {
+        qp,
+        s,
+        z,
+        r_e: &r_e,
+        r_i: &r_i,
+    };
+    let d: Vec<f64> = (0..m).map(|i| s[i] / z[i]).collect();
+    // The corrector needs an accuracy just ahead of the iterate's own.
+    let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
+    // The direction's own error in the dual residual worth Krylov cycles to remove.
+    let krylov_goal =
+        (!fallback_is_costly(n)).then(|| (KRYLOV_GOAL * inf_norm(&r_d)).max(dual_tolerance));
+    let aims = Aims {
+        minus_rd: &minus_rd,
+        mu,
+        precision,
+        krylov_goal,
+    };
+    REGULARISATION.iter().find_map(|&reg| {
+        let mut newton = Newton::new(normal, cons, with_eq_zeros(qp.eq.nrows(), &d), reg, space)?;
+        corrected_direction(&sides, &mut newton, &aims, tol)
+    })
+}
+
+/// Mehrotra's predictor–corrector with Gondzio's centrality correctors on one factor.
+fn corrected_direction(
+    sides: &NewtonSides,
+    newton: &mut Newton,
+    aims: &Aims,
+    tol: &Tolerances,
+) -> Option<Direction> {
+    let (s, z, m) = (sides.s, sides.z, sides.s.len());
+    let (minus_rd, mu) = (aims.minus_rd, aims.mu);
+    let r_aff: Vec<f64> = (0..m).map(|i| -s[i] * z[i]).collect();
+    let sol = newton.approximate(minus_rd, &sides.rhs(&r_aff));
+    let (_, _, ds_a, dz_a) = sides.split(sol, &r_aff);
+    let alpha_a = sides.step_length(&ds_a, &dz_a);
+    let mu_aff = if m > 0 {
+        (0..m)
+            .map(|i| (s[i] + alpha_a * ds_a[i]) * (z[i] + alpha_a * dz_a[i]))
+            .sum::<f64>()
+            / m as f64
+    } else {
+        0.0
+    };
+    let sigma = if mu > 0.0 {
+        (mu_aff / mu).clamp(0.0, 1.0).powi(3)
+    } else {
+        0.0
+    };
+    let r_c: Vec<f64> = (0..m)
+        .map(|i| -s[i] * z[i] + sigma * mu - ds_a[i] * dz_a[i])
+        .collect();
+    let (r_c, b2, sol) = gondzio_correctors(sides, newton, minus_rd, r_c, sigma * mu, tol);
+    let sol = newton.refine(sol, minus_rd, &b2, aims.precision, false, aims.krylov_goal)?;
+    Some(sides.split(sol, &r_c))
+}
+
+/// Gondzio's centrality correctors, with coarse solves: a few blocking products s_i z_i
+/// otherwise hold the step to a fraction of the way. Returns the kept target, the right side
+/// of its system and its unrefined solution.
+fn gondzio_correctors(
+    sides: &NewtonSides,
+    newton: &mut Newton,
+    minus_rd: &[f64],
+    mut r_c: Vec<f64>,
+    target: f64,
+    tol: &Tolerances,
+) -> (Vec<f64>, Vec<f64>, [Vec<f64>; 2]) {
+    let (s, z, m) = (sides.s, sides.z, sides.s.len());
+    let mut b2 = sides.rhs(&r_c);
+    let mut sol = newton.approximate(minus_rd, &b2);
+    let mut dir = sides.split(sol.clone(), &r_c);
+    let mut alpha = sides.step_length(&dir.2, &dir.3);
+    for _ in 0..tol.correctors {
+        if alpha >= 0.9 || target <= 0.0 {
             break;
         }
-        // Close to the optimum the active set is plain to see: solving for it directly ends
-        // the iterations the gap would otherwise need to creep down to the tolerance, which
-        // near a zero objective is at the edge of double precision.
-        let guess = (kkt.near(tol) && kkt.gap <= polish_below).then(|| active_guess(&s, &z));
-        if let Some(guess) = guess.filter(|g| failed_guess.as_ref() != Some(g)) {
-            let point = Point {
-                x: &x,
-                lambda: &lambda,
-                z: &z,
-            };
-            match polish(
-                qp,
-                normal,
-                cons,
-                &point,
-                (&guess, Corrections::Few),
-                tol,
-                &mut space,
-            ) {
-                Ok((x, active)) => {
-                    return IpmOutput {
-                        x,
-                        status: IpmStatus::Solved,
-                        iterations: iteration + 1,
-                        active,
-                    }
-                }
-                Err(PolishFailure::EarlyGuess) => {
-                    polish_below = f64::INFINITY;
-                    failed_guess = Some(guess);
-                }
-                Err(PolishFailure::Inexact) => {
-                    polish_below = INEXACT_RETRY * kkt.gap;
-                    failed_guess = None;
-                }
-            }
+        let trial = (CORRECTOR_STRETCH * alpha + CORRECTOR_ADD).min(1.0);
+        let mut r_try = r_c.clone();
+        for i in 0..m {
+            let v = (s[i] + trial * dir.2[i]) * (z[i] + trial * dir.3[i]);
+            let want = v.clamp(0.1 * target, 10.0 * target);
+            r_try[i] += (want - v).max(-10.0 * target);
         }
-        let dual_tolerance = (tol.dual_feas * kkt.dual_scale).max(kkt.dual_floor);
-        let Kkt {
-            r_d,
-            r_e,
-            r_i,
-            gap,
-            dual_scale,
-            ..
-        } = kkt;
-        let mu = if m > 0 { gap / m as f64 } else { 0.0 };
-
-        let minus_rd: Vec<f64> = r_d.iter().map(|v| -v).collect();
-        // Direction for a complementarity target r_c (Z ds + S dz = r_c): in augmented form
-        // P dx + Eᵀ(−dλ) + Gᵀ(−dz) = −r_d,  E dx = −r_e,  G dx − (s/z)(−dz) = r_c/z − r_i.
-        let rhs = |r_c: &[f64]| {
-            let mut b2: Vec<f64> = r_e.iter().map(|v| -v).collect();
-            b2.extend((0..m).map(|i| r_c[i] / z[i] - r_i[i]));
-            b2
-        };
-        let split = |[dx, mut w]: [Vec<f64>; 2], r_c: &[f64]| {
-            let w_in = w.split_off(m_eq);
-            let dl: Vec<f64> = w.iter().map(|w| -w).collect();
-            // Of ds and dz, the one of the larger variable comes from the linear system, the
-            // other from complementarity: dividing by the tiny one would amplify errors.
-            let gdx = qp.ineq.mul(&dx);
-            let (mut ds, mut dz) = (vec![0.0; m], vec![0.0; m]);
-            for i in 0..m {
-                if s[i] >= z[i] {
-                    ds[i] = gdx[i] + r_i[i];
-                    dz[i] = (r_c[i] - z[i] * ds[i]) / s[i];
-                } else {
-                    dz[i] = -w_in[i];
-                    ds[i] = (r_c[i] - s[i] * dz[i]) / z[i];
-                }
-            }
-            (dx, dl, ds, dz)
-        };
-        let step_length = |ds: &[f64], dz: &[f64]| max_step(&s, ds).min(max_step(&z, dz));
-        // Predictor (affine scaling), then the centred, second-order corrected step, with the
-        // least regularisation whose factor is sound.
-        let r_aff: Vec<f64> = (0..m).map(|i| -s[i] * z[i]).collect();
-        let d: Vec<f64> = (0..m).map(|i| s[i] / z[i]).collect();
-        // The corrector needs an accuracy just ahead of the iterate's own.
-        let precision = (1e-3 * inf_norm(&r_d) / dual_scale).clamp(1e-2 * tol.feas, 1e-6);
-        // The direction's own error in the dual residual worth Krylov cycles to remove.
-        let krylov_goal =
-            (!fallback_is_costly(n)).then(|| (KRYLOV_GOAL * inf_norm(&r_d)).max(dual_tolerance));
-        let mut step = |reg: f64| {
-            let mut newton = Newton::new(normal, cons, with_eq_zeros(&d), reg, &mut space)?;
-            let sol = newton.approximate(&minus_rd, &rhs(&r_aff));
-            let (_, _, ds_a, dz_a) = split(sol, &r_aff);
-            let alpha_a = step_length(&ds_a, &dz_a);
-            let mu_aff = if m > 0 {
-                (0..m)
-                    .map(|i| (s[i] + alpha_a * ds_a[i]) * (z[i] + alpha_a * dz_a[i]))
-                    .sum::<f64>()
-                    / m as f64
-            } else {
-                0.0
-            };
-            let sigma = if mu > 0.0 {
-                (mu_aff / mu).clamp(0.0, 1.0).powi(3)
-            } else {
-                0.0
-            };
-            let mut r_c: Vec<f64> = (0..m)
-                .map(|i| -s[i] * z[i] + sigma * mu - ds_a[i] * dz_a[i])
-                .collect();
-            // Gondzio's centrality correctors, with coarse solves: a few blocking
-            // products s_i z_i otherwise hold the step to a fraction of the way.
-            let mut b2 = rhs(&r_c);
-            let mut sol = newton.approximate(&minus_rd, &b2);
-            let mut dir = split(sol.clone(), &r_c);
-            let mut alpha = step_length(&dir.2, &dir.3);
-            let target = sigma * mu;
-            for _ in 0..tol.correctors {
-                if alpha >= 0.9 || target <= 0.0 {
-                    break;
-                }
-                let trial = (CORRECTOR_STRETCH * alpha + CORRECTOR_ADD).min(1.0);
-                let mut r_try = r_c.clone();
-                for i in 0..m {
-                    let v = (s[i] + trial * dir.2[i]) * (z[i] + trial * dir.3[i]);
-                    let want = v.clamp(0.1 * target, 10.0 * target);
-                    r_try[i] += (want - v).max(-10.0 * target);
-                }
-                let b_try = rhs(&r_try);
-                let sol_try = newton.approximate(&minus_rd, &b_try);
-                let dir_try = split(sol_try.clone(), &r_try);
-                let a = step_length(&dir_try.2, &dir_try.3);
-                if a < alpha + 0.1 * (trial - alpha) {
-                    break;
-                }
-                (alpha, r_c, b2, sol, dir) = (a, r_try, b_try, sol_try, dir_try);
-            }
-            drop(dir);
-            let sol = newton.refine(sol, &minus_rd, &b2, precision, false, krylov_goal)?;
-            Some(split(sol, &r_c))
-        };
-        let Some((dx, dl, ds, dz)) = REGULARISATION.iter().find_map(|&reg| step(reg)) else {
-            return fail(x, iteration, almost);
-        };
-        let alpha = (STEP_FRACTION * max_step(&s, &ds).min(max_step(&z, &dz))).min(1.0);
-        x.iter_mut().zip(&dx).for_each(|(a, d)| *a += alpha * d);
-        lambda
-            .iter_mut()
-            .zip(&dl)
-            .for_each(|(a, d)| *a += alpha * d);
-        s.iter_mut().zip(&ds).for_each(|(a, d)| *a += alpha * d);
-        z.iter_mut().zip(&dz).for_each(|(a, d)| *a += alpha * d);
+        let b_try = sides.rhs(&r_try);
+        let sol_try = newton.approximate(minus_rd, &b_try);
+        let dir_try = sides.split(sol_try.clone(), &r_try);
+        let a = sides.step_length(&dir_try.2, &dir_try.3);
+        if a < alpha + 0.1 * (trial - alpha) {
+            break;
+        }
+        (alpha, r_c, b2, sol, dir) = (a, r_try, b_try, sol_try, dir_try);
     }
-    match almost {
-        Some(x) => IpmOutput {
-            x,
-            status: IpmStatus::AlmostSolved,
-            iterations,
-            active: Vec::new(),
-        },
-        None => IpmOutput {
-            x,
-            status: IpmStatus::MaxIterations,
-            iterations,
-            active: Vec::new(),
-        },
-    }
+    (r_c, b2, sol)
 }
 
 #[cfg(test)]

@@ -1,8 +1,9 @@
 //! The Newton system of the interior-point method in augmented form, solved with the
 //! regularised factor of the normal matrix and refined against the exact system.
 
-use super::*;
-use super::{factorise, supernodal};
+use super::pattern::Normal;
+use super::{factorise, fallback_is_costly, gmres, inf_norm, mul_t, supernodal};
+use crate::stress::sparse::Csr;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};

@@ -5,8 +5,7 @@
 use super::factorise::Plan;
 use super::ordering::nested_dissection_labels;
 use super::supernodal::Split;
-use super::*;
-use crate::stress::sparse::bucketed;
+use crate::stress::sparse::{bucketed, Csr};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,

@@ -1,7 +1,11 @@
 //! Polishing: the optimum for a guessed active set, solved for directly from an iterate or
 //! from the previous form-finding step's answer, with the guess corrected where it was wrong.
 
-use super::*;
+use super::kkt::Kkt;
+use super::newton::{FactorSpace, Newton, REGULARISATION};
+use super::pattern::Normal;
+use super::{mul_t, Qp, Tolerances};
+use crate::stress::sparse::Csr;
 
 /// When `Kkt::near` holds: residuals within this many times the tolerance, relative gap
 /// below `POLISH_GAP`.

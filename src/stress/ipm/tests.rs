@@ -1,4 +1,18 @@
-use super::*;
+use super::kkt::{Progress, STALL_WINDOW};
+use super::newton::{FactorSpace, Newton};
+use super::pattern::{
+    amd_labels, product_pattern, products, relabel_vector, relabelled_lower, stacked,
+    symbolic_cholesky, transpose, Normal, Pattern, PatternCache,
+};
+use super::polish::{
+    active_guess, polish, polish_step, Corrections, Hopeless, Point, PolishFailure, PolishFrom,
+    PolishStep,
+};
+use super::{
+    factorise, fallback_is_costly, inf_norm, ordering, solve, supernodal, IpmStatus, Qp,
+    Relabelled, RowGroups, Tolerances,
+};
+use crate::stress::sparse::Csr;
 
 fn csr(ncols: usize, rows: &[&[(usize, f64)]]) -> Csr {
     let mut m = Csr::new(ncols);
