@@ -76,9 +76,9 @@ fn run(label: &str, problem: &Problem) -> FormFindResult {
         r.history
     );
     let eps = certify(label, problem, &r);
-    // One ε∞ per stress step, plus the last shape step's certificate when it converged there.
+    // One ε∞ per stress step, plus the certificates of height steps that reached equilibrium.
     assert!(
-        r.history.len() == r.iterations || r.history.len() == r.iterations + 1,
+        r.history.len() >= r.iterations,
         "{label}: {} history entries for {} stress steps",
         r.history.len(),
         r.iterations
@@ -452,7 +452,7 @@ fn dual_length_smoothing_gives_lilium_a_smoother_force_diagram() {
     let problem = Problem::new(mesh);
     // The paper's loop trades nearness for smoothness freely; the nearest method keeps the
     // shape near the input, so the smoothing it can afford is smaller.
-    for (method, factor) in [(FormMethod::Paper, 0.5), (FormMethod::Nearest, 0.9)] {
+    for (method, factor) in [(FormMethod::Paper, 0.5), (FormMethod::Nearest, 1.0)] {
         let mut settings = FormFindSettings {
             method,
             ..Default::default()

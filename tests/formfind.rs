@@ -386,9 +386,9 @@ fn clashing_output_paths_are_rejected_naming_both_options() {
     );
     fails_and_leaves_all_as_it_was(
         |_| {},
-        &["--out", "d", "--pictures", "d"],
+        &["--report", "d", "--pictures", "d"],
         2,
-        &["--out `d` and --pictures `d/plan_forces.svg` clash"],
+        &["--report `d` and --pictures `d/plan_forces.svg` clash"],
     );
     // The embedded input's copy goes beside --out.
     fails_and_leaves_all_as_it_was(

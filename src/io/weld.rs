@@ -29,11 +29,22 @@ pub struct Welded {
 
 impl Welded {
     /// The welded ids of input vertex ids (such as supports), each once, in input order. An
-    /// id `>=` the input vertex count is an [`Error::InvalidAnchor`].
+    /// id `>=` the input vertex count, or listed twice, is an [`Error::InvalidAnchor`].
     pub fn map_ids(&self, ids: &[u32]) -> Result<Vec<u32>> {
         let mut seen = vec![false; self.positions.len()];
+        let mut listed = vec![false; self.welded_id.len()];
         let mut out = Vec::with_capacity(ids.len());
         for &id in ids {
+            // The same input id twice is a mistake; two ids of one seam are not.
+            if listed.get(id as usize).copied() == Some(true) {
+                return Err(Error::InvalidAnchor {
+                    index: u64::from(id),
+                    reason: "listed twice",
+                });
+            }
+            if let Some(flag) = listed.get_mut(id as usize) {
+                *flag = true;
+            }
             let welded = *self
                 .welded_id
                 .get(id as usize)
@@ -65,8 +76,9 @@ pub fn weld(positions: &[[f64; 3]], faces: &[[u32; 3]], relative_tolerance: f64)
     }
     super::atomic::check_positions_finite(positions)?;
     super::atomic::check_face_indices(positions.len(), faces)?;
+    // Coordinates whose diagonal overflows are left to mesh validation, which names them.
     let tolerance = relative_tolerance * diagonal(positions);
-    let welded_id = if tolerance > 0.0 {
+    let welded_id = if tolerance > 0.0 && tolerance.is_finite() {
         weld_within(positions, tolerance)
     } else {
         weld_exact(positions)

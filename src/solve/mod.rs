@@ -133,11 +133,12 @@ pub struct FormFindResult {
     /// loop's stress QPs are solved to coarse optimality (a relative gap of 1e-3) with the same
     /// feasibility, so `Solved` there means an answer within that gap of the optimum.
     pub stress: StressResult,
-    /// ε∞ after each stress step, plus a last entry when the last shape step was certified
-    /// with the previous forces (`stress` is then those forces at `positions`, and the
-    /// progress callback was not called for it). A stress step that stopped short of its
-    /// optimum and balanced the shape worse than the previous forces at the same heights is
-    /// not taken: its entry is those forces' ε∞.
+    /// ε∞ after each stress step, plus certificates of height steps: the paper's loop adds a
+    /// last entry when its last height step was certified with the previous forces; the
+    /// nearest method adds one for every height step that reached equilibrium. The returned
+    /// `stress` is the state of one of these entries (the nearest method's: the nearest state
+    /// in equilibrium, not necessarily the last). A stress step that stopped short of its
+    /// optimum and did worse than the forces at hand is not taken: its entry is theirs.
     pub history: Vec<f64>,
     /// Stress steps taken.
     pub iterations: usize,
