@@ -41,7 +41,7 @@ const BACKTRACKS: usize = 6;
 /// first height step must reach (see `Nearest::initial_weight`).
 const INITIAL_WEIGHT_FACTOR: f64 = 3.0;
 const INITIAL_WEIGHT_TRIALS: usize = 40;
-const INITIAL_DECREASE: f64 = 0.1;
+const INITIAL_DECREASE: f64 = 0.02;
 /// The multipliers are updated where ‖r̂‖ has fallen below this fraction of its value at the
 /// last update; otherwise w grows.
 const RESIDUAL_FACTOR: f64 = 0.5;
