@@ -1,9 +1,7 @@
 //! Wavefront OBJ: `v x y z` vertices and `f` faces (triangulated as a fan).
 
 use std::fs;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 
 use super::{io_error, RawMesh};
 use crate::{Error, Result};
@@ -143,54 +141,16 @@ fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, Strin
 /// temporary file in the same folder and renamed over `path`, so a failure never leaves a
 /// half-written file. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
 pub fn write_obj(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Result<()> {
-    let n = positions.len();
-    if let Some((t, &i)) = faces
-        .iter()
-        .enumerate()
-        .find_map(|(t, f)| f.iter().find(|&&i| i as usize >= n).map(|i| (t, i)))
-    {
-        return Err(Error::InvalidArgument {
-            name: "faces",
-            reason: format!("face {t} refers to vertex {i}, but there are only {n} positions"),
-        });
-    }
-    let tmp = temp_path(path)?;
-    let written = write_to(&tmp, positions, faces).and_then(|()| fs::rename(&tmp, path));
-    if let Err(e) = written {
-        // Best effort: the temporary file may not exist if creating it failed.
-        let _ = fs::remove_file(&tmp);
-        return Err(io_error(path, &e));
-    }
-    Ok(())
-}
-
-fn write_to(tmp: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> std::io::Result<()> {
-    let file = fs::File::create(tmp)?;
-    let mut out = BufWriter::new(file);
-    writeln!(out, "# {} vertices, {} faces", positions.len(), faces.len())?;
-    for p in positions {
-        writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-    }
-    for f in faces {
-        let [a, b, c] = f.map(|i| u64::from(i) + 1);
-        writeln!(out, "f {a} {b} {c}")?;
-    }
-    let file = out.into_inner().map_err(|e| e.into_error())?;
-    file.sync_all()
-}
-
-/// `.NAME.PID.COUNTER.tmp` next to `path`.
-fn temp_path(path: &Path) -> Result<PathBuf> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let Some(name) = path.file_name() else {
-        return Err(Error::Io {
-            path: path.display().to_string(),
-            reason: "not a file path".to_string(),
-        });
-    };
-    let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(name);
-    tmp_name.push(format!(".{}.{unique}.tmp", std::process::id()));
-    Ok(path.with_file_name(tmp_name))
+    super::atomic::check_face_indices(positions.len(), faces)?;
+    super::atomic::write_atomically(path, |out| {
+        writeln!(out, "# {} vertices, {} faces", positions.len(), faces.len())?;
+        for p in positions {
+            writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+        }
+        for f in faces {
+            let [a, b, c] = f.map(|i| u64::from(i) + 1);
+            writeln!(out, "f {a} {b} {c}")?;
+        }
+        Ok(())
+    })
 }
