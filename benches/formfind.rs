@@ -39,6 +39,7 @@ fn method_name(m: FormMethod) -> &'static str {
     match m {
         FormMethod::Nearest => "nearest",
         FormMethod::Paper => "paper",
+        _ => "other",
     }
 }
 
@@ -74,10 +75,7 @@ fn known(seeds: u64, sizes: &[usize]) {
                         .into_iter()
                         .enumerate()
                     {
-                        let s = FormFindSettings {
-                            method,
-                            ..settings.clone()
-                        };
+                        let s = settings.clone().with_method(method);
                         let t = Instant::now();
                         let problem = Problem::new(input.clone());
                         let r = form_find(&problem, &s, None).expect("form finding");
@@ -149,10 +147,7 @@ fn models() {
         .expect("model");
         let problem = Problem::new(mesh);
         for method in [FormMethod::Nearest, FormMethod::Paper] {
-            let s = FormFindSettings {
-                method,
-                ..Default::default()
-            };
+            let s = FormFindSettings::default().with_method(method);
             let t = Instant::now();
             let r = form_find(&problem, &s, None).expect("form finding");
             println!(

@@ -123,11 +123,9 @@ struct Step {
 }
 
 fn step(problem: &Problem, formulation: Formulation, solver: QpSolver) -> Step {
-    let settings = StressSettings {
-        formulation,
-        solver,
-        ..Default::default()
-    };
+    let settings = StressSettings::default()
+        .with_formulation(formulation)
+        .with_solver(solver);
     let mut seconds = Vec::new();
     loop {
         let t = Instant::now();

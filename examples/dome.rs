@@ -53,11 +53,9 @@ fn main() -> Result<(), voussoir::Error> {
         anchored.len()
     );
     let problem = Problem::new(Mesh::new(positions, triangles, &anchored)?);
-    let settings = FormFindSettings {
-        tolerance: 1e-6,
-        max_iterations: 100,
-        ..Default::default()
-    };
+    let settings = FormFindSettings::default()
+        .with_tolerance(1e-6)
+        .with_max_iterations(100);
     let mut progress = |k: usize, eps: f64| {
         println!("  iteration {k:2}  eps_inf = {eps:.3e}");
         true // continue

@@ -8,6 +8,7 @@ const MAX_IDS_SHOWN: usize = 8;
 
 /// Everything that can go wrong before or during a solve.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Error {
     /// An argument is invalid (empty, wrong length, NaN, out of range, ...).
     InvalidArgument { name: &'static str, reason: String },

@@ -250,6 +250,7 @@ pub fn polar_disk(rings: usize) -> PlanMesh {
 
 /// Plans of the known-answer cases ([`self_supporting`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum KnownPlan {
     /// The unit disk, rim anchored.
     Disk,
@@ -343,6 +344,7 @@ pub fn self_supporting(
 
 /// Changes of a self-supporting shape that make the known-answer inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Perturbation {
     /// A smooth concave dent of a third of the rise, off-centre.
     Dent,

@@ -1,25 +1,56 @@
 //! Voussoir: self-supporting masonry shapes (de Goes et al. 2013).
+//!
+//! A vault is a [`Mesh`] (a triangle mesh over a plan with anchored vertices) wrapped in a
+//! [`Problem`] (loads, prescribed forces). [`analyse`] answers whether it can stand: the best
+//! compressive stress for the shape, its force diagram and the residual per vertex.
+//! [`form_find`] finds the nearest shape that can. Meshes are read and written with [`io`];
+//! [`generate`] builds test shapes with known answers; [`capi`] is the C ABI.
+//!
+//! ```
+//! use voussoir::{form_find, generate, FormFindSettings, Problem, Termination};
+//!
+//! let mesh = generate::cap_dome(0.8, 200)?;
+//! let result = form_find(&Problem::new(mesh), &FormFindSettings::default(), None)?;
+//! assert_eq!(result.termination, Termination::Converged);
+//! # Ok::<(), voussoir::Error>(())
+//! ```
 #![deny(unsafe_code)]
 
 pub mod capi;
-pub mod error;
+mod error;
 pub mod generate;
-pub mod geometry;
+mod geometry;
 pub mod io;
-pub mod mesh;
-pub mod problem;
-pub mod shape;
-pub mod smooth;
-pub mod solve;
-pub mod stress;
+mod mesh;
+mod problem;
+mod setters;
+mod shape;
+mod smooth;
+mod solve;
+mod stress;
 
 pub use error::{Error, Result};
+pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;
-pub use mesh::Mesh;
+pub use mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
+pub use mesh::{BoundaryLoop, Edge, Mesh, Side, MAX_COORDINATE, MIN_PLAN_EXTENT};
 pub use problem::Problem;
-pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Termination};
+pub use shape::Schedule;
+pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Progress, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{
     analyse, EdgeScope, Formulation, QBound, QpSolver, StressResult, StressSettings, StressStatus,
-    TauMode,
+    TauMode, MAX_MEAN_LOAD, MIN_MEAN_LOAD,
 };
+
+/// Internals that the integration tests check against independent mathematics. Not part of
+/// the API: compiled only with the `internals` feature, which this package's tests enable.
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::geometry::dual::{edge_normal, power_centre};
+    pub use crate::geometry::{Frame, Plan};
+    pub use crate::stress::airy::AiryOperator;
+    pub use crate::stress::holes::cut_holes;
+    pub use crate::stress::{analyse_at, analyse_cached, StressCache};
+}

@@ -6,6 +6,7 @@ use crate::mesh::Mesh;
 
 /// A mesh and its loading. Construct with [`Problem::new`] and the validating `with_*` setters.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Problem {
     pub mesh: Mesh,
     /// Weight per unit area of each face (density × thickness × g). Default 1.

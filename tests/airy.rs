@@ -4,9 +4,7 @@
 
 mod common;
 use common::{holed_disk, jiggle, Rng};
-use voussoir::geometry::dual::{edge_normal, power_centre};
-use voussoir::geometry::{Frame, Plan};
-use voussoir::stress::airy::AiryOperator;
+use voussoir::internals::{edge_normal, power_centre, AiryOperator, Frame, Plan};
 use voussoir::{HoleMode, Mesh};
 
 fn setup(mesh: &Mesh) -> Plan {

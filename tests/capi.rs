@@ -1101,10 +1101,7 @@ fn both_methods_through_the_c_abi_equal_the_rust_ones_bit_for_bit() {
         assert_ok(unsafe { vsr_settings_set_method(s, method as u32) });
         let mut r = null_mut();
         assert_ok(unsafe { vsr_form_find(mesh, s, &mut r) });
-        let settings = voussoir::FormFindSettings {
-            method: rust_method,
-            ..Default::default()
-        };
+        let settings = voussoir::FormFindSettings::default().with_method(rust_method);
         let expected = voussoir::form_find(&problem, &settings, None).unwrap();
         let flat: Vec<f64> = expected.positions.iter().flatten().copied().collect();
         assert_eq!(doubles(r, vsr_result_positions), flat, "{method:?}");

@@ -111,10 +111,7 @@ fn every_shared_model_converges_with_default_settings() {
         let r = run(name, &problem);
         assert_eq!(r.solvers.len(), r.iterations, "{name}");
         // The paper's loop also converges, and the nearest shape changes the input less.
-        let paper = FormFindSettings {
-            method: FormMethod::Paper,
-            ..Default::default()
-        };
+        let paper = FormFindSettings::default().with_method(FormMethod::Paper);
         let p = form_find(&problem, &paper, None).unwrap();
         assert_eq!(p.termination, Termination::Converged, "{name}: paper");
         certify(name, &problem, &p);
@@ -267,10 +264,7 @@ fn a_light_or_heavy_cap_changes_the_shape() {
         })
         .collect();
     let (mut crowns, mut nearest) = (Vec::new(), Vec::new());
-    let paper = FormFindSettings {
-        method: FormMethod::Paper,
-        ..Default::default()
-    };
+    let paper = FormFindSettings::default().with_method(FormMethod::Paper);
     for factor in [0.1, 1.0, 5.0] {
         let density = cap.iter().map(|&c| if c { factor } else { 1.0 }).collect();
         let problem = Problem::new(mesh.clone())
@@ -331,10 +325,7 @@ fn infeasible_bounds_are_reported_not_hidden() {
 fn odt_smoothing_improves_the_plan_and_never_flips_a_triangle() {
     let base = common::jiggle(&common::holed_disk(11, 0.01, |_, outer| outer), 11, 0.35);
     let problem = Problem::new(base.clone());
-    let settings = FormFindSettings {
-        odt_iterations: 3,
-        ..Default::default()
-    };
+    let settings = FormFindSettings::default().with_odt_iterations(3);
     let r = form_find(&problem, &settings, None).unwrap();
     assert_eq!(r.termination, Termination::Converged, "{:?}", r.history);
     certify("odt", &problem, &r);
@@ -453,10 +444,7 @@ fn dual_length_smoothing_gives_lilium_a_smoother_force_diagram() {
     // The paper's loop trades nearness for smoothness freely; the nearest method keeps the
     // shape near the input, so the smoothing it can afford is smaller.
     for (method, factor) in [(FormMethod::Paper, 0.5), (FormMethod::Nearest, 1.0)] {
-        let mut settings = FormFindSettings {
-            method,
-            ..Default::default()
-        };
+        let mut settings = FormFindSettings::default().with_method(method);
         let plain = form_find(&problem, &settings, None).unwrap();
         assert_eq!(plain.termination, Termination::Converged, "{method:?}");
         settings.stress.dual_length_smoothing = 1.0;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use voussoir::io;
-use voussoir::mesh::repair::{repair_plan, DEFAULT_REPAIR_TOLERANCE};
+use voussoir::{repair_plan, DEFAULT_REPAIR_TOLERANCE};
 
 const MODELS: [&str; 9] = [
     "free_vault",

@@ -10,18 +10,13 @@ use voussoir::*;
 /// Plain compression (q ≥ 0, and q_min on interior edges only where a test sets it): the
 /// setting most of these tests are about; the default q_min is 0.05 p̄/L₀ on all edges.
 fn plain_compression() -> StressSettings {
-    StressSettings {
-        q_min: QBound::Absolute(0.0),
-        q_min_scope: EdgeScope::Interior,
-        ..Default::default()
-    }
+    StressSettings::default()
+        .with_q_min(QBound::Absolute(0.0))
+        .with_q_min_scope(EdgeScope::Interior)
 }
 
 fn solve(problem: &Problem, settings: &StressSettings, formulation: Formulation) -> StressResult {
-    let s = StressSettings {
-        formulation,
-        ..settings.clone()
-    };
+    let s = settings.clone().with_formulation(formulation);
     analyse(problem, &s).unwrap()
 }
 
@@ -142,26 +137,17 @@ fn reduced_equals_edge_based_on_generated_meshes() {
     let hemi = Problem::new(polar_cap(10, 1.3));
     assert_same_optimum("anchored rim", &hemi, &base);
     // q_min > 0 on interior edges.
-    let qmin = StressSettings {
-        q_min: QBound::Relative(0.05),
-        ..base.clone()
-    };
+    let qmin = base.clone().with_q_min(QBound::Relative(0.05));
     assert_same_optimum("anchored rim, q_min", &hemi, &qmin);
     // With τ on free vertices a hole can take a net force: only affine jumps match VHWP12.
-    let base = StressSettings {
-        holes: HoleMode::Affine,
-        ..base
-    };
+    let base = base.with_holes(HoleMode::Affine);
     // Free edges: only an arc of the rim is anchored; τ optimised and τ = 0.
     let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
     assert_same_optimum("free rim arc, tau optimised", &arc, &base);
     assert_same_optimum(
         "free rim arc, tau zero",
         &arc,
-        &StressSettings {
-            tau: TauMode::Zero,
-            ..base.clone()
-        },
+        &base.clone().with_tau(TauMode::Zero),
     );
     // A free hole (its loop has no support).
     let free_hole = Problem::new(holed_disk(4, 0.01, |_, outer| outer));
@@ -171,14 +157,7 @@ fn reduced_equals_edge_based_on_generated_meshes() {
         outer || (u[0] - 0.3).hypot(u[1] - 0.1) < 0.26
     }));
     let (red, _) = assert_same_optimum("anchored hole (affine jumps)", &anchored, &base);
-    let constant = analyse(
-        &anchored,
-        &StressSettings {
-            holes: HoleMode::Constant,
-            ..base.clone()
-        },
-    )
-    .unwrap();
+    let constant = analyse(&anchored, &base.clone().with_holes(HoleMode::Constant)).unwrap();
     assert!(
         constant.objective >= red.objective * (1.0 - 1e-6),
         "constant jumps cannot beat affine ones"
@@ -190,27 +169,18 @@ fn reduced_equals_edge_based_on_generated_meshes() {
     assert_same_optimum(
         "prescribed tau",
         &tau,
-        &StressSettings {
-            tau: TauMode::Prescribed,
-            ..base.clone()
-        },
+        &base.clone().with_tau(TauMode::Prescribed),
     );
     assert_same_optimum(
         "q_max",
         &hemi,
-        &StressSettings {
-            q_max: Some(QBound::Relative(1.0)),
-            ..base.clone()
-        },
+        &base.clone().with_q_max(Some(QBound::Relative(1.0))),
     );
 }
 
 #[test]
 fn reduced_equals_edge_based_on_every_real_model() {
-    let settings = StressSettings {
-        holes: HoleMode::Affine,
-        ..plain_compression()
-    };
+    let settings = plain_compression().with_holes(HoleMode::Affine);
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
         assert_same_optimum(name, &Problem::new(mesh), &settings);
@@ -243,11 +213,9 @@ fn default_stress_step_of_holed_models_is_the_edge_based_optimum() {
 #[test]
 fn native_solver_equals_clarabel_on_every_real_model() {
     let plain = plain_compression();
-    let q_min = StressSettings {
-        q_min: QBound::Relative(0.05),
-        q_min_scope: EdgeScope::All,
-        ..Default::default()
-    };
+    let q_min = StressSettings::default()
+        .with_q_min(QBound::Relative(0.05))
+        .with_q_min_scope(EdgeScope::All);
     for name in MODELS {
         let Some(mesh) = load_model(name) else { return };
         let problem = Problem::new(mesh);
@@ -256,10 +224,10 @@ fn native_solver_equals_clarabel_on_every_real_model() {
             (Formulation::EdgeBased, &plain),
             (Formulation::Reduced, &q_min),
         ] {
-            let with = |solver| StressSettings {
-                solver,
-                formulation,
-                ..base.clone()
+            let with = |solver| {
+                base.clone()
+                    .with_solver(solver)
+                    .with_formulation(formulation)
             };
             let native = analyse(&problem, &with(QpSolver::Native)).unwrap();
             let reference = analyse(&problem, &with(QpSolver::Clarabel)).unwrap();
@@ -276,11 +244,10 @@ fn native_solver_equals_clarabel_on_every_real_model() {
 #[test]
 fn native_solver_equals_clarabel_on_generated_meshes() {
     let base = plain_compression();
-    let qmin = StressSettings {
-        q_min: QBound::Relative(0.05),
-        q_min_scope: EdgeScope::All,
-        ..base.clone()
-    };
+    let qmin = base
+        .clone()
+        .with_q_min(QBound::Relative(0.05))
+        .with_q_min_scope(EdgeScope::All);
     let cases = [
         ("cap, anchored rim", polar_cap(10, 1.2), base.clone()),
         ("cap, q_min", polar_cap(10, 1.2), qmin.clone()),
@@ -297,10 +264,7 @@ fn native_solver_equals_clarabel_on_generated_meshes() {
     ];
     for (label, mesh, settings) in cases {
         let problem = Problem::new(mesh);
-        let with = |solver| StressSettings {
-            solver,
-            ..settings.clone()
-        };
+        let with = |solver| settings.clone().with_solver(solver);
         let native = analyse(&problem, &with(QpSolver::Native)).unwrap();
         let reference = analyse(&problem, &with(QpSolver::Clarabel)).unwrap();
         assert_eq!(native.solver, QpSolver::Native, "{label}: fell back");
@@ -352,18 +316,14 @@ fn dual_length_smoothing_trades_residual_for_a_smoother_diagram() {
         let problem = Problem::new(mesh);
         // Affine hole jumps: the reduced space then holds every balanced stress of a mesh with
         // free holes, as the edge-based one does.
-        let base = StressSettings {
-            holes: HoleMode::Affine,
-            ..plain_compression()
-        };
+        let base = plain_compression().with_holes(HoleMode::Affine);
         let plain = analyse(&problem, &base).unwrap();
         let smooth = |solver, formulation| {
-            let s = StressSettings {
-                dual_length_smoothing: mu,
-                solver,
-                formulation,
-                ..base.clone()
-            };
+            let s = base
+                .clone()
+                .with_dual_length_smoothing(mu)
+                .with_solver(solver)
+                .with_formulation(formulation);
             analyse(&problem, &s).unwrap()
         };
         let runs = [
@@ -473,46 +433,29 @@ fn invalid_settings_are_rejected_by_name() {
     let problem = Problem::new(polar_cap(3, 0.5));
     for (settings, name) in [
         (
-            StressSettings {
-                q_min: QBound::Absolute(f64::NAN),
-                ..Default::default()
-            },
+            StressSettings::default().with_q_min(QBound::Absolute(f64::NAN)),
             "q_min",
         ),
         (
-            StressSettings {
-                q_min: QBound::Relative(-1.0),
-                ..Default::default()
-            },
+            StressSettings::default().with_q_min(QBound::Relative(-1.0)),
             "q_min",
         ),
         (
-            StressSettings {
-                q_max: Some(QBound::Absolute(0.0)),
-                ..Default::default()
-            },
+            StressSettings::default().with_q_max(Some(QBound::Absolute(0.0))),
             "q_max",
         ),
         (
-            StressSettings {
-                q_min: QBound::Absolute(2.0),
-                q_max: Some(QBound::Absolute(1.0)),
-                ..Default::default()
-            },
+            StressSettings::default()
+                .with_q_min(QBound::Absolute(2.0))
+                .with_q_max(Some(QBound::Absolute(1.0))),
             "q_max",
         ),
         (
-            StressSettings {
-                regularisation: f64::INFINITY,
-                ..Default::default()
-            },
+            StressSettings::default().with_regularisation(f64::INFINITY),
             "regularisation",
         ),
         (
-            StressSettings {
-                dual_length_smoothing: -1.0,
-                ..Default::default()
-            },
+            StressSettings::default().with_dual_length_smoothing(-1.0),
             "dual_length_smoothing",
         ),
     ] {
@@ -575,10 +518,7 @@ fn the_edge_based_step_solves_a_seven_thousand_vertex_dome() {
 /// [`assert_same_optimum`] with affine hole jumps (so that both formulations have the same
 /// feasible forces), each answered by the native solver and `Solved`.
 fn assert_same_native_optimum(label: &str, problem: &Problem) -> (StressResult, StressResult) {
-    let settings = StressSettings {
-        holes: HoleMode::Affine,
-        ..plain_compression()
-    };
+    let settings = plain_compression().with_holes(HoleMode::Affine);
     let (red, edge) = assert_same_optimum(label, problem, &settings);
     for r in [&red, &edge] {
         assert_eq!(
@@ -614,19 +554,11 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     let other_arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[0] < 0.3));
     assert_eq!(arc.mesh.faces, other_arc.mesh.faces);
     assert_ne!(arc.mesh.anchored, other_arc.mesh.anchored);
-    let plain = StressSettings {
-        solver: QpSolver::Native,
-        q_min: QBound::Relative(0.05),
-        ..plain_compression()
-    };
-    let bounded = StressSettings {
-        q_max: Some(QBound::Relative(1.0)),
-        ..plain.clone()
-    };
-    let constant = StressSettings {
-        holes: HoleMode::Constant,
-        ..plain.clone()
-    };
+    let plain = plain_compression()
+        .with_solver(QpSolver::Native)
+        .with_q_min(QBound::Relative(0.05));
+    let bounded = plain.clone().with_q_max(Some(QBound::Relative(1.0)));
+    let constant = plain.clone().with_holes(HoleMode::Constant);
     let steps = [
         (&dome, &dome.mesh.positions, &plain),
         (&dome, &lowered, &plain),
@@ -639,11 +571,11 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
         (&other_arc, &other_arc.mesh.positions, &plain),
         (&other_arc, &other_arc.mesh.positions, &constant),
     ];
-    let mut cache = stress::StressCache::default();
+    let mut cache = internals::StressCache::default();
     for (k, &(problem, positions, settings)) in steps.iter().enumerate() {
         let cached =
-            stress::analyse_cached(problem, positions, settings, None, &mut cache).unwrap();
-        let fresh = stress::analyse_at(problem, positions, settings).unwrap();
+            internals::analyse_cached(problem, positions, settings, None, &mut cache).unwrap();
+        let fresh = internals::analyse_at(problem, positions, settings).unwrap();
         assert_eq!(cached.solver, QpSolver::Native, "step {k}");
         assert_same_results(&format!("step {k}"), problem, cached, fresh);
     }
@@ -655,18 +587,16 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
 #[test]
 fn a_slightly_moved_shape_is_solved_from_the_previous_active_set() {
     let dome = Problem::new(polar_cap(10, 1.3));
-    let settings = StressSettings {
-        solver: QpSolver::Native,
-        q_min: QBound::Relative(0.05),
-        ..plain_compression()
-    };
-    let mut cache = stress::StressCache::default();
-    let first =
-        stress::analyse_cached(&dome, &dome.mesh.positions, &settings, None, &mut cache).unwrap();
+    let settings = plain_compression()
+        .with_solver(QpSolver::Native)
+        .with_q_min(QBound::Relative(0.05));
+    let mut cache = internals::StressCache::default();
+    let first = internals::analyse_cached(&dome, &dome.mesh.positions, &settings, None, &mut cache)
+        .unwrap();
     assert!(first.iterations > 0);
     let raised = heights_scaled(&dome.mesh, 1.01);
-    let warm = stress::analyse_cached(&dome, &raised, &settings, None, &mut cache).unwrap();
-    let cold = stress::analyse_at(&dome, &raised, &settings).unwrap();
+    let warm = internals::analyse_cached(&dome, &raised, &settings, None, &mut cache).unwrap();
+    let cold = internals::analyse_at(&dome, &raised, &settings).unwrap();
     assert_eq!(warm.solver, QpSolver::Native);
     assert_eq!(warm.iterations, 0, "cold: {} iterations", cold.iterations);
     assert!(cold.iterations > 0);
@@ -680,25 +610,28 @@ fn a_slightly_moved_shape_is_solved_from_the_previous_active_set() {
 fn form_findings_cache_solves_only_large_qps_coarsely() {
     let settings = FormFindSettings::default().stress;
     let small = Problem::new(polar_cap(10, 1.3));
-    let mut cache = stress::StressCache::for_form_finding();
+    let mut cache = internals::StressCache::for_form_finding();
     let cached =
-        stress::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache).unwrap();
-    let fresh = stress::analyse(&small, &settings).unwrap();
+        internals::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache)
+            .unwrap();
+    let fresh = analyse(&small, &settings).unwrap();
     assert_eq!(cached.iterations, fresh.iterations);
     assert_eq!(cached.objective, fresh.objective);
     // Small QPs try the last active set even far from balance: the same QP again is solved
     // from it, without interior-point iterations.
     cache.far_from_balance(true);
     let again =
-        stress::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache).unwrap();
+        internals::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache)
+            .unwrap();
     assert_eq!((again.status, again.iterations), (StressStatus::Solved, 0));
 
     let large = Problem::new(generate::cap_dome(0.8, 13_500).unwrap());
     assert!(large.mesh.positions.len() > 20_000);
-    let mut cache = stress::StressCache::for_form_finding();
+    let mut cache = internals::StressCache::for_form_finding();
     let coarse =
-        stress::analyse_cached(&large, &large.mesh.positions, &settings, None, &mut cache).unwrap();
-    let exact = stress::analyse(&large, &settings).unwrap();
+        internals::analyse_cached(&large, &large.mesh.positions, &settings, None, &mut cache)
+            .unwrap();
+    let exact = analyse(&large, &settings).unwrap();
     for r in [&coarse, &exact] {
         assert_eq!(
             (r.status, r.solver),
@@ -835,7 +768,7 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
     .unwrap();
     // The side holes are nearer the rim than the middle one, and nearer the middle one than
     // the rim: the cuts chain rim ← side ← middle ← other side.
-    let cuts = voussoir::stress::holes::cut_holes(&row).unwrap();
+    let cuts = voussoir::internals::cut_holes(&row).unwrap();
     assert!(
         cuts.iter().any(|c| c
             .ends_at_hole
@@ -853,10 +786,7 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
     }
     for (label, mesh, holes) in cases {
         let problem = Problem::new(mesh);
-        let settings = StressSettings {
-            holes,
-            ..plain_compression()
-        };
+        let settings = plain_compression().with_holes(holes);
         let r = analyse(&problem, &settings).unwrap();
         assert!(r.status.is_solved(), "{label}: {:?}", r.status);
         let expected = airy_periods(&problem.mesh, &r.force_densities);
@@ -898,7 +828,7 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
         }
         // The jump across each cut is that around its hole plus those across the cuts ending
         // on its loop: where the cuts nest, it differs from the returned coefficients.
-        let cuts = voussoir::stress::holes::cut_holes(&problem.mesh).unwrap();
+        let cuts = voussoir::internals::cut_holes(&problem.mesh).unwrap();
         let mut across = expected.clone();
         for _ in 0..cuts.len() {
             across = (0..cuts.len())
@@ -984,16 +914,13 @@ fn a_hole_ringed_by_holes_is_cut_through_the_ring() {
     for &v in &mesh.loops[centre_loop].vertices {
         assert!(mesh.neighbours(v).all(|w| mesh.on_boundary[w as usize]));
     }
-    let cuts = voussoir::stress::holes::cut_holes(&mesh).unwrap();
+    let cuts = voussoir::internals::cut_holes(&mesh).unwrap();
     let centre = cuts
         .iter()
         .find(|c| c.loop_index == centre_loop)
         .expect("the central hole's cut");
     assert_eq!(centre.path.len(), 2, "one edge to a ring hole");
     assert!(centre.ends_at_hole.is_some());
-    let settings = StressSettings {
-        holes: HoleMode::Affine,
-        ..plain_compression()
-    };
+    let settings = plain_compression().with_holes(HoleMode::Affine);
     assert_same_optimum("ringed hole", &Problem::new(mesh), &settings);
 }

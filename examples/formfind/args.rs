@@ -47,6 +47,7 @@ pub fn bound_text(b: Option<QBound>) -> String {
         None => "none".into(),
         Some(QBound::Relative(v)) => format!("{v}"),
         Some(QBound::Absolute(v)) => format!("{v}abs"),
+        Some(other) => format!("{other:?}"),
     }
 }
 

@@ -263,7 +263,7 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
         let flips = m
             .repairs
             .iter()
-            .filter(|r| matches!(r, voussoir::mesh::repair::PlanRepair::Flip { .. }))
+            .filter(|r| matches!(r, voussoir::PlanRepair::Flip { .. }))
             .count();
         say!(
             "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",

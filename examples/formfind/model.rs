@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use voussoir::generate::{self, Domain};
-use voussoir::mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 use voussoir::{io, Mesh};
+use voussoir::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 
 use crate::args::Options;
 

@@ -1,7 +1,7 @@
 //! The JSON report: every number a run computed, in physical units, plus the settings used.
 
 use serde_json::{json, Value};
-use voussoir::mesh::repair::PlanRepair;
+use voussoir::PlanRepair;
 use voussoir::{QBound, StressResult, Termination};
 
 use crate::args::{name_of, Options, LOADS, METHODS, QP_SOLVERS, SCOPES, SOLVERS, TAUS};
@@ -47,6 +47,7 @@ fn bound(b: QBound, unit: f64) -> Value {
     match b {
         QBound::Relative(v) => json!({ "relative": v, "physical": b.physical(unit) }),
         QBound::Absolute(v) => json!({ "absolute": v, "physical": v }),
+        other => json!({ "bound": format!("{other:?}"), "physical": other.physical(unit) }),
     }
 }
 

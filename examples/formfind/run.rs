@@ -4,7 +4,6 @@
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use voussoir::geometry::Frame;
 use voussoir::{analyse, form_find, Problem, QpSolver, StressResult, Termination};
 
 use crate::args::Options;
@@ -143,7 +142,6 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
         }
     };
     outcome.p_bar = mean_load(&outcome.model, &outcome.stress.loads);
-    let frame = Frame::of(&outcome.model.mesh, &outcome.positions);
-    outcome.q_unit = outcome.p_bar / frame.scale;
+    outcome.q_unit = outcome.p_bar / outcome.model.mesh.plan_scale(&outcome.positions);
     Ok(outcome)
 }

@@ -10,6 +10,7 @@ use std::collections::VecDeque;
 
 /// Force diagram in physical units (force).
 #[derive(Debug, Clone, Default)]
+#[non_exhaustive]
 pub struct ForceDiagram {
     /// One point per face.
     pub centres: Vec<[f64; 2]>,
@@ -30,6 +31,7 @@ pub fn gradient(u: [[f64; 2]; 3], f: [f64; 3]) -> [f64; 2] {
 }
 
 /// Power centre of three weighted sites: the point with equal |c − u_a|² − w_a to all three.
+#[cfg(any(test, feature = "internals"))]
 pub fn power_centre(u: [[f64; 2]; 3], w: [f64; 3]) -> [f64; 2] {
     // 2 c·(u_b − u_a) = |u_b|² − w_b − |u_a|² + w_a for b = 1, 2.
     let rhs = |b: usize| (dot(u[b], u[b]) - w[b] - dot(u[0], u[0]) + w[0]) / 2.0;

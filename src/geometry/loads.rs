@@ -4,6 +4,7 @@ use crate::mesh::Mesh;
 
 /// How a face's weight is shared among its three vertices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum LoadRule {
     /// One third of the 3-D triangle area each (the paper's and VHWP12's rule).
     #[default]

@@ -10,7 +10,7 @@ mod connectivity;
 mod overlap;
 mod query;
 pub mod repair;
-pub use build::{ANGLE_TOL, AREA_TOL, MAX_COORDINATE, MIN_PLAN_EXTENT};
+pub use build::{MAX_COORDINATE, MIN_PLAN_EXTENT};
 
 #[cfg(test)]
 mod repair_tests;
@@ -54,6 +54,7 @@ pub struct BoundaryLoop {
 
 /// A validated triangle mesh: plan (x, y), heights z, supports and derived connectivity.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Mesh {
     /// Vertex positions as given (x, y plan; z height). Length n_vertices.
     pub positions: Vec<[f64; 3]>,

@@ -1,8 +1,15 @@
 //! Small queries on a validated mesh.
 
 use super::Mesh;
+use crate::geometry::Frame;
 
 impl Mesh {
+    /// L₀, the length unit of relative force-density bounds ([`crate::QBound::Relative`]):
+    /// half the plan bounding-box diagonal of the referenced vertices at `positions`.
+    pub fn plan_scale(&self, positions: &[[f64; 3]]) -> f64 {
+        Frame::of(self, positions).scale
+    }
+
     /// Number of vertices, including unreferenced ones.
     pub fn n_vertices(&self) -> usize {
         self.positions.len()

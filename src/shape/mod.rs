@@ -18,6 +18,7 @@ use faer::{Mat, Side};
 
 /// Parameters of the paper's proximal schedule ([`crate::FormMethod::Paper`]): μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct Schedule {
     pub mu0: f64,
     pub beta: f64,
@@ -40,6 +41,14 @@ impl Default for Schedule {
         }
     }
 }
+
+crate::setters::with_setters!(Schedule {
+    with_mu0: mu0: f64,
+    with_beta: beta: f64,
+    with_mu_min: mu_min: f64,
+    with_eta: eta: f64,
+    with_pull: pull: f64,
+});
 
 /// The height step with its sparsity pattern analysed once: KᵀK has the two-ring pattern of
 /// the mesh restricted to non-anchored vertices, whatever the force densities.

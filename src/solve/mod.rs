@@ -13,6 +13,7 @@ use std::time::Instant;
 
 /// Why the loop stopped.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Termination {
     /// ε∞ < tolerance.
     Converged,
@@ -44,6 +45,7 @@ pub enum Termination {
 
 /// How form finding moves the shape.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum FormMethod {
     /// The nearest self-supporting shape: minimise the area-weighted squared height change
     /// (plus an optional fairness term) subject to equilibrium, by a penalty continuation
@@ -57,6 +59,7 @@ pub enum FormMethod {
 
 /// Settings of the whole loop.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct FormFindSettings {
     pub stress: StressSettings,
     /// Default [`FormMethod::Nearest`].
@@ -119,11 +122,27 @@ impl Default for FormFindSettings {
     }
 }
 
+crate::setters::with_setters!(FormFindSettings {
+    with_stress: stress: StressSettings,
+    with_method: method: FormMethod,
+    with_fairness: fairness: f64,
+    with_max_height_change: max_height_change: f64,
+    with_tolerance: tolerance: f64,
+    with_max_iterations: max_iterations: usize,
+    with_schedule: schedule: Schedule,
+    with_stall_window: stall_window: usize,
+    with_odt_iterations: odt_iterations: usize,
+    with_odt_free_boundary: odt_free_boundary: bool,
+    with_proximal_weight: proximal_weight: f64,
+    with_smoothing_decay: smoothing_decay: f64,
+});
+
 /// Progress: (iteration, ε∞) → return false to cancel.
 pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 
 /// The outcome of form finding.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct FormFindResult {
     pub termination: Termination,
     /// Final positions (heights moved; the plan too when ODT is on).

@@ -10,6 +10,7 @@ use crate::mesh::{Mesh, Side};
 
 /// How the Airy function may jump around a hole.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum HoleMode {
     /// A constant jump c_h per hole (the paper's hole-induced stress): a net torque only, so
     /// on holes whose rings are anchored or loaded by τ the optimum can lie above the
@@ -123,6 +124,7 @@ impl AiryOperator {
         Ok(op)
     }
 
+    #[cfg(any(test, feature = "internals"))]
     pub fn n_unknowns(&self) -> usize {
         self.s.ncols
     }

@@ -18,6 +18,7 @@ use std::collections::BinaryHeap;
 #[derive(Debug, Clone)]
 pub struct HoleCut {
     /// Index into `mesh.loops` of the hole.
+    #[cfg_attr(not(feature = "internals"), allow(dead_code))]
     pub loop_index: usize,
     /// The hole whose loop the path ends on (None: the outer loop).
     pub ends_at_hole: Option<usize>,

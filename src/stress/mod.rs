@@ -27,6 +27,7 @@ use Formulation::{EdgeBased, Reduced};
 
 /// How the stress QP ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum StressStatus {
     /// Solved to the solver's tolerances; in form finding beyond 20k unknowns to coarse
     /// optimality (relative gap 1e-3, bounds and equality rows as tight as ever).
@@ -72,6 +73,7 @@ impl StressStatus {
 
 /// The outcome of one stress step, in physical units.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct StressResult {
     pub status: StressStatus,
     /// Force density per mesh edge (compression positive; 0 on edges that carry none).
@@ -105,7 +107,7 @@ pub struct StressResult {
     pub objective: f64,
     pub force_diagram: ForceDiagram,
     /// Iterations of the QP solver; 0 when the native solver reached the optimum from the
-    /// previous step's active set alone (see [`analyse_cached`]).
+    /// previous step's active set alone (form finding reuses it between steps).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
     /// every reduced attempt failed numerically.

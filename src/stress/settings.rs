@@ -6,6 +6,7 @@ use crate::geometry::loads::LoadRule;
 
 /// Which edges a lower bound q_min applies to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum EdgeScope {
     /// Interior edges only; boundary creases stay merely q ≥ 0.
     Interior,
@@ -16,6 +17,7 @@ pub enum EdgeScope {
 
 /// Normal stress at free boundary vertices (docs/method.md §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum TauMode {
     /// An optimised inward push τ ≥ 0 per free vertex, as the paper does. Non-zero τ means the
     /// free edge needs a tie or buttress there: results report it per vertex.
@@ -30,6 +32,7 @@ pub enum TauMode {
 /// A force-density bound, either physical (force per length) or relative to the problem's
 /// natural scale p̄ / L₀ (mean load over non-anchored vertices / half the plan diagonal).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum QBound {
     Absolute(f64),
     Relative(f64),
@@ -53,6 +56,7 @@ impl QBound {
 
 /// Which formulation solves the stress QP.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Formulation {
     /// de Goes et al. 2013: Airy values (vertex weights) as unknowns, one equation per vertex.
     #[default]
@@ -63,6 +67,7 @@ pub enum Formulation {
 
 /// Which solver minimises the stress QP.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum QpSolver {
     /// The structured interior-point method (sparse LDLᵀ of the two-ring Newton matrix, one
     /// symbolic analysis); when it does not converge the step falls back to clarabel, except
@@ -79,6 +84,7 @@ pub enum QpSolver {
 /// (`FormFindSettings::default().stress`) and of the C API's `vsr_settings_create`, so that
 /// `analyse` and `vsr_analyse` give the same answer.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct StressSettings {
     /// Lower bound on force densities (default: 0.05 p̄/L₀, `QBound::Relative(0.05)`, on all
     /// edges). Set q_min to 0 (`QBound::Absolute(0.0)`) for plain compression.
@@ -162,3 +168,17 @@ impl StressSettings {
         Ok(())
     }
 }
+
+crate::setters::with_setters!(StressSettings {
+    with_q_min: q_min: QBound,
+    with_q_min_scope: q_min_scope: EdgeScope,
+    with_q_max: q_max: Option<QBound>,
+    with_tau: tau: TauMode,
+    with_holes: holes: HoleMode,
+    with_load_rule: load_rule: LoadRule,
+    with_formulation: formulation: Formulation,
+    with_dual_length_bounds: dual_length_bounds: Option<(f64, f64)>,
+    with_dual_length_smoothing: dual_length_smoothing: f64,
+    with_regularisation: regularisation: f64,
+    with_solver: solver: QpSolver,
+});
