@@ -50,6 +50,19 @@ struct Case {
 }
 
 fn bad_meshes() -> Vec<Case> {
+    [
+        input_cases(),
+        topology_cases(),
+        plan_cases(),
+        support_cases(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// Empty meshes, indices out of range, non-finite coordinates.
+fn input_cases() -> Vec<Case> {
     let (gp, gf) = grid(2, 2);
     let tri = plan(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
     let mut cases = vec![
@@ -116,7 +129,12 @@ fn bad_meshes() -> Vec<Case> {
         expected: Error::NonFiniteCoordinate { vertex: 5 },
         needles: vec!["vertex 5"],
     });
+    cases
+}
 
+/// Faces that do not make an oriented manifold surface.
+fn topology_cases() -> Vec<Case> {
+    let mut cases = Vec::new();
     let quad = plan(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
     cases.push(Case {
         name: "repeated vertex in a face",
@@ -190,6 +208,13 @@ fn bad_meshes() -> Vec<Case> {
         needles: vec!["vertex 2"],
     });
 
+    cases
+}
+
+/// Plans that fold over or overlap themselves.
+fn plan_cases() -> Vec<Case> {
+    let quad = plan(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    let mut cases = Vec::new();
     // Interior vertex 12 = (2, 2) of a 4 × 4 grid pulled past its neighbour 13 = (3, 2).
     let (mut fold, gf44) = grid(4, 4);
     fold[12] = [3.5, 2.25, 0.0];
@@ -249,6 +274,14 @@ fn bad_meshes() -> Vec<Case> {
         needles: vec!["faces 0 and 2 overlap"],
     });
 
+    cases
+}
+
+/// Meshes with a part that nothing holds up.
+fn support_cases() -> Vec<Case> {
+    let (gp, gf) = grid(2, 2);
+    let tri = plan(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let mut cases = Vec::new();
     let mut two = tri.clone();
     two.extend(plan(&[[3.0, 0.0], [4.0, 0.0], [3.0, 1.0]]));
     cases.push(Case {

@@ -12,6 +12,7 @@ use crate::shape::ShapeStep;
 use crate::stress::{
     analyse_cached, Prior, StressCache, StressResult, StressSettings, StressStatus,
 };
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// The paper's loop: stress step, then a height step pulled towards the current heights with
@@ -46,50 +47,18 @@ pub(super) fn paper(
             shape_s += t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
-        let prior = last
-            .as_ref()
-            .filter(|s| s.status.is_solved())
-            .map(|s| Prior {
-                force_densities: &s.force_densities,
-                weight: settings.proximal_weight,
-                lifted_first: s.lifted,
-            });
-        // A fixed smoothing weight would keep trading residual for smoothness, so the loop
-        // could not reach ε∞ → 0: the weight fades (and is dropped once negligible), the shape
-        // adapts to the smoother stress of the early steps and the proximal term keeps it.
-        let faded;
-        let stress_settings = if settings.stress.dual_length_smoothing > 0.0 {
-            let factor = settings.smoothing_decay.powi(k as i32);
-            faded = StressSettings {
-                dual_length_smoothing: settings.stress.dual_length_smoothing
-                    * if factor > 1e-12 { factor } else { 0.0 },
-                ..settings.stress.clone()
-            };
-            &faded
-        } else {
-            &settings.stress
-        };
+        let prior = prior(last.as_ref(), settings);
+        let stress_settings = &faded(settings, k);
         cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         solvers.push(stress.solver);
-        // A step that stopped short of its optimum may balance the shape worse than the forces
-        // at hand (the previous ones, certified at these heights): those are kept instead,
-        // unless ODT has just moved the plan under them.
-        let stress = match last.take() {
-            // A smoothed step trades residual for smoothness on purpose: only once the
-            // smoothing has faded is a coarse one judged by its residual.
-            Some(held)
-                if k >= settings.odt_iterations
-                    && falls_short(
-                        &stress,
-                        cache.last_was_coarse() && stress_settings.dual_length_smoothing == 0.0,
-                        &held,
-                    ) =>
-            {
-                held
-            }
-            _ => stress,
-        };
+        let stress = keep_better(
+            stress,
+            last.take(),
+            &cache,
+            stress_settings,
+            k >= settings.odt_iterations,
+        );
         stress_s += t.elapsed().as_secs_f64();
         stress_steps += 1;
         history.push(stress.eps_inf);
@@ -102,20 +71,9 @@ pub(super) fn paper(
                 break;
             }
         }
-        match status {
-            StressStatus::Infeasible => {
-                termination = Termination::Infeasible {
-                    constraint: infeasibility_hint(&settings.stress),
-                };
-                break;
-            }
-            StressStatus::NumericalError => {
-                termination = Termination::NumericalError {
-                    what: "stress QP failed".into(),
-                };
-                break;
-            }
-            _ => {}
+        if let Some(failed) = failure(status, settings) {
+            termination = failed;
+            break;
         }
         if eps < settings.tolerance {
             termination = Termination::Converged;
@@ -172,4 +130,60 @@ pub(super) fn paper(
         },
         start,
     ))
+}
+
+/// The proximal term towards the previous step's forces, when that step was solved.
+fn prior<'a>(last: Option<&'a StressResult>, settings: &FormFindSettings) -> Option<Prior<'a>> {
+    last.filter(|s| s.status.is_solved()).map(|s| Prior {
+        force_densities: &s.force_densities,
+        weight: settings.proximal_weight,
+        lifted_first: s.lifted,
+    })
+}
+
+/// The stress settings of step `k`: a fixed smoothing weight would keep trading residual for
+/// smoothness, so the loop could not reach ε∞ → 0; the weight fades (and is dropped once
+/// negligible), the shape adapts to the smoother stress of the early steps and the proximal
+/// term keeps it.
+fn faded(settings: &FormFindSettings, k: usize) -> Cow<'_, StressSettings> {
+    if settings.stress.dual_length_smoothing > 0.0 {
+        let factor = settings.smoothing_decay.powi(k as i32);
+        let mut faded = settings.stress.clone();
+        faded.dual_length_smoothing *= if factor > 1e-12 { factor } else { 0.0 };
+        Cow::Owned(faded)
+    } else {
+        Cow::Borrowed(&settings.stress)
+    }
+}
+
+/// The stress step's answer, or the forces at hand (the previous ones, certified at these
+/// heights) when the step stopped short of its optimum and balances the shape worse, unless
+/// ODT has just moved the plan under them (`plan_settled` false).
+fn keep_better(
+    stress: StressResult,
+    held: Option<StressResult>,
+    cache: &StressCache,
+    settings: &StressSettings,
+    plan_settled: bool,
+) -> StressResult {
+    // A smoothed step trades residual for smoothness on purpose: only once the smoothing has
+    // faded is a coarse one judged by its residual.
+    let coarse = cache.last_was_coarse() && settings.dual_length_smoothing == 0.0;
+    match held {
+        Some(held) if plan_settled && falls_short(&stress, coarse, &held) => held,
+        _ => stress,
+    }
+}
+
+/// The termination for a stress step that failed, if it did.
+fn failure(status: StressStatus, settings: &FormFindSettings) -> Option<Termination> {
+    match status {
+        StressStatus::Infeasible => Some(Termination::Infeasible {
+            constraint: infeasibility_hint(&settings.stress),
+        }),
+        StressStatus::NumericalError => Some(Termination::NumericalError {
+            what: "stress QP failed".into(),
+        }),
+        _ => None,
+    }
 }
