@@ -278,11 +278,12 @@ pub fn check_same_plan(input: &Path, output: &Path) {
     }
 }
 
-pub const PICTURES: [&str; 4] = [
+pub const PICTURES: [&str; 5] = [
     "plan_forces.svg",
     "force_diagram.svg",
     "residuals.svg",
     "height_change.svg",
+    "shape_3d.svg",
 ];
 
 pub fn check_pictures(dir: &Path) {
