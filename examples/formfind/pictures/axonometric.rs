@@ -15,7 +15,7 @@ pub const AZIMUTH_DEG: f64 = -60.0;
 /// The viewer's elevation above the horizon, in degrees.
 pub const ELEVATION_DEG: f64 = 30.0;
 /// Brightness of a face turned away from the light, so that no face turns black.
-const AMBIENT: f64 = 0.4;
+const AMBIENT: f64 = 0.35;
 /// Brightness of a face square to the light: below 1, so that pale faces stand out from the page.
 const FULL: f64 = 0.92;
 /// Brightness factor of back faces: the underside, seen through openings or past free edges.
@@ -56,7 +56,7 @@ impl Projection {
         let right = [-a.sin(), a.cos(), 0.0];
         let up = cross(eye, right);
         // From the upper left, on the viewer's side: the usual light of a drawing.
-        let l: V3 = std::array::from_fn(|k| -0.45 * right[k] + 0.6 * up[k] + 0.65 * eye[k]);
+        let l: V3 = std::array::from_fn(|k| -0.6 * right[k] + 0.6 * up[k] + 0.45 * eye[k]);
         let n = dot(l, l).sqrt();
         Projection {
             right,
