@@ -187,12 +187,17 @@ pub fn shape_3d(o: &Outcome) -> Document {
         .iter()
         .map(|d| draw::diverging_rgb(if m > 0.0 { 0.5 + 0.5 * d / m } else { 0.5 }))
         .collect();
+    let both = if panels.len() > 1 {
+        "; one projection and scale for both views"
+    } else {
+        ""
+    };
     let mut doc = page(
         WIDTH,
         height,
         &format!("{}: 3-D view", o.model.name),
         &format!(
-            "axonometric, from {}° azimuth (plan x to the right), {ELEVATION_DEG}° above the horizon; one scale for both views",
+            "axonometric, from {}° azimuth (plan x to the right), {ELEVATION_DEG}° above the horizon{both}",
             fmt(AZIMUTH_DEG).replace('-', "−")
         ),
     );
@@ -209,36 +214,46 @@ pub fn shape_3d(o: &Outcome) -> Document {
         ));
     }
     let y = height - LEGEND + 40.0;
-    let shading = "lit from the upper left; darker: the underside";
-    if o.termination.is_none() {
-        return doc.add(text(30.0, y, 12.0, shading));
-    }
-    let (plan_lo, plan_hi) = plan_box(mesh, &o.positions);
-    let diagonal = (plan_hi[0] - plan_lo[0]).hypot(plan_hi[1] - plan_lo[1]);
+    let (colours, x) = if o.termination.is_some() {
+        let (plan_lo, plan_hi) = plan_box(mesh, &o.positions);
+        let diagonal = (plan_hi[0] - plan_lo[0]).hypot(plan_hi[1] - plan_lo[1]);
+        doc = doc.add(change_bar(m, diagonal, y));
+        ("same colours in both views: down blue, up red", 420.0)
+    } else {
+        (
+            "no form finding (--stress-only): the input alone, in grey",
+            30.0,
+        )
+    };
+    doc.add(text(x, y + 4.0, 12.0, colours))
+        .add(text(
+            x,
+            y + 22.0,
+            12.0,
+            "lit from the upper left; darker: the underside",
+        ))
+        .add(draw::scale_bar(
+            &views[0],
+            (790.0, y + 10.0),
+            90.0,
+            "length",
+        ))
+}
+
+/// The colour bar of the height change, up to `m` either way, with ticks in model units and in
+/// per cent of the plan `diagonal`.
+fn change_bar(m: f64, diagonal: f64, y: f64) -> Group {
     let share = format!("{:.2}%", 100.0 * m / diagonal.max(1e-300));
     let ticks = vec![
         (0.0, format!("−{} (−{share})", fmt(m))),
         (0.5, "0".to_string()),
         (1.0, format!("+{} (+{share})", fmt(m))),
     ];
-    doc.add(colour_bar(
+    colour_bar(
         "dz3",
         (70.0, y, 260.0),
         draw::diverging,
         "height change Δz in model units (% of the plan diagonal)",
         &ticks,
-    ))
-    .add(text(
-        420.0,
-        y + 4.0,
-        12.0,
-        "same colours in both views: down blue, up red",
-    ))
-    .add(text(420.0, y + 22.0, 12.0, shading))
-    .add(draw::scale_bar(
-        &views[0],
-        (790.0, y + 10.0),
-        90.0,
-        "length",
-    ))
+    )
 }
