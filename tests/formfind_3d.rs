@@ -333,3 +333,41 @@ fn the_xml_check_rejects_an_unclosed_element() {
 fn the_xml_check_rejects_an_unquoted_attribute() {
     parse_xml("<svg width=3/>");
 }
+
+/// A square grid of `n` × `n` cells, two triangles each, over a shallow dome.
+fn grid_obj(n: usize) -> String {
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            let z = 0.3 * x * (1.0 - x) * y * (1.0 - y) * 16.0;
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i + 1;
+            let (b, c, d) = (a + 1, a + n + 2, a + n + 1);
+            obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    obj
+}
+
+#[test]
+fn the_3d_picture_takes_under_80_bytes_a_face() {
+    let dir = Scratch::new("3d-compact");
+    fs::write(dir.path("grid.obj"), grid_obj(60)).unwrap();
+    let args = ["grid.obj", "--anchor-boundary", "--stress-only"];
+    run_ok(&dir, &args);
+    let picture = dir.path("formfind-out/pictures/shape_3d.svg");
+    let bytes = fs::metadata(&picture).unwrap().len() as f64;
+    let faces = 2 * 60 * 60;
+    assert_eq!(
+        view_polygons(&read_picture(&picture), "input-faces").len(),
+        faces
+    );
+    // The points to a tenth of a pixel and one colour: about 70 bytes a face.
+    let per_face = bytes / faces as f64;
+    assert!(per_face < 80.0, "{per_face:.1} bytes per face");
+}
