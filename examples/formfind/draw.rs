@@ -61,8 +61,9 @@ impl View {
     }
 }
 
-/// Linear interpolation in a list of equally spaced `#rrggbb` stops, t in [0, 1].
-fn interpolate(stops: &[u32], t: f64) -> String {
+/// Linear interpolation in a list of equally spaced `0xrrggbb` stops, t in [0, 1], as red,
+/// green and blue in [0, 255].
+fn interpolate_rgb(stops: &[u32], t: f64) -> [f64; 3] {
     let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
     let x = t * (stops.len() - 1) as f64;
     let k = (x.floor() as usize).min(stops.len() - 2);
@@ -70,9 +71,19 @@ fn interpolate(stops: &[u32], t: f64) -> String {
     let channel = |c: u32, shift: u32| ((c >> shift) & 0xff) as f64;
     let mix = |shift| {
         let (a, b) = (channel(stops[k], shift), channel(stops[k + 1], shift));
-        (a + (b - a) * f).round() as u8
+        a + (b - a) * f
     };
-    format!("#{:02x}{:02x}{:02x}", mix(16), mix(8), mix(0))
+    [mix(16), mix(8), mix(0)]
+}
+
+/// `#rrggbb` of red, green and blue in [0, 255] (clamped).
+pub fn hex(rgb: [f64; 3]) -> String {
+    let [r, g, b] = rgb.map(|c| c.round().clamp(0.0, 255.0) as u8);
+    format!("#{r:02x}{g:02x}{b:02x}")
+}
+
+fn interpolate(stops: &[u32], t: f64) -> String {
+    hex(interpolate_rgb(stops, t))
 }
 
 /// Viridis: dark blue (low) to yellow (high). For force densities.
@@ -91,12 +102,18 @@ pub fn heat(t: f64) -> String {
     interpolate(&STOPS, t)
 }
 
-/// Blue (t = 0, down) through white (0.5) to red (1, up). For height changes.
-pub fn diverging(t: f64) -> String {
+/// Blue (t = 0, down) through a neutral grey-white (0.5) to red (1, up), as red, green and
+/// blue in [0, 255]. For height changes.
+pub fn diverging_rgb(t: f64) -> [f64; 3] {
     const STOPS: [u32; 7] = [
         0x2166ac, 0x67a9cf, 0xd1e5f0, 0xf7f7f7, 0xfddbc7, 0xef8a62, 0xb2182b,
     ];
-    interpolate(&STOPS, t)
+    interpolate_rgb(&STOPS, t)
+}
+
+/// [`diverging_rgb`] as `#rrggbb`.
+pub fn diverging(t: f64) -> String {
+    hex(diverging_rgb(t))
 }
 
 pub fn text(x: f64, y: f64, size: f64, content: impl Into<String>) -> SvgText {

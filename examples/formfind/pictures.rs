@@ -1,4 +1,7 @@
-//! The SVG pictures: forces in plan, force diagram, residuals before/after, height change.
+//! The SVG pictures: forces in plan, force diagram, residuals before/after, height change, and
+//! a shaded 3-D view.
+
+mod axonometric;
 
 use svg::node::element::{Circle, Group, Polygon, Rectangle};
 use svg::Document;
@@ -392,13 +395,12 @@ fn height_change(o: &Outcome) -> Document {
 
 /// The file names of the pictures (no height change without form finding).
 pub fn names(stress_only: bool) -> Vec<&'static str> {
-    let all = [
-        "plan_forces.svg",
-        "force_diagram.svg",
-        "residuals.svg",
-        "height_change.svg",
-    ];
-    all[..if stress_only { 3 } else { 4 }].to_vec()
+    let mut names = vec!["plan_forces.svg", "force_diagram.svg", "residuals.svg"];
+    if !stress_only {
+        names.push("height_change.svg");
+    }
+    names.push("shape_3d.svg");
+    names
 }
 
 /// The pictures of a run as (file name, SVG text), in the order of [`names`].
@@ -411,6 +413,7 @@ pub fn all(o: &Outcome) -> Vec<(&'static str, String)> {
     if o.termination.is_some() {
         out.push(height_change(o).to_string());
     }
+    out.push(axonometric::shape_3d(o).to_string());
     names(o.termination.is_none())
         .into_iter()
         .zip(out)

@@ -106,6 +106,8 @@ pub fn run(cwd: &Path, args: &[&str]) -> Output {
         .expect("formfind runs")
 }
 
+pub mod xml;
+
 #[path = "../common/models.rs"]
 mod models;
 pub use models::models_dir;
@@ -278,19 +280,19 @@ pub fn check_same_plan(input: &Path, output: &Path) {
     }
 }
 
-pub const PICTURES: [&str; 4] = [
+pub const PICTURES: [&str; 5] = [
     "plan_forces.svg",
     "force_diagram.svg",
     "residuals.svg",
     "height_change.svg",
+    "shape_3d.svg",
 ];
 
+/// Every picture is a well-formed SVG document.
 pub fn check_pictures(dir: &Path) {
     for name in PICTURES {
         let text = fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(
-            text.contains("<svg") && text.trim_end().ends_with("</svg>"),
-            "{name}"
-        );
+        let elements = xml::parse_xml(&text);
+        assert_eq!(elements[0].name, "svg", "{name}: the root is not <svg>");
     }
 }
