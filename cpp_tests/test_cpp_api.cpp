@@ -31,7 +31,8 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 template <typename T>
 bool same_bits(const std::vector<T> &a, const std::vector<T> &b) {
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -39,9 +40,9 @@ bool same_bits(const std::vector<T> &a, const std::vector<T> &b) {
 
 struct HostileCase {
     const char *name;
-    std::function<VsrStatus()> c_call;       // the C API with the same input
-    std::function<void()> cpp_call;          // must throw voussoir::Error
-    std::function<VsrStatus()> try_call;     // the try_ twin (may be empty)
+    std::function<VsrStatus()> c_call;    // the C API with the same input
+    std::function<void()> cpp_call;       // must throw voussoir::Error
+    std::function<VsrStatus()> try_call;  // the try_ twin (may be empty)
 };
 
 void PrintTo(const HostileCase &c, std::ostream *os) { *os << c.name; }
@@ -90,10 +91,11 @@ HostileCase settings_case(const char *name, std::function<VsrStatus(VsrSettings 
             }};
 }
 
-#define VSR_SETTER_CASE(setter, ...)                                                        \
-    settings_case(#setter, [](VsrSettings *s) { return vsr_settings_set_##setter(s, __VA_ARGS__); }, \
-                  [](voussoir::Settings &s) { s.setter(__VA_ARGS__); },                     \
-                  [](voussoir::Settings &s) { return s.try_##setter(__VA_ARGS__); })
+#define VSR_SETTER_CASE(setter, ...)                                                       \
+    settings_case(                                                                         \
+        #setter, [](VsrSettings *s) { return vsr_settings_set_##setter(s, __VA_ARGS__); }, \
+        [](voussoir::Settings &s) { s.setter(__VA_ARGS__); },                              \
+        [](voussoir::Settings &s) { return s.try_##setter(__VA_ARGS__); })
 
 // A mesh setter on the square.
 HostileCase mesh_setter_case(const char *name, std::function<VsrStatus(VsrMesh *)> c,
@@ -166,21 +168,26 @@ std::vector<HostileCase> hostile_cases() {
         VSR_SETTER_CASE(schedule_pull, -1.0),
         VSR_SETTER_CASE(proximal_weight, -1.0),
         mesh_setter_case(
-            "face_density_nan", [=](VsrMesh *m) { return vsr_mesh_set_face_density(m, nan4.data(), 4); },
+            "face_density_nan",
+            [=](VsrMesh *m) { return vsr_mesh_set_face_density(m, nan4.data(), 4); },
             [=](voussoir::Mesh &m) { m.face_density(nan4); },
             [=](voussoir::Mesh &m) { return m.try_face_density(nan4.data(), 4); }),
         mesh_setter_case(
-            "face_density_count", [=](VsrMesh *m) { return vsr_mesh_set_face_density(m, ones3.data(), 3); },
+            "face_density_count",
+            [=](VsrMesh *m) { return vsr_mesh_set_face_density(m, ones3.data(), 3); },
             [=](voussoir::Mesh &m) { m.face_density(ones3); },
             [=](voussoir::Mesh &m) { return m.try_face_density(ones3.data(), 3); }),
         mesh_setter_case(
-            "extra_loads_nan", [=](VsrMesh *m) { return vsr_mesh_set_extra_loads(m, nan5.data(), 5); },
+            "extra_loads_nan",
+            [=](VsrMesh *m) { return vsr_mesh_set_extra_loads(m, nan5.data(), 5); },
             [=](voussoir::Mesh &m) { m.extra_loads(nan5); },
             [=](voussoir::Mesh &m) { return m.try_extra_loads(nan5.data(), 5); }),
         mesh_setter_case(
             "horizontal_forces_count",
             [=](VsrMesh *m) { return vsr_mesh_set_horizontal_forces(m, ones3.data(), 1); },
-            [=](voussoir::Mesh &m) { m.horizontal_forces({1.0, 1.0}); },
+            [=](voussoir::Mesh &m) {
+                m.horizontal_forces({1.0, 1.0});
+            },
             [=](voussoir::Mesh &m) { return m.try_horizontal_forces(ones3.data(), 1); }),
         mesh_setter_case(
             "prescribed_tau_negative",
@@ -224,7 +231,8 @@ std::vector<HostileCase> hostile_cases() {
         {"read_missing_file",
          [] {
              VsrMesh *out = nullptr;
-             return vsr_mesh_read("vsr_cpp_missing.obj", nullptr, nullptr, 0, 1e-9, 1e-4, nullptr, &out);
+             return vsr_mesh_read("vsr_cpp_missing.obj", nullptr, nullptr, 0, 1e-9, 1e-4, nullptr,
+                                  &out);
          },
          [] { (void)voussoir::Mesh::read("vsr_cpp_missing.obj"); },
          [] {
@@ -234,7 +242,8 @@ std::vector<HostileCase> hostile_cases() {
         {"read_bad_weld_tolerance",
          [] {
              VsrMesh *out = nullptr;
-             return vsr_mesh_read("vsr_cpp_missing.off", nullptr, nullptr, 0, kNaN, 1e-4, nullptr, &out);
+             return vsr_mesh_read("vsr_cpp_missing.off", nullptr, nullptr, 0, kNaN, 1e-4, nullptr,
+                                  &out);
          },
          [] {
              voussoir::ReadOptions o;
@@ -254,7 +263,8 @@ std::vector<HostileCase> hostile_cases() {
              return vsr_mesh_counts(nullptr, &v, &e, &f, &h);
          },
          [] { (void)voussoir::Mesh().counts(); }, nullptr},
-        {"empty_result_positions", [] { return vsr_result_positions(nullptr, nullptr, 0, nullptr); },
+        {"empty_result_positions",
+         [] { return vsr_result_positions(nullptr, nullptr, 0, nullptr); },
          [] { (void)voussoir::Result().positions(); },
          [] { return voussoir::Result().try_positions(nullptr, 0, nullptr); }},
     };
@@ -291,7 +301,8 @@ INSTANTIATE_TEST_SUITE_P(CppApi, Hostile, ::testing::ValuesIn(hostile_cases()),
                          });
 
 TEST(CppApi, ShortCallerBufferThrowsBufferTooSmall) {
-    const voussoir::Result result = voussoir::analyse(voussoir::Mesh(kPositions, kTriangles, kAnchored));
+    const voussoir::Result result =
+        voussoir::analyse(voussoir::Mesh(kPositions, kTriangles, kAnchored));
     double buffer[14];
     std::size_t needed = 0;
     ASSERT_EQ(vsr_result_positions(result.get(), buffer, 14, &needed), VSR_STATUS_BUFFER_TOO_SMALL);
@@ -334,7 +345,7 @@ TEST(CppApi, MovesTransferOwnershipAndEmptyTheSource) {
     VsrMesh *const handle = mesh.get();
     voussoir::Mesh moved(std::move(mesh));
     EXPECT_EQ(moved.get(), handle);
-    EXPECT_EQ(mesh.get(), nullptr);   // NOLINT(bugprone-use-after-move): the state is specified
+    EXPECT_EQ(mesh.get(), nullptr);  // NOLINT(bugprone-use-after-move): the state is specified
     EXPECT_FALSE(mesh);
     try {
         (void)mesh.counts();
@@ -378,8 +389,9 @@ TEST(CppApi, MovesTransferOwnershipAndEmptyTheSource) {
 TEST(CppApi, TryCreateLeavesTheOutputOnFailure) {
     voussoir::Mesh out(kPositions, kTriangles, kAnchored);
     VsrMesh *const before = out.get();
-    EXPECT_EQ(voussoir::Mesh::try_create(kPositions.data(), 5, kTriangles.data(), 4, nullptr, 0, out),
-              VSR_STATUS_NO_SUPPORT);
+    EXPECT_EQ(
+        voussoir::Mesh::try_create(kPositions.data(), 5, kTriangles.data(), 4, nullptr, 0, out),
+        VSR_STATUS_NO_SUPPORT);
     EXPECT_EQ(out.get(), before);
     EXPECT_EQ(voussoir::Mesh::try_create(kPositions.data(), 5, kTriangles.data(), 4,
                                          kAnchored.data(), 4, out),
@@ -422,7 +434,8 @@ CSolve c_solve(const vsrt::MeshData &m, bool form_find) {
     voussoir::check(vsr_settings_set_fairness(settings, 0.05));
     voussoir::check(vsr_settings_set_q_min(settings, 0.02, VSR_BOUND_KIND_RELATIVE));
     voussoir::check(vsr_settings_set_load_rule(settings, VSR_LOAD_RULE_VORONOI));
-    voussoir::check(form_find ? vsr_form_find(mesh, settings, &r) : vsr_analyse(mesh, settings, &r));
+    voussoir::check(form_find ? vsr_form_find(mesh, settings, &r)
+                              : vsr_analyse(mesh, settings, &r));
     CSolve s;
     s.positions = c_copy(vsr_result_positions, r);
     s.q = c_copy(vsr_result_force_densities, r);
@@ -448,7 +461,10 @@ CSolve c_solve(const vsrt::MeshData &m, bool form_find) {
 
 voussoir::Settings cpp_settings() {
     voussoir::Settings s;
-    s.max_iterations(30).fairness(0.05).q_min(0.02, VSR_BOUND_KIND_RELATIVE).load_rule(VSR_LOAD_RULE_VORONOI);
+    s.max_iterations(30)
+        .fairness(0.05)
+        .q_min(0.02, VSR_BOUND_KIND_RELATIVE)
+        .load_rule(VSR_LOAD_RULE_VORONOI);
     return s;
 }
 
@@ -565,7 +581,8 @@ TEST(CppApi, EverySettingReachesItsCSetter) {
         .odt_iterations(0)
         .odt_free_boundary(true)
         .progress(nullptr);
-    const voussoir::Result r = voussoir::analyse(voussoir::Mesh(kPositions, kTriangles, kAnchored), s);
+    const voussoir::Result r =
+        voussoir::analyse(voussoir::Mesh(kPositions, kTriangles, kAnchored), s);
     EXPECT_EQ(r.qp_solver(), VSR_QP_SOLVER_CLARABEL);
     EXPECT_DOUBLE_EQ(r.regularisation(), 1e-9);
 }
@@ -633,7 +650,8 @@ TEST(CppApi, ConcurrentSolvesOnSharedConstObjectsAgree) {
     std::vector<double> z[2];
     std::thread threads[2];
     for (int k = 0; k < 2; ++k)
-        threads[k] = std::thread([&, k] { z[k] = voussoir::form_find(mesh, settings).positions(); });
+        threads[k] =
+            std::thread([&, k] { z[k] = voussoir::form_find(mesh, settings).positions(); });
     for (auto &t : threads) t.join();
     const voussoir::Result alone = voussoir::form_find(mesh, settings);
     EXPECT_TRUE(same_bits(z[0], z[1]));

@@ -156,9 +156,9 @@ inline int progress_trampoline(void *user, std::size_t iteration, double eps_inf
 // Numbers of rows of a flat row-major array, or an Error naming it.
 inline std::size_t rows(std::size_t size, std::size_t width, const char *argument) {
     if (size % width != 0)
-        throw Error(VSR_STATUS_INVALID_ARGUMENT,
-                    "`" + std::string(argument) + "` has " + std::to_string(size) +
-                        " values, not " + std::to_string(width) + " per row");
+        throw Error(VSR_STATUS_INVALID_ARGUMENT, "`" + std::string(argument) + "` has " +
+                                                     std::to_string(size) + " values, not " +
+                                                     std::to_string(width) + " per row");
     return size / width;
 }
 
@@ -166,19 +166,21 @@ inline std::size_t rows(std::size_t size, std::size_t width, const char *argumen
 
 // Three forms of each copy-out getter: a new vector, a caller's vector (capacity reused), a
 // caller's buffer (returns the element count), and the try_ twin with the C signature.
-#define VOUSSOIR_DETAIL_GETTER(Type, name, c_function, Handle)                                 \
-    std::vector<Type> name() const {                                                          \
-        std::vector<Type> out;                                                                \
-        name(out);                                                                            \
-        return out;                                                                           \
-    }                                                                                         \
-    void name(std::vector<Type> &out) const { detail::copy_into<Type, Handle>(c_function, get(), out); } \
-    std::size_t name(Type *out, std::size_t len) const {                                      \
-        return detail::copy_into<Type, Handle>(c_function, get(), out, len);                  \
-    }                                                                                         \
-    [[nodiscard]] VsrStatus try_##name(Type *out, std::size_t len, std::size_t *needed)       \
-        const noexcept {                                                                      \
-        return c_function(get(), out, len, needed);                                           \
+#define VOUSSOIR_DETAIL_GETTER(Type, name, c_function, Handle)                          \
+    std::vector<Type> name() const {                                                    \
+        std::vector<Type> out;                                                          \
+        name(out);                                                                      \
+        return out;                                                                     \
+    }                                                                                   \
+    void name(std::vector<Type> &out) const {                                           \
+        detail::copy_into<Type, Handle>(c_function, get(), out);                        \
+    }                                                                                   \
+    std::size_t name(Type *out, std::size_t len) const {                                \
+        return detail::copy_into<Type, Handle>(c_function, get(), out, len);            \
+    }                                                                                   \
+    [[nodiscard]] VsrStatus try_##name(Type *out, std::size_t len, std::size_t *needed) \
+        const noexcept {                                                                \
+        return c_function(get(), out, len, needed);                                     \
     }
 
 /// Sizes of a mesh or result (vsr_mesh_counts).
@@ -188,10 +190,10 @@ struct Counts {
 
 /// Options of Mesh::read (those of vsr_mesh_read).
 struct ReadOptions {
-    std::string supports_path;             ///< JSON file of anchored ids; empty: `anchored`
-    std::vector<std::uint32_t> anchored;   ///< the file's vertex ids of the supports
-    double weld_tolerance = 1e-9;          ///< × bounding-box diagonal
-    double repair_tolerance = 1e-4;        ///< × median plan area; 0 mends nothing
+    std::string supports_path;            ///< JSON file of anchored ids; empty: `anchored`
+    std::vector<std::uint32_t> anchored;  ///< the file's vertex ids of the supports
+    double weld_tolerance = 1e-9;         ///< × bounding-box diagonal
+    double repair_tolerance = 1e-4;       ///< × median plan area; 0 mends nothing
 };
 
 /// A validated triangle mesh, its supports and loads (VsrMesh).
@@ -210,8 +212,8 @@ class Mesh {
     [[nodiscard]] static VsrStatus try_create(const double *positions, std::size_t n_vertices,
                                               const std::uint32_t *triangles,
                                               std::size_t n_triangles,
-                                              const std::uint32_t *anchored,
-                                              std::size_t n_anchored, Mesh &out) noexcept {
+                                              const std::uint32_t *anchored, std::size_t n_anchored,
+                                              Mesh &out) noexcept {
         VsrMesh *raw = nullptr;
         const VsrStatus status = vsr_mesh_create(positions, n_vertices, triangles, n_triangles,
                                                  anchored, n_anchored, &raw);
@@ -269,8 +271,7 @@ class Mesh {
     }
     /// Prescribed horizontal force per vertex (#V by 2 values).
     Mesh &horizontal_forces(const std::vector<double> &forces) {
-        check(try_horizontal_forces(forces.data(),
-                                    detail::rows(forces.size(), 2, "forces")));
+        check(try_horizontal_forces(forces.data(), detail::rows(forces.size(), 2, "forces")));
         return *this;
     }
     [[nodiscard]] VsrStatus try_horizontal_forces(const double *forces,
@@ -291,13 +292,13 @@ class Mesh {
 };
 
 // One fluent setter over vsr_settings_set_<name> and its try_ twin.
-#define VOUSSOIR_DETAIL_SETTER(name, Type)                                                     \
-    Settings &name(Type value) {                                                              \
-        check(try_##name(value));                                                             \
-        return *this;                                                                         \
-    }                                                                                         \
-    [[nodiscard]] VsrStatus try_##name(Type value) noexcept {                                 \
-        return vsr_settings_set_##name(get(), value);                                         \
+#define VOUSSOIR_DETAIL_SETTER(name, Type)                    \
+    Settings &name(Type value) {                              \
+        check(try_##name(value));                             \
+        return *this;                                         \
+    }                                                         \
+    [[nodiscard]] VsrStatus try_##name(Type value) noexcept { \
+        return vsr_settings_set_##name(get(), value);         \
     }
 
 /// Solver options with the C API's defaults (vsr_settings_create), set fluently:
@@ -381,15 +382,15 @@ class Settings {
     /// keep the function; it is called on the solving thread.
     Settings &progress(ProgressFn callback) {
         auto fn = callback ? std::make_unique<ProgressFn>(std::move(callback)) : nullptr;
-        check(vsr_settings_set_progress(get(), fn ? detail::progress_trampoline : nullptr,
-                                        fn.get()));
+        check(
+            vsr_settings_set_progress(get(), fn ? detail::progress_trampoline : nullptr, fn.get()));
         progress_ = std::move(fn);
         return *this;
     }
 
   private:
     detail::Owner<VsrSettings, vsr_settings_destroy> owner_;
-    std::unique_ptr<ProgressFn> progress_;   // heap: its address survives moves
+    std::unique_ptr<ProgressFn> progress_;  // heap: its address survives moves
 };
 
 #undef VOUSSOIR_DETAIL_SETTER
@@ -452,8 +453,10 @@ class Result {
     VOUSSOIR_DETAIL_GETTER(double, residuals, vsr_result_residuals, VsrResult)
     VOUSSOIR_DETAIL_GETTER(double, horizontal_imbalance, vsr_result_horizontal_imbalance, VsrResult)
     VOUSSOIR_DETAIL_GETTER(double, hole_coefficients, vsr_result_hole_coefficients, VsrResult)
-    VOUSSOIR_DETAIL_GETTER(double, force_diagram_centres, vsr_result_force_diagram_centres, VsrResult)
-    VOUSSOIR_DETAIL_GETTER(double, force_diagram_segments, vsr_result_force_diagram_segments, VsrResult)
+    VOUSSOIR_DETAIL_GETTER(double, force_diagram_centres, vsr_result_force_diagram_centres,
+                           VsrResult)
+    VOUSSOIR_DETAIL_GETTER(double, force_diagram_segments, vsr_result_force_diagram_segments,
+                           VsrResult)
     VOUSSOIR_DETAIL_GETTER(std::uint32_t, force_diagram_segment_edges,
                            vsr_result_force_diagram_segment_edges, VsrResult)
     VOUSSOIR_DETAIL_GETTER(double, eps_history, vsr_result_eps_history, VsrResult)

@@ -40,8 +40,7 @@ struct is_handle_range : std::false_type {};
 template <typename Range, typename Handle>
 struct is_handle_range<Range, Handle,
                        std::void_t<decltype(std::begin(std::declval<const Range &>()))>>
-    : std::is_same<std::decay_t<decltype(*std::begin(std::declval<const Range &>()))>,
-                   Handle> {};
+    : std::is_same<std::decay_t<decltype(*std::begin(std::declval<const Range &>()))>, Handle> {};
 
 template <typename Point>
 void push_point(std::vector<double> &positions, const Point &p) {
@@ -58,9 +57,9 @@ inline std::uint32_t vertex_id(std::size_t id, const char *what) {
 }
 
 inline Error not_a_triangle(const char *what, std::size_t index, std::size_t corners) {
-    return Error(VSR_STATUS_INVALID_TOPOLOGY,
-                 std::string(what) + " " + std::to_string(index) + " has " +
-                     std::to_string(corners) + " vertices; Voussoir takes triangles only");
+    return Error(VSR_STATUS_INVALID_TOPOLOGY, std::string(what) + " " + std::to_string(index) +
+                                                  " has " + std::to_string(corners) +
+                                                  " vertices; Voussoir takes triangles only");
 }
 
 // Dense ids of a Surface_mesh's vertices in sm.vertices() order, indexed by Vertex_index.
@@ -82,9 +81,9 @@ template <typename Point>
 void check_vertex_count(const Result &result, const CGAL::Surface_mesh<Point> &sm) {
     const std::size_t n = result.counts().vertices;
     if (n != sm.number_of_vertices())
-        throw Error(VSR_STATUS_INVALID_ARGUMENT,
-                    "`result` has " + std::to_string(n) + " vertices, the surface mesh " +
-                        std::to_string(sm.number_of_vertices()));
+        throw Error(VSR_STATUS_INVALID_ARGUMENT, "`result` has " + std::to_string(n) +
+                                                     " vertices, the surface mesh " +
+                                                     std::to_string(sm.number_of_vertices()));
 }
 
 }  // namespace detail
@@ -134,9 +133,11 @@ Mesh to_mesh(const std::vector<Point> &points, const Polygons &polygons,
     std::vector<std::uint32_t> triangles;
     std::size_t index = 0;
     for (const auto &polygon : polygons) {
-        const auto corners = static_cast<std::size_t>(std::distance(std::begin(polygon), std::end(polygon)));
+        const auto corners =
+            static_cast<std::size_t>(std::distance(std::begin(polygon), std::end(polygon)));
         if (corners != 3) throw detail::not_a_triangle("polygon", index, corners);
-        for (auto id : polygon) triangles.push_back(detail::vertex_id(static_cast<std::size_t>(id), "point"));
+        for (auto id : polygon)
+            triangles.push_back(detail::vertex_id(static_cast<std::size_t>(id), "point"));
         ++index;
     }
     std::vector<std::uint32_t> anchored;
@@ -207,8 +208,9 @@ add_force_densities(const Result &result, CGAL::Surface_mesh<Point> &sm,
     for (std::size_t e = 0; e < q.size(); ++e) {
         const auto h = sm.halfedge(handles[edges[2 * e]], handles[edges[2 * e + 1]]);
         if (h == SM::null_halfedge())
-            throw Error(VSR_STATUS_INVALID_ARGUMENT,
-                        "edge " + std::to_string(e) + " of `result` is not an edge of the surface mesh");
+            throw Error(
+                VSR_STATUS_INVALID_ARGUMENT,
+                "edge " + std::to_string(e) + " of `result` is not an edge of the surface mesh");
         map[sm.edge(h)] = q[e];
     }
     return map;

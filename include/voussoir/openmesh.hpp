@@ -55,9 +55,9 @@ std::vector<OpenMesh::VertexHandle> checked_vertices(const Result &result, const
     std::vector<OpenMesh::VertexHandle> handles = vertices(om);
     const std::size_t n = result.counts().vertices;
     if (n != handles.size())
-        throw Error(VSR_STATUS_INVALID_ARGUMENT,
-                    "`result` has " + std::to_string(n) + " vertices, the OpenMesh mesh " +
-                        std::to_string(handles.size()));
+        throw Error(VSR_STATUS_INVALID_ARGUMENT, "`result` has " + std::to_string(n) +
+                                                     " vertices, the OpenMesh mesh " +
+                                                     std::to_string(handles.size()));
     return handles;
 }
 
@@ -116,7 +116,8 @@ Mesh to_mesh(const TriMesh &om, const Supports &supports) {
         }
     } else if constexpr (std::is_same<Supports, OpenMesh::VPropHandleT<bool>>::value) {
         for (auto v : om.vertices())
-            if (om.property(supports, v)) anchored.push_back(ids[static_cast<std::size_t>(v.idx())]);
+            if (om.property(supports, v))
+                anchored.push_back(ids[static_cast<std::size_t>(v.idx())]);
     } else {
         for (auto v : om.vertices())
             if (supports[v]) anchored.push_back(ids[static_cast<std::size_t>(v.idx())]);
