@@ -8,7 +8,8 @@
 #   3. examples/ (C dome, C hostile-input test, C++ OpenMesh and CGAL examples) builds against the
 #      installed package with find_package(Voussoir CONFIG REQUIRED) and runs under ctest:
 #      shared library; static library with AddressSanitizer + UBSan (Debug);
-#   4. the C dome and hostile-input test build with `pkg-config --cflags --libs voussoir` alone;
+#   4. the C dome, the hostile-input test and a C++ square (voussoir.hpp) build with
+#      `pkg-config --cflags --libs voussoir` alone;
 #   5. the hostile-input test links against the build tree (cargo's target/release, where the
 #      CMake build leaves the SONAME'd library and its libvoussoir.so.1 link) with an rpath;
 #   6. the Rust example (examples/dome.rs) runs.
@@ -92,6 +93,22 @@ for prog in examples/c/dome.c tests/c/hostile.c; do
   "$exe" >"$exe.log" || { cat "$exe.log"; exit 1; }
   tail -n 1 "$exe.log"
 done
+# The C++ header from the same flags: a square of 4 triangles form found through voussoir.hpp.
+cat >"$work/pkgconfig/square.cpp" <<'CPP'
+#include <voussoir.hpp>
+#include <iostream>
+int main() {
+    const voussoir::Mesh mesh({0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0.3},
+                              {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4}, {0, 1, 2, 3});
+    const voussoir::Result result = voussoir::form_find(mesh);
+    std::cout << "voussoir.hpp: " << result.termination_message() << "\n";
+    return result.termination().converged() ? 0 : 1;
+}
+CPP
+# shellcheck disable=SC2086
+c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror "$work/pkgconfig/square.cpp" -o "$work/pkgconfig/square" \
+  $flags -Wl,-rpath,"$libdir"
+"$work/pkgconfig/square"
 
 step "the build tree: -L target/release -lvoussoir with an rpath"
 tree=${CARGO_TARGET_DIR:-$root/target}/release
