@@ -2,8 +2,8 @@
 // of the C ABI (NULL in each slot, zero / huge / overflowing lengths, out-of-range ids, NaN,
 // invalid enums, NaN / negative / out-of-range settings, destroy(NULL), short buffers), each
 // with the right status, a non-empty one-line message naming the argument, and untouched
-// outputs and handles; then RAII use from C++ (std::unique_ptr with custom deleters, a
-// throwing status check, progress callbacks, concurrent solves).
+// outputs and handles; then concurrent solves on shared const handles. Handles are owned by
+// voussoir.hpp's classes (test_cpp_api.cpp tests those).
 #include "support.hpp"
 
 #include <gtest/gtest.h>
@@ -22,9 +22,6 @@
 namespace {
 
 using vsrt::MeshData;
-using vsrt::MeshPtr;
-using vsrt::ResultPtr;
-using vsrt::SettingsPtr;
 
 // A square of 4 triangles around a raised centre vertex, corners anchored (as tests/c/hostile.c).
 const std::vector<double> kPositions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 0.3};
@@ -63,16 +60,15 @@ VsrResult *const kSentinelResult = reinterpret_cast<VsrResult *>(uintptr_t{0xdea
     return ::testing::AssertionSuccess();
 }
 
-MeshPtr square() {
+voussoir::Mesh square() {
     return vsrt::make_mesh({"square", kPositions, kTriangles, kAnchored});
 }
 
 // Force densities of an analysis with these handles (to show a handle kept its state).
 std::vector<double> analyse_q(const VsrMesh *mesh, const VsrSettings *settings) {
     VsrResult *raw = nullptr;
-    vsrt::check(vsr_analyse(mesh, settings, &raw), "vsr_analyse");
-    ResultPtr result(raw);
-    return vsrt::read_solution(result.get()).force_densities;
+    voussoir::check(vsr_analyse(mesh, settings, &raw));
+    return voussoir::Result(raw).force_densities();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -205,7 +201,7 @@ TEST_P(MeshCreate, FailsCleanly) {
     EXPECT_TRUE(Fails(c.call(&out), c.want, c.argument));
     EXPECT_EQ(out, kSentinelMesh) << "output written on failure";
     // The failure leaves nothing behind: the same thread can go on.
-    MeshPtr ok = square();
+    voussoir::Mesh ok = square();
     EXPECT_STREQ(vsr_last_error_message(), "");
 }
 
@@ -308,8 +304,8 @@ class Setter : public ::testing::TestWithParam<SetterCase> {};
 
 TEST_P(Setter, FailsCleanlyAndKeepsTheSettings) {
     const SetterCase &c = GetParam();
-    MeshPtr mesh = square();
-    SettingsPtr settings = vsrt::make_settings();
+    voussoir::Mesh mesh = square();
+    voussoir::Settings settings;
     const std::vector<double> before = analyse_q(mesh.get(), settings.get());
     EXPECT_TRUE(Fails(c.call(settings.get()), c.want, c.argument));
     EXPECT_EQ(analyse_q(mesh.get(), settings.get()), before) << "settings changed by a failure";
@@ -319,7 +315,7 @@ INSTANTIATE_TEST_SUITE_P(Contract, Setter, ::testing::ValuesIn(setter_cases()),
                          [](const auto &info) { return std::string(info.param.name); });
 
 TEST(Setter, ValidValuesAreAccepted) {
-    SettingsPtr s = vsrt::make_settings();
+    voussoir::Settings s;
     EXPECT_TRUE(Succeeds(vsr_settings_set_tolerance(s.get(), 1e-8)));
     EXPECT_TRUE(Succeeds(vsr_settings_set_q_min(s.get(), 0.0, VSR_BOUND_KIND_ABSOLUTE)));
     EXPECT_TRUE(Succeeds(vsr_settings_set_q_max(s.get(), kInf, VSR_BOUND_KIND_RELATIVE)));
@@ -392,8 +388,8 @@ class MeshSetter : public ::testing::TestWithParam<MeshSetterCase> {};
 
 TEST_P(MeshSetter, FailsCleanlyAndKeepsTheMesh) {
     const MeshSetterCase &c = GetParam();
-    MeshPtr mesh = square();
-    SettingsPtr settings = vsrt::make_settings();
+    voussoir::Mesh mesh = square();
+    voussoir::Settings settings;
     const std::vector<double> before = analyse_q(mesh.get(), settings.get());
     EXPECT_TRUE(Fails(c.call(mesh.get()), c.want, c.argument));
     EXPECT_EQ(analyse_q(mesh.get(), settings.get()), before) << "mesh changed by a failure";
@@ -420,8 +416,8 @@ TEST(Contract, DestroyNullDoesNothingAndKeepsTheLastError) {
 }
 
 TEST(Contract, SolvesRejectNullAndLeaveTheOutputAlone) {
-    MeshPtr mesh = square();
-    SettingsPtr settings = vsrt::make_settings();
+    voussoir::Mesh mesh = square();
+    voussoir::Settings settings;
     VsrResult *out = kSentinelResult;
     EXPECT_TRUE(Fails(vsr_analyse(nullptr, settings.get(), &out), VSR_STATUS_NULL_POINTER, "mesh"));
     EXPECT_TRUE(Fails(vsr_analyse(mesh.get(), nullptr, &out), VSR_STATUS_NULL_POINTER, "settings"));
@@ -444,7 +440,7 @@ TEST(Contract, SolvesRejectNullAndLeaveTheOutputAlone) {
     EXPECT_TRUE(Succeeds(vsr_mesh_set_face_density(mesh.get(), ones.data(), kF)));
     // Reuse after the failed calls.
     EXPECT_TRUE(Succeeds(vsr_analyse(mesh.get(), settings.get(), &out)));
-    ResultPtr result(out);
+    voussoir::Result result(out);
     EXPECT_NE(out, kSentinelResult);
 }
 
@@ -452,14 +448,14 @@ class Getters : public ::testing::Test {
   protected:
     void SetUp() override {
         mesh_ = square();
-        settings_ = vsrt::make_settings();
+        settings_ = voussoir::Settings();
         VsrResult *raw = nullptr;
-        vsrt::check(vsr_analyse(mesh_.get(), settings_.get(), &raw), "vsr_analyse");
-        result_.reset(raw);
+        voussoir::check(vsr_analyse(mesh_.get(), settings_.get(), &raw));
+        result_ = voussoir::Result(raw);
     }
-    MeshPtr mesh_;
-    SettingsPtr settings_;
-    ResultPtr result_;
+    voussoir::Mesh mesh_;
+    voussoir::Settings settings_;
+    voussoir::Result result_;
 };
 
 // Every copy-out getter of doubles: #V×3, #E, #V, #V, #V, #V×2, #V, #V, #V×2, #F×2, #S×4.
@@ -579,7 +575,7 @@ TEST(Contract, LastErrorIsPerThread) {
     std::string there = "unset";
     std::thread([&] {
         there = vsr_last_error_message();   // a fresh thread has no error
-        SettingsPtr s = vsrt::make_settings();
+        voussoir::Settings s;
         (void)vsr_settings_set_tolerance(s.get(), -1.0);
     }).join();
     EXPECT_EQ(there, "");
@@ -587,79 +583,12 @@ TEST(Contract, LastErrorIsPerThread) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// RAII from C++.
+// Concurrency through the C API (voussoir.hpp owns the handles).
 
-TEST(Raii, HandlesAreOwnedByUniquePtrs) {
-    MeshPtr mesh = square();
-    SettingsPtr settings = vsrt::make_settings();
-    VsrResult *raw = nullptr;
-    vsrt::check(vsr_form_find(mesh.get(), settings.get(), &raw), "vsr_form_find");
-    ResultPtr result(raw);
-    // A result owns its data: it outlives the mesh and the settings it came from.
-    mesh.reset();
-    settings.reset();
-    const vsrt::Solution s = vsrt::read_solution(result.get());
-    EXPECT_EQ(s.kind, VSR_RESULT_KIND_FORM_FINDING);
-    EXPECT_EQ(s.termination, VSR_TERMINATION_CONVERGED) << s.termination_message;
-    EXPECT_EQ(s.n_vertices, kV);
-    // Moves transfer ownership; the moved-from pointer is empty and destroys nothing.
-    ResultPtr other = std::move(result);
-    EXPECT_EQ(result, nullptr);
-    EXPECT_NE(other, nullptr);
-}
-
-TEST(Raii, FailuresThrowWithTheLibrarysMessageAndLeakNothing) {
-    try {
-        MeshPtr mesh = vsrt::make_mesh({"bad", kPositions, kTriangles, {}});
-        FAIL() << "no exception";
-    } catch (const vsrt::Error &e) {
-        EXPECT_EQ(e.status(), VSR_STATUS_NO_SUPPORT);
-        EXPECT_NE(e.message().find("`anchored`"), std::string::npos) << e.message();
-        EXPECT_NE(std::string(e.what()).find("VSR_STATUS_NO_SUPPORT"), std::string::npos);
-    }
-    // Handles created before a throw are released by their unique_ptrs (ASan checks).
-    EXPECT_THROW(
-        {
-            SettingsPtr settings = vsrt::make_settings();
-            MeshPtr mesh = square();
-            vsrt::check(vsr_settings_set_schedule_eta(settings.get(), -1.0), "eta");
-        },
-        vsrt::Error);
-}
-
-TEST(Raii, ProgressCallbackCancelsFromCpp) {
-    MeshData dome = vsrt::generated("disk_cap");
-    MeshPtr mesh = vsrt::make_mesh(dome);
-    SettingsPtr settings = vsrt::make_settings();
-    struct Progress {
-        std::vector<double> eps;
-        std::size_t cancel_at;
-    } progress{{}, 2};
-    // A captureless lambda converts to the C function pointer; it must not throw.
-    auto callback = [](void *user, std::size_t iteration, double eps_inf) noexcept -> int {
-        auto *p = static_cast<Progress *>(user);
-        p->eps.push_back(eps_inf);
-        return iteration + 1 >= p->cancel_at ? 1 : 0;
-    };
-    ASSERT_TRUE(Succeeds(vsr_settings_set_progress(settings.get(), callback, &progress)));
-    VsrResult *raw = nullptr;
-    ASSERT_TRUE(Succeeds(vsr_form_find(mesh.get(), settings.get(), &raw)));
-    ResultPtr result(raw);
-    const vsrt::Solution s = vsrt::read_solution(result.get());
-    EXPECT_EQ(s.termination, VSR_TERMINATION_CANCELLED) << s.termination_message;
-    EXPECT_EQ(progress.eps.size(), 2u);
-    EXPECT_EQ(s.iterations, 2u);
-    std::size_t needed = 0;
-    ASSERT_TRUE(Succeeds(vsr_result_eps_history(result.get(), nullptr, 0, &needed)));
-    std::vector<double> history(needed);
-    ASSERT_TRUE(Succeeds(vsr_result_eps_history(result.get(), history.data(), needed, &needed)));
-    EXPECT_EQ(history, progress.eps);
-}
-
-TEST(Raii, ConcurrentSolvesOnSharedConstHandlesAgree) {
+TEST(Contract, ConcurrentSolvesOnSharedConstHandlesAgree) {
     MeshData dome = vsrt::generated("disk_off_centre_hole");
-    const MeshPtr mesh = vsrt::make_mesh(dome);
-    const SettingsPtr settings = vsrt::make_settings();
+    const voussoir::Mesh mesh = vsrt::make_mesh(dome);
+    const voussoir::Settings settings;
     const VsrMesh *m = mesh.get();
     const VsrSettings *s = settings.get();
     std::vector<double> q[2];

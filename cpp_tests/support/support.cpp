@@ -33,101 +33,56 @@
 namespace vsrt {
 
 // =============================================================================================
-// RAII and copy-out
+// Solves through voussoir.hpp
 
-Error::Error(const std::string &call, VsrStatus status)
-    : std::runtime_error(call + ": " + vsr_status_name(status) + ": " + vsr_last_error_message()),
-      status_(status),
-      message_(vsr_last_error_message()) {}
-
-void check(VsrStatus status, const char *call) {
-    if (status != VSR_STATUS_OK) throw Error(call, status);
+voussoir::Mesh make_mesh(const MeshData &mesh) {
+    return voussoir::Mesh(mesh.positions, mesh.triangles, mesh.anchored);
 }
 
-MeshPtr make_mesh(const MeshData &mesh) {
-    VsrMesh *raw = nullptr;
-    check(vsr_mesh_create(mesh.positions.data(), mesh.n_vertices(), mesh.triangles.data(),
-                          mesh.n_faces(), mesh.anchored.data(), mesh.anchored.size(), &raw),
-          "vsr_mesh_create");
-    return MeshPtr(raw);
-}
-
-SettingsPtr make_settings() {
-    VsrSettings *raw = nullptr;
-    check(vsr_settings_create(&raw), "vsr_settings_create");
-    return SettingsPtr(raw);
-}
-
-namespace {
-
-// Size query, then copy: the pattern every copy-out getter supports.
-template <typename T, typename Getter>
-std::vector<T> copy_out(Getter getter, const VsrResult *result, const char *call) {
-    std::size_t needed = 0;
-    check(getter(result, nullptr, 0, &needed), call);
-    std::vector<T> out(needed);
-    std::size_t again = 0;
-    check(getter(result, out.data(), out.size(), &again), call);
-    if (again != needed) throw std::runtime_error(std::string(call) + ": size changed");
-    return out;
-}
-
-}  // namespace
-
-#define VSRT_COPY(T, fn) copy_out<T>(fn, result, #fn)
-
-Solution read_solution(const VsrResult *result) {
+Solution read_solution(const voussoir::Result &result) {
     Solution s;
-    check(vsr_result_kind(result, &s.kind), "vsr_result_kind");
-    check(vsr_result_counts(result, &s.n_vertices, &s.n_edges, &s.n_faces, &s.n_holes),
-          "vsr_result_counts");
-    s.positions = VSRT_COPY(double, vsr_result_positions);
-    s.edges = VSRT_COPY(uint32_t, vsr_result_edges);
-    s.force_densities = VSRT_COPY(double, vsr_result_force_densities);
-    s.weights = VSRT_COPY(double, vsr_result_weights);
-    s.airy = VSRT_COPY(double, vsr_result_airy);
-    s.loads = VSRT_COPY(double, vsr_result_loads);
-    s.external = VSRT_COPY(double, vsr_result_external_horizontal);
-    s.residuals = VSRT_COPY(double, vsr_result_residuals);
-    s.imbalance = VSRT_COPY(double, vsr_result_horizontal_imbalance);
-    s.holes = VSRT_COPY(double, vsr_result_hole_coefficients);
-    s.centres = VSRT_COPY(double, vsr_result_force_diagram_centres);
-    s.segments = VSRT_COPY(double, vsr_result_force_diagram_segments);
-    s.segment_edges = VSRT_COPY(uint32_t, vsr_result_force_diagram_segment_edges);
-    check(vsr_result_stress_summary(result, &s.stress_status, &s.eps_inf, &s.objective,
-                                    &s.qp_iterations),
-          "vsr_result_stress_summary");
+    s.kind = result.kind();
+    const voussoir::Counts counts = result.counts();
+    s.n_vertices = counts.vertices, s.n_edges = counts.edges;
+    s.n_faces = counts.faces, s.n_holes = counts.holes;
+    s.positions = result.positions();
+    s.edges = result.edges();
+    s.force_densities = result.force_densities();
+    s.weights = result.weights();
+    s.airy = result.airy();
+    s.loads = result.loads();
+    s.external = result.external_horizontal();
+    s.residuals = result.residuals();
+    s.imbalance = result.horizontal_imbalance();
+    s.holes = result.hole_coefficients();
+    s.centres = result.force_diagram_centres();
+    s.segments = result.force_diagram_segments();
+    s.segment_edges = result.force_diagram_segment_edges();
+    const voussoir::StressSummary stress = result.stress_summary();
+    s.stress_status = stress.status;
+    s.eps_inf = stress.eps_inf, s.objective = stress.objective;
+    s.qp_iterations = stress.qp_iterations;
     if (s.kind == VSR_RESULT_KIND_FORM_FINDING) {
-        check(vsr_result_termination(result, &s.termination, &s.iterations),
-              "vsr_result_termination");
-        std::vector<char> text = VSRT_COPY(char, vsr_result_termination_message);
-        s.termination_message = text.empty() ? std::string() : std::string(text.data());
+        const voussoir::Termination termination = result.termination();
+        s.termination = termination.reason;
+        s.iterations = termination.iterations;
+        s.termination_message = result.termination_message();
     }
     return s;
 }
-
-#undef VSRT_COPY
 
 const char *to_string(Solve solve) {
     return solve == Solve::Analysis ? "analysis" : "form finding";
 }
 
 Solution solve(const MeshData &mesh, Solve how, std::size_t max_iterations) {
-    MeshPtr vmesh = make_mesh(mesh);
-    SettingsPtr settings = make_settings();
-    check(vsr_settings_set_max_iterations(settings.get(), max_iterations),
-          "vsr_settings_set_max_iterations");
+    const voussoir::Mesh vmesh = make_mesh(mesh);
+    voussoir::Settings settings;
     // reference_check explains the faces along hole cuts and the force diagram's closure
     // around holes by constant Airy jumps only (no net force through a hole).
-    check(vsr_settings_set_hole_mode(settings.get(), VSR_HOLE_MODE_CONSTANT),
-          "vsr_settings_set_hole_mode");
-    VsrResult *raw = nullptr;
-    if (how == Solve::Analysis)
-        check(vsr_analyse(vmesh.get(), settings.get(), &raw), "vsr_analyse");
-    else
-        check(vsr_form_find(vmesh.get(), settings.get(), &raw), "vsr_form_find");
-    ResultPtr result(raw);
-    return read_solution(result.get());
+    settings.max_iterations(max_iterations).hole_mode(VSR_HOLE_MODE_CONSTANT);
+    return read_solution(how == Solve::Analysis ? voussoir::analyse(vmesh, settings)
+                                                : voussoir::form_find(vmesh, settings));
 }
 
 // =============================================================================================

@@ -1,9 +1,10 @@
-// Support code of the C++ tests: RAII wrappers over the C API, meshes built by CGAL and read
-// by OpenMesh, and the CGAL-based reference checker. Only support.cpp includes CGAL and
-// OpenMesh (they are slow to compile); the tests include this header alone.
+// Support code of the C++ tests: meshes built by CGAL and read by OpenMesh, results as plain
+// arrays, and the CGAL-based reference checker. Handles and errors are the public
+// voussoir.hpp's. Only support.cpp includes CGAL and OpenMesh (they are slow to compile);
+// the tests include this header alone.
 #pragma once
 
-#include <voussoir.h>
+#include <voussoir.hpp>
 
 #include <array>
 #include <cstddef>
@@ -17,37 +18,6 @@
 namespace vsrt {
 
 // ---------------------------------------------------------------------------------------------
-// RAII over the C API: std::unique_ptr with custom deleters, and a throwing status check.
-
-struct MeshDeleter {
-    void operator()(VsrMesh *m) const noexcept { vsr_mesh_destroy(m); }
-};
-struct SettingsDeleter {
-    void operator()(VsrSettings *s) const noexcept { vsr_settings_destroy(s); }
-};
-struct ResultDeleter {
-    void operator()(VsrResult *r) const noexcept { vsr_result_destroy(r); }
-};
-using MeshPtr = std::unique_ptr<VsrMesh, MeshDeleter>;
-using SettingsPtr = std::unique_ptr<VsrSettings, SettingsDeleter>;
-using ResultPtr = std::unique_ptr<VsrResult, ResultDeleter>;
-
-// A failed C call: the status and the library's one-line message (copied at once).
-class Error : public std::runtime_error {
-  public:
-    Error(const std::string &call, VsrStatus status);
-    VsrStatus status() const noexcept { return status_; }
-    const std::string &message() const noexcept { return message_; }
-
-  private:
-    VsrStatus status_;
-    std::string message_;
-};
-
-// Throws Error unless `status` is VSR_STATUS_OK.
-void check(VsrStatus status, const char *call);
-
-// ---------------------------------------------------------------------------------------------
 // Problems and solutions as plain arrays (the C API's layouts).
 
 struct MeshData {
@@ -59,10 +29,9 @@ struct MeshData {
     std::size_t n_faces() const { return triangles.size() / 3; }
 };
 
-MeshPtr make_mesh(const MeshData &mesh);   // throws Error
-SettingsPtr make_settings();               // defaults; throws Error
+voussoir::Mesh make_mesh(const MeshData &mesh);   // throws voussoir::Error
 
-// Everything a result reports, read through the copy-out getters (size query first).
+// Everything a result reports, read through voussoir::Result's getters.
 struct Solution {
     VsrResultKind kind = VSR_RESULT_KIND_ANALYSIS;
     std::size_t n_vertices = 0, n_edges = 0, n_faces = 0, n_holes = 0;
@@ -88,7 +57,7 @@ struct Solution {
     std::string termination_message;
 };
 
-Solution read_solution(const VsrResult *result);   // throws Error
+Solution read_solution(const voussoir::Result &result);   // throws voussoir::Error
 
 enum class Solve { Analysis, FormFinding };
 const char *to_string(Solve solve);
