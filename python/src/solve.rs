@@ -5,7 +5,7 @@ use crate::errors::{from_error, invalid};
 use crate::mesh::Mesh;
 use crate::results;
 use crate::settings;
-use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -105,6 +105,16 @@ pub fn write_mesh(
     }
     let flat: Vec<f64> = positions.as_array().iter().copied().collect();
     let rows: Vec<[f64; 3]> = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    voussoir::io::write_mesh(&std::path::Path::new(&path), &rows, &m.input_faces())
+    voussoir::io::write_mesh(&path, &rows, &m.input_faces())
         .map_err(|e| from_error("path", e))
+}
+
+/// The vertices and faces of a mesh file as they are (no welding, no validation).
+#[pyfunction]
+pub fn read_mesh_file<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+    let (positions, faces) = voussoir::io::read_mesh(&path).map_err(|e| from_error("path", e))?;
+    Ok((results::matrix(py, &positions), results::matrix(py, &faces)))
 }
