@@ -35,10 +35,9 @@ fn rows<T: numpy::Element + Copy>(
         } else {
             format!("(n, {width})")
         };
-        let got: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
         return Err(invalid(
             name,
-            format_args!("has shape ({}), expected {want}", got.join(", ")),
+            format_args!("has shape {}, expected {want}", shape_text(shape)),
         ));
     }
     Ok(array.as_array().iter().copied().collect())
@@ -58,6 +57,17 @@ fn ids(name: &str, values: Vec<i64>) -> PyResult<Vec<u32>> {
             })
         })
         .collect()
+}
+
+/// A shape as Python prints it: `(5,)`, `(5, 2)`.
+pub fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => {
+            let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+            format!("({})", dims.join(", "))
+        }
+    }
 }
 
 fn triples<T: Copy>(flat: &[T]) -> Vec<[T; 3]> {

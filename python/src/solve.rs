@@ -100,7 +100,10 @@ pub fn write_mesh(
     if positions.shape() != [n, 3] {
         return Err(invalid(
             "positions",
-            format_args!("has shape {:?}, expected ({n}, 3)", positions.shape()),
+            format_args!(
+                "has shape {}, expected ({n}, 3)",
+                crate::mesh::shape_text(positions.shape())
+            ),
         ));
     }
     let flat: Vec<f64> = positions.as_array().iter().copied().collect();

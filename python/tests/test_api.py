@@ -52,7 +52,8 @@ def test_settings_reach_the_solver(models):
     one_step = voussoir.form_find(mesh, method="paper", max_iterations=1, tolerance=1e-300)
     assert one_step.iterations == 1 and one_step.termination == "max_iterations"
     bounded = voussoir.analyse(mesh, q_max=1e-3, q_max_kind="absolute", q_min=0.0)
-    assert bounded.status == "infeasible"
+    assert bounded.force_densities.max() <= 1e-3 * (1 + 1e-6)
+    assert bounded.eps_inf > voussoir.analyse(mesh).eps_inf
 
 
 def expected_shapes(n, m, e, h, s):
