@@ -151,9 +151,14 @@ fn with_loads(
     let p = loads(p, "extra_loads", extra_loads, 1, false, |p, v| {
         p.with_extra_loads(v)
     })?;
-    let p = loads(p, "horizontal_forces", horizontal_forces, 2, false, |p, v| {
-        p.with_horizontal_forces(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect())
-    })?;
+    let p = loads(
+        p,
+        "horizontal_forces",
+        horizontal_forces,
+        2,
+        false,
+        |p, v| p.with_horizontal_forces(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect()),
+    )?;
     loads(p, "prescribed_tau", prescribed_tau, 1, false, |p, v| {
         p.with_prescribed_tau(v)
     })
@@ -163,7 +168,10 @@ fn tolerance(name: &str, value: f64) -> PyResult<f64> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
-        Err(invalid(name, format_args!("{value} is not a finite number >= 0")))
+        Err(invalid(
+            name,
+            format_args!("{value} is not a finite number >= 0"),
+        ))
     }
 }
 
@@ -183,7 +191,8 @@ impl Mesh {
         let positions = triples(&rows("vertices", &vertices, 3)?);
         let faces = triples(&ids("faces", rows("faces", &faces, 3)?)?);
         let anchored = ids("anchored", rows("anchored", &anchored, 1)?)?;
-        let mesh = RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("faces", e))?;
+        let mesh =
+            RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("faces", e))?;
         let problem = with_loads(
             Problem::new(mesh),
             face_density,

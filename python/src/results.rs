@@ -42,7 +42,10 @@ pub fn stress<'py>(
     d.set_item("positions", matrix(py, positions))?;
     let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
     d.set_item("edges", matrix(py, &edges))?;
-    d.set_item("force_densities", PyArray1::from_slice(py, &s.force_densities))?;
+    d.set_item(
+        "force_densities",
+        PyArray1::from_slice(py, &s.force_densities),
+    )?;
     d.set_item("airy", PyArray1::from_slice(py, &s.airy))?;
     d.set_item("weights", PyArray1::from_slice(py, &s.weights))?;
     d.set_item("hole_coefficients", matrix(py, &s.hole_coefficients))?;
@@ -91,7 +94,9 @@ fn termination(t: &Termination) -> (&'static str, Vec<u32>, Option<String>) {
         Termination::Infeasible { constraint } => ("infeasible", vec![], Some(constraint.clone())),
         Termination::NumericalError { what } => ("numerical_error", vec![], Some(what.clone())),
         Termination::Cancelled => ("cancelled", vec![], None),
-        Termination::Blocked { vertices, hint } => ("blocked", vertices.clone(), Some(hint.clone())),
+        Termination::Blocked { vertices, hint } => {
+            ("blocked", vertices.clone(), Some(hint.clone()))
+        }
     }
 }
 

@@ -51,16 +51,23 @@ fn choice<T: Copy>(name: &str, value: &Bound<'_, PyAny>, table: &[(&str, T)]) ->
     let text: String = value.extract().map_err(|_| {
         invalid(
             name,
-            format_args!("{} is not a string", value.repr().map_or("?".into(), |r| r.to_string())),
+            format_args!(
+                "{} is not a string",
+                value.repr().map_or("?".into(), |r| r.to_string())
+            ),
         )
     })?;
-    table.iter().find(|(n, _)| *n == text).map(|(_, v)| *v).ok_or_else(|| {
-        let allowed: Vec<String> = table.iter().map(|(n, _)| format!("'{n}'")).collect();
-        invalid(
-            name,
-            format_args!("'{text}' is not one of {}", allowed.join(", ")),
-        )
-    })
+    table
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| {
+            let allowed: Vec<String> = table.iter().map(|(n, _)| format!("'{n}'")).collect();
+            invalid(
+                name,
+                format_args!("'{text}' is not one of {}", allowed.join(", ")),
+            )
+        })
 }
 
 fn number(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {

@@ -108,16 +108,15 @@ pub fn write_mesh(
     }
     let flat: Vec<f64> = positions.as_array().iter().copied().collect();
     let rows: Vec<[f64; 3]> = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    voussoir::io::write_mesh(&path, &rows, &m.input_faces())
-        .map_err(|e| from_error("path", e))
+    voussoir::io::write_mesh(&path, &rows, &m.input_faces()).map_err(|e| from_error("path", e))
 }
+
+/// (n, 3) float64 vertices and (m, 3) uint32 faces.
+type RawArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
 
 /// The vertices and faces of a mesh file as they are (no welding, no validation).
 #[pyfunction]
-pub fn read_mesh_file<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>)> {
+pub fn read_mesh_file<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RawArrays<'py>> {
     let (positions, faces) = voussoir::io::read_mesh(&path).map_err(|e| from_error("path", e))?;
     Ok((results::matrix(py, &positions), results::matrix(py, &faces)))
 }
