@@ -7,13 +7,7 @@ Every setting of the Rust `FormFindSettings` and `StressSettings` (and so of the
 
 from __future__ import annotations
 
-import sys
-from typing import Optional, Tuple
-
-if sys.version_info >= (3, 11):
-    from typing import Literal, TypedDict
-else:  # pragma: no cover - Python 3.9 and 3.10
-    from typing import Literal, TypedDict
+from typing import Literal, Optional, Tuple, TypedDict
 
 
 class Settings(TypedDict, total=False):
