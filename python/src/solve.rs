@@ -5,7 +5,7 @@ use crate::errors::{from_error, invalid};
 use crate::mesh::Mesh;
 use crate::results;
 use crate::settings;
-use numpy::{PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -111,12 +111,27 @@ pub fn write_mesh(
     voussoir::io::write_mesh(&path, &rows, &m.input_faces()).map_err(|e| from_error("path", e))
 }
 
-/// (n, 3) float64 vertices and (m, 3) uint32 faces.
-type RawArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
+/// Welded (n, 3) float64 vertices, (m, 3) uint32 faces and, per file vertex, its welded id.
+type WeldedArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<u32>>,
+);
 
-/// The vertices and faces of a mesh file as they are (no welding, no validation).
+/// The vertices and faces of a mesh file, welded as `Mesh.from_file` welds them (no other
+/// check): what the command line's `--anchor-boundary` and `--anchor-lowest` look at.
 #[pyfunction]
-pub fn read_mesh_file<'py>(py: Python<'py>, path: PathBuf) -> PyResult<RawArrays<'py>> {
+pub fn read_welded<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    weld_tolerance: f64,
+) -> PyResult<WeldedArrays<'py>> {
     let (positions, faces) = voussoir::io::read_mesh(&path).map_err(|e| from_error("path", e))?;
-    Ok((results::matrix(py, &positions), results::matrix(py, &faces)))
+    let w = voussoir::io::weld(&positions, &faces, weld_tolerance)
+        .map_err(|e| from_error("path", e))?;
+    Ok((
+        results::matrix(py, &w.positions),
+        results::matrix(py, &w.faces),
+        PyArray1::from_vec(py, w.welded_id),
+    ))
 }

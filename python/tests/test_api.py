@@ -170,3 +170,13 @@ def test_command_line_rejects_bad_input_and_writes_nothing(tmp_path):
     assert not (tmp_path / "formfind-out").exists()
     done = run_cli("bad.off", cwd=tmp_path)
     assert done.returncode == 2 and "--supports" in done.stderr
+
+
+def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):
+    # An STL file repeats every vertex per triangle: the boundary is the welded mesh's.
+    square().write(tmp_path / "square.stl")
+    done = run_cli("square.stl", "--anchor-boundary", "--stress-only", "--report", "r.json",
+                   "--out", "out.obj", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert len(report["anchored"]) == 4 and len(report["positions"]) == 5

@@ -142,11 +142,15 @@ def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
         raise Failure(f"--weld: must be >= 0, got {weld}")
     anchored: Optional[List[int]] = None
     if not a.supports:
-        vertices, faces = _native.read_mesh_file(os.fspath(a.mesh))
+        # Boundary and heights of the welded mesh, named by a file vertex of each.
+        vertices, faces, welded_id = _native.read_welded(os.fspath(a.mesh), weld)
+        faces = faces.astype(np.int64)
         if a.anchor_boundary:
-            anchored = _boundary_vertices(faces.astype(np.int64))
+            chosen = _boundary_vertices(faces)
         else:
-            anchored = _lowest_vertices(vertices, faces.astype(np.int64), a.anchor_lowest)
+            chosen = _lowest_vertices(vertices, faces, a.anchor_lowest)
+        _, first_file_vertex = np.unique(welded_id, return_index=True)
+        anchored = [int(first_file_vertex[v]) for v in chosen]
     probe = voussoir.Mesh.from_file(
         a.mesh, a.supports, anchored=anchored, weld_tolerance=weld,
         repair_tolerance=0.0 if a.strict else None,
