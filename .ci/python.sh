@@ -14,7 +14,8 @@ work=${VSR_PYTHON_DIR:-$root/target/python-checks}
 python=${PYTHON:-python3}
 step() { printf '\n== %s\n' "$*"; }
 
-if ! "$python" -m venv --help >/dev/null 2>&1; then
+# Debian's python3 has venv but not ensurepip without python3-venv.
+if ! "$python" -c 'import ensurepip, venv' >/dev/null 2>&1; then
   # shellcheck source=.ci/apt.sh
   source .ci/apt.sh
   ensure_debian_packages python3-venv
