@@ -2,9 +2,10 @@
 raises VoussoirError with the C API's message, the argument named as the Python signature names
 it (C `positions`/`triangles` are `vertices`/`faces`; a setter's value is its keyword).
 
-C cases without a Python form: NULL `out` pointers and lengths past the address space (numpy
-arrays carry their own length), short copy-out buffers (results are whole arrays), and getters a
-result kind lacks (an analysis result has no `history` attribute at all).
+C cases without a Python form: NULL `out` pointers, NULL handles to setters and to
+`_destroy` (there are no handles), lengths past the address space (numpy arrays carry their own
+length), short copy-out buffers (results are whole arrays), getters a result kind lacks (an
+analysis result has no `history` attribute at all) and status names (there are no statuses).
 """
 
 from __future__ import annotations
@@ -178,6 +179,17 @@ def test_zero_density_is_nothing_to_balance():
 
 def test_not_a_mesh():
     raises("argument `mesh`: is a list, not a voussoir.Mesh", voussoir.analyse, [V, F, A])
+    raises("argument `mesh`: is a NoneType, not a voussoir.Mesh", voussoir.form_find, None)
+
+
+def test_a_valid_mesh_after_failures_solves_and_keeps_its_positions():
+    for bad in ({"tolerance": -1.0}, {"tau": "sideways"}):
+        with pytest.raises(voussoir.VoussoirError):
+            voussoir.analyse(mesh(), **bad)
+    result = voussoir.analyse(mesh())
+    assert result.status == "solved"
+    assert np.array_equal(result.positions, np.array(V, dtype=float))
+    assert result.positions[4, 2] == 0.3
 
 
 def test_bad_progress():
@@ -196,6 +208,7 @@ def test_mesh_files(tmp_path, monkeypatch):
     (tmp_path / "short.stl").write_bytes(bytes(90))
     (tmp_path / "good.off").write_text(GOOD_OFF)
     read = voussoir.Mesh.from_file
+    raises("argument `path` is None", read, None, anchored=A)
     raises(
         "argument `path`: missing.obj: No such file or directory (os error 2)",
         read,
@@ -251,6 +264,8 @@ def test_mesh_files(tmp_path, monkeypatch):
         anchored=A,
     )
     good = read("good.off", "supports.json")
+    raises("argument `path` is None", good.write, None)
+    raises("argument `positions`: has shape (4, 3), expected (5, 3)", good.write, "x.off", np.zeros((4, 3)))
     message = str(pytest.raises(voussoir.VoussoirError, good.write, "no_such_dir/out.off").value)
     assert re.match(r"argument `path`: .*no_such_dir", message), message
     assert not (tmp_path / "no_such_dir").exists()

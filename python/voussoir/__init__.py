@@ -217,7 +217,7 @@ class Mesh:
         """Writes `positions` (default: the mesh's own) with the faces to `path`: .obj, .off,
         .ply (every bit kept) or .stl (single precision), all or nothing."""
         points = self.vertices if positions is None else _floats("positions", positions)
-        _native.write_mesh(self._native, points, os.fspath(path))
+        _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
 
     def __repr__(self) -> str:
         return (
