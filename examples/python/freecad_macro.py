@@ -47,20 +47,19 @@ def form_find_points(
 
 def run_in_freecad() -> None:  # pragma: no cover - needs FreeCAD
     import FreeCAD
+    import FreeCADGui
     import Mesh as FreeCADMesh
 
     doc = FreeCAD.ActiveDocument
-    selected = [o for o in FreeCAD.Gui.Selection.getSelection() if hasattr(o, "Mesh")]
+    selected = [o for o in FreeCADGui.Selection.getSelection() if hasattr(o, "Mesh")]
     source = selected[0] if selected else next(o for o in doc.Objects if hasattr(o, "Mesh"))
-    topology = source.Mesh.Topology
-    points = [(p.x, p.y, p.z) for p in topology[0]]
-    found, summary = form_find_points(points, topology[1])
-    shape = FreeCADMesh.Mesh((found, topology[1]))
+    points, facets = source.Mesh.Topology
+    found, summary = form_find_points([(p.x, p.y, p.z) for p in points], facets)
+    triangles = [[found[i] for i in facet] for facet in facets]
     target = doc.addObject("Mesh::Feature", f"{source.Name}_selfsupporting")
-    target.Mesh = shape
+    target.Mesh = FreeCADMesh.Mesh(triangles)
     doc.recompute()
     FreeCAD.Console.PrintMessage(f"Voussoir: {summary}\n")
-
 
 if __name__ == "__main__":  # pragma: no cover - a FreeCAD macro runs as __main__
     run_in_freecad()

@@ -21,7 +21,7 @@ import numpy as np
 
 from . import _voussoir as _native
 from ._results import FormFindResult, StressResult
-from ._settings import SETTING_NAMES, Settings
+from ._settings import Settings
 
 if TYPE_CHECKING:
     from typing_extensions import Unpack
