@@ -1,0 +1,32 @@
+//! `voussoir._voussoir`: the native half of the Python package `voussoir`.
+//!
+//! It converts numpy arrays and keyword settings into the Rust library's types, runs the
+//! solvers with the GIL released, and hands results back as numpy arrays in a dict that
+//! `voussoir/_results.py` wraps in typed classes. Errors carry the C API's one-line messages,
+//! with the argument named as the Python signature names it.
+
+mod errors;
+mod mesh;
+mod results;
+mod settings;
+mod solve;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("VoussoirError", m.py().get_type::<errors::VoussoirError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<mesh::Mesh>()?;
+    m.add("WELD_TOLERANCE", voussoir::io::DEFAULT_WELD_TOLERANCE)?;
+    m.add(
+        "REPAIR_TOLERANCE",
+        voussoir::mesh::repair::DEFAULT_REPAIR_TOLERANCE,
+    )?;
+    m.add_function(wrap_pyfunction!(settings::defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::analyse, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(solve::read_welded, m)?)?;
+    Ok(())
+}

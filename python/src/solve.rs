@@ -1,0 +1,137 @@
+//! The solves, with the GIL released; the progress hook re-attaches once per iteration to
+//! check for Ctrl-C and to call the user's callback, either of which may cancel.
+
+use crate::errors::{from_error, invalid};
+use crate::mesh::Mesh;
+use crate::results;
+use crate::settings;
+use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+fn settings_of(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<voussoir::FormFindSettings> {
+    match kwargs {
+        Some(k) => settings::from_kwargs(k),
+        None => Ok(voussoir::FormFindSettings::default()),
+    }
+}
+
+/// Stress analysis of the mesh as it stands; returns the result's fields.
+#[pyfunction]
+#[pyo3(signature = (mesh, settings=None))]
+pub fn analyse<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    settings: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let form = settings_of(settings)?;
+    let m: &Mesh = mesh.get();
+    let stress = py
+        .detach(|| voussoir::analyse(&m.problem, &form.stress))
+        .map_err(|e| from_error("mesh", e))?;
+    results::stress(py, &m.problem.mesh, &m.problem.mesh.positions, &stress)
+}
+
+/// What the progress hook saw: a Python exception (KeyboardInterrupt from Ctrl-C, or one the
+/// callback raised) is raised again once the solve has returned.
+fn progress_step(
+    py: Python<'_>,
+    callback: Option<&Py<PyAny>>,
+    k: usize,
+    eps: f64,
+) -> PyResult<bool> {
+    py.check_signals()?;
+    let Some(cb) = callback else {
+        return Ok(true);
+    };
+    let answer = cb.call1(py, (k, eps))?;
+    let answer = answer.bind(py);
+    Ok(answer.is_none() || answer.is_truthy()?)
+}
+
+/// Form finding; `progress(iteration, eps_inf)` is called after every stress step.
+#[pyfunction]
+#[pyo3(signature = (mesh, settings=None, progress=None))]
+pub fn form_find<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    settings: Option<&Bound<'py, PyDict>>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let form = settings_of(settings)?;
+    if let Some(p) = &progress {
+        if !p.is_none() && !p.is_callable() {
+            return Err(invalid("progress", "is not callable"));
+        }
+    }
+    let callback: Option<Py<PyAny>> = progress.filter(|p| !p.is_none()).map(Bound::unbind);
+    let m: &Mesh = mesh.get();
+    let mut raised: Option<PyErr> = None;
+    let found = py.detach(|| {
+        let mut hook = |k: usize, eps: f64| {
+            Python::attach(|py| match progress_step(py, callback.as_ref(), k, eps) {
+                Ok(go_on) => go_on,
+                Err(e) => {
+                    raised = Some(e);
+                    false
+                }
+            })
+        };
+        voussoir::form_find(&m.problem, &form, Some(&mut hook))
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    let found = found.map_err(|e| from_error("mesh", e))?;
+    results::form_found(py, &m.problem.mesh, &found)
+}
+
+/// Writes `positions` with the mesh's faces (as given) to `path`, in the format of its
+/// extension, all or nothing.
+#[pyfunction]
+pub fn write_mesh(
+    mesh: &Bound<'_, Mesh>,
+    positions: PyReadonlyArrayDyn<'_, f64>,
+    path: PathBuf,
+) -> PyResult<()> {
+    let m: &Mesh = mesh.get();
+    let n = m.problem.mesh.n_vertices();
+    if positions.shape() != [n, 3] {
+        return Err(invalid(
+            "positions",
+            format_args!(
+                "has shape {}, expected ({n}, 3)",
+                crate::mesh::shape_text(positions.shape())
+            ),
+        ));
+    }
+    let flat: Vec<f64> = positions.as_array().iter().copied().collect();
+    let rows: Vec<[f64; 3]> = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    voussoir::io::write_mesh(&path, &rows, &m.input_faces()).map_err(|e| from_error("path", e))
+}
+
+/// Welded (n, 3) float64 vertices, (m, 3) uint32 faces and, per file vertex, its welded id.
+type WeldedArrays<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<u32>>,
+    Bound<'py, PyArray1<u32>>,
+);
+
+/// The vertices and faces of a mesh file, welded as `Mesh.from_file` welds them (no other
+/// check): what the command line's `--anchor-boundary` and `--anchor-lowest` look at.
+#[pyfunction]
+pub fn read_welded<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    weld_tolerance: f64,
+) -> PyResult<WeldedArrays<'py>> {
+    let (positions, faces) = voussoir::io::read_mesh(&path).map_err(|e| from_error("path", e))?;
+    let w = voussoir::io::weld(&positions, &faces, weld_tolerance)
+        .map_err(|e| from_error("path", e))?;
+    Ok((
+        results::matrix(py, &w.positions),
+        results::matrix(py, &w.faces),
+        PyArray1::from_vec(py, w.welded_id),
+    ))
+}

@@ -1,0 +1,182 @@
+"""The Python API: shapes and dtypes of every result array, settings and their defaults,
+files in every format, loads, and the command line."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import voussoir
+from conftest import REPO, SQUARE_ANCHORED, SQUARE_FACES, SQUARE_POSITIONS
+
+from voussoir._settings import SETTING_NAMES
+
+
+def square(**loads) -> voussoir.Mesh:
+    return voussoir.Mesh(SQUARE_POSITIONS, SQUARE_FACES, SQUARE_ANCHORED, **loads)
+
+
+def test_import_has_the_library_version_and_error_is_a_value_error():
+    manifest = (REPO / "Cargo.toml").read_text()
+    assert f'\nversion = "{voussoir.__version__}"\n' in manifest
+    assert issubclass(voussoir.VoussoirError, ValueError)
+
+
+def test_settings_list_every_default_and_nothing_else():
+    d = voussoir.defaults()
+    assert set(d) == set(SETTING_NAMES)
+    assert d["method"] == "nearest" and d["q_max"] is None and d["dual_length_bounds"] is None
+
+
+def test_a_default_given_explicitly_changes_nothing():
+    mesh = square()
+    plain = voussoir.form_find(mesh)
+    explicit = voussoir.form_find(mesh, **voussoir.defaults())
+    assert np.array_equal(plain.positions, explicit.positions)
+    assert np.array_equal(plain.force_densities, explicit.force_densities)
+
+
+def test_settings_reach_the_solver(models):
+    vault = voussoir.Mesh.from_file(models / "free_vault.obj", models / "free_vault.json")
+    base = voussoir.analyse(vault)
+    plain_compression = voussoir.analyse(vault, q_min=0.0)
+    assert base.force_densities.min() > plain_compression.force_densities.min()
+    mesh = square()
+    edge_based = voussoir.analyse(mesh, formulation="edge_based", qp_solver="clarabel")
+    assert edge_based.formulation == "edge_based" and edge_based.qp_solver == "clarabel"
+    one_step = voussoir.form_find(mesh, method="paper", max_iterations=1, tolerance=1e-300)
+    assert one_step.iterations == 1 and one_step.termination == "max_iterations"
+    bounded = voussoir.analyse(mesh, q_max=1e-3, q_max_kind="absolute", q_min=0.0)
+    assert bounded.force_densities.max() <= 1e-3 * (1 + 1e-6)
+    assert bounded.eps_inf > voussoir.analyse(mesh).eps_inf
+
+
+def expected_shapes(n, m, e, h, s):
+    return {
+        "positions": ((n, 3), np.float64),
+        "edges": ((e, 2), np.uint32),
+        "force_densities": ((e,), np.float64),
+        "airy": ((n,), np.float64),
+        "weights": ((n,), np.float64),
+        "hole_coefficients": ((h, 3), np.float64),
+        "tau": ((n,), np.float64),
+        "external_horizontal": ((n, 2), np.float64),
+        "loads": ((n,), np.float64),
+        "residuals": ((n,), np.float64),
+        "horizontal_imbalance": ((n, 2), np.float64),
+        "force_diagram_centres": ((m, 2), np.float64),
+        "force_diagram_segments": ((s, 2, 2), np.float64),
+        "force_diagram_segment_edges": ((s,), np.uint32),
+    }
+
+
+def check_arrays(result, n, m, e, h):
+    s = len(result.force_diagram_segment_edges)
+    for name, (shape, dtype) in expected_shapes(n, m, e, h, s).items():
+        array = getattr(result, name)
+        assert isinstance(array, np.ndarray), name
+        assert array.shape == shape, (name, array.shape, shape)
+        assert array.dtype == dtype, (name, array.dtype)
+
+
+def test_result_arrays_have_the_documented_shapes_and_dtypes(models):
+    mesh = voussoir.Mesh.from_file(models / "hex.obj", models / "hex.json")
+    n, m, e, h = len(mesh.vertices), len(mesh.faces), len(mesh.edges), mesh.n_holes
+    assert h == 3
+    stress = voussoir.analyse(mesh)
+    check_arrays(stress, n, m, e, h)
+    found = voussoir.form_find(mesh, max_iterations=3)
+    check_arrays(found, n, m, e, h)
+    assert found.history.dtype == np.float64 and found.history.ndim == 1
+    assert found.termination_vertices.dtype == np.uint32
+    assert len(found.step_solvers) == found.iterations
+    assert isinstance(found.termination_message, str) and found.termination_message
+
+
+def test_mesh_round_trips_through_every_format(tmp_path):
+    mesh = square(face_density=[1, 2, 3, 4])
+    for suffix in (".obj", ".off", ".ply", ".stl"):
+        path = tmp_path / f"square{suffix}"
+        mesh.write(path)
+        again = voussoir.Mesh.from_file(path, anchored=[0, 1, 2, 3])
+        if suffix == ".stl":
+            # STL keeps single precision and one vertex per triangle corner, welded on reading.
+            assert len(again.vertices) == 5
+            assert len(again.welded_ids) == 12
+        else:
+            assert np.array_equal(again.vertices, mesh.vertices), suffix
+            assert np.array_equal(again.faces, mesh.faces), suffix
+
+
+def test_loads_are_kept_and_change_the_answer():
+    light = square()
+    heavy = square(face_density=[1, 1, 1, 5], extra_loads=[0, 0, 0, 0, 0.5])
+    assert np.array_equal(heavy.face_density, [1, 1, 1, 5])
+    assert heavy.extra_loads[4] == 0.5
+    assert voussoir.analyse(heavy).loads[4] > voussoir.analyse(light).loads[4]
+
+
+def test_faces_keep_their_orientation():
+    clockwise = [f[::-1] for f in SQUARE_FACES]
+    mesh = voussoir.Mesh(SQUARE_POSITIONS, clockwise, SQUARE_ANCHORED)
+    assert np.array_equal(mesh.faces, clockwise)
+
+
+def test_results_are_frozen_dataclasses():
+    found = voussoir.form_find(square())
+    assert dataclasses.is_dataclass(found)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        found.eps_inf = 0.0  # type: ignore[misc]
+    assert found.converged
+
+
+def run_cli(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "voussoir", *map(str, args)],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+    )
+
+
+def test_command_line_writes_the_mesh_and_report(tmp_path, models):
+    done = run_cli(
+        models / "neumunster.obj",
+        "--supports",
+        models / "neumunster.json",
+        "--out",
+        "out.ply",
+        "--report",
+        "r.json",
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["termination"] == "converged"
+    written = voussoir.Mesh.from_file(tmp_path / "out.ply", anchored=report["anchored"])
+    assert np.array_equal(written.vertices, np.array(report["positions"]))
+
+
+def test_command_line_rejects_bad_input_and_writes_nothing(tmp_path):
+    (tmp_path / "bad.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
+    done = run_cli("bad.off", "--anchor-boundary", cwd=tmp_path)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "bad.off:6:" in done.stderr
+    assert not (tmp_path / "formfind-out").exists()
+    done = run_cli("bad.off", cwd=tmp_path)
+    assert done.returncode == 2 and "--supports" in done.stderr
+
+
+def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):
+    # An STL file repeats every vertex per triangle: the boundary is the welded mesh's.
+    square().write(tmp_path / "square.stl")
+    done = run_cli("square.stl", "--anchor-boundary", "--stress-only", "--report", "r.json",
+                   "--out", "out.obj", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert len(report["anchored"]) == 4 and len(report["positions"]) == 5

@@ -1,0 +1,145 @@
+"""Control of a running solve: cancel from the progress callback (returning False or raising),
+Ctrl-C, the GIL released while solving, and two threads solving at once."""
+
+from __future__ import annotations
+
+import _thread
+import dataclasses
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import voussoir
+
+# The paper's loop with an unreachable tolerance runs every iteration it is allowed
+# (about 30 ms each on lilium): a solve whose length the test chooses.
+ENDLESS = dict(method="paper", tolerance=1e-300, stall_window=100_000)
+
+
+@pytest.fixture(scope="module")
+def lilium(models):
+    return voussoir.Mesh.from_file(models / "lilium.obj", models / "lilium.json")
+
+
+def test_returning_false_cancels_with_the_state_reached(lilium):
+    seen = []
+
+    def progress(k, eps):
+        seen.append((k, eps))
+        return k < 2
+
+    result = voussoir.form_find(lilium, progress=progress, **ENDLESS, max_iterations=50)
+    assert result.termination == "cancelled"
+    assert result.termination_message == "cancelled by the progress callback"
+    assert [k for k, _ in seen] == [0, 1, 2]
+    assert result.iterations == 3
+    assert all(isinstance(eps, float) and eps > 0 for _, eps in seen)
+
+
+def test_returning_none_goes_on(lilium):
+    calls = []
+    result = voussoir.form_find(lilium, progress=lambda k, e: calls.append(k), max_iterations=3,
+                                **{k: v for k, v in ENDLESS.items()})
+    assert result.termination == "max_iterations" and calls == [0, 1, 2]
+
+
+def test_an_exception_in_the_callback_cancels_and_propagates(lilium):
+    calls = []
+
+    def progress(k, eps):
+        calls.append(k)
+        if k == 1:
+            raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        voussoir.form_find(lilium, progress=progress, **ENDLESS, max_iterations=50)
+    assert calls == [0, 1]
+
+
+def test_ctrl_c_cancels_a_running_solve_without_a_callback(lilium):
+    # 2000 iterations would take about a minute; the interrupt comes after 0.3 s.
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            voussoir.form_find(lilium, **ENDLESS, max_iterations=2000)
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - start < 15
+
+
+def test_the_gil_is_released_while_solving(lilium):
+    started = threading.Event()
+    outcome = {}
+
+    def solve():
+        started.set()
+        outcome["result"] = voussoir.form_find(lilium, **ENDLESS, max_iterations=40)
+
+    worker = threading.Thread(target=solve)
+    worker.start()
+    started.wait()
+    time.sleep(0.05)
+    # Pure Python work for 0.2 s: were the GIL held by the solve (over a second long), this
+    # loop could only run once the solve had ended.
+    count, end = 0, time.perf_counter() + 0.2
+    while time.perf_counter() < end:
+        count += 1
+    still_solving = worker.is_alive()
+    worker.join()
+    assert still_solving and count > 1000
+    assert outcome["result"].iterations == 40
+
+
+def comparable(result):
+    """Every field but the timings."""
+    return {
+        k: v
+        for k, v in dataclasses.asdict(result).items()
+        if "seconds" not in k
+    }
+
+
+def assert_same(a, b):
+    fa, fb = comparable(a), comparable(b)
+    assert fa.keys() == fb.keys()
+    for key in fa:
+        if isinstance(fa[key], np.ndarray):
+            assert fa[key].dtype == fb[key].dtype and np.array_equal(fa[key], fb[key]), key
+        else:
+            assert fa[key] == fb[key], key
+
+
+def test_two_threads_solving_at_once_give_the_sequential_results(models):
+    meshes = [
+        voussoir.Mesh.from_file(models / f"{n}.obj", models / f"{n}.json")
+        for n in ("free_vault", "three_pillar")
+    ]
+    sequential = [voussoir.form_find(m) for m in meshes]
+    concurrent = [None, None]
+
+    def solve(i):
+        concurrent[i] = voussoir.form_find(meshes[i], progress=lambda k, e: None)
+
+    threads = [threading.Thread(target=solve, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for s, c in zip(sequential, concurrent):
+        assert_same(s, c)
+    # The same mesh from two threads at once, too.
+    twice = [None, None]
+
+    def again(i):
+        twice[i] = voussoir.analyse(meshes[0])
+
+    threads = [threading.Thread(target=again, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert_same(twice[0], twice[1])

@@ -1,0 +1,277 @@
+"""Voussoir: self-supporting masonry shapes (de Goes et al. 2013) from Python.
+
+    import voussoir
+    mesh = voussoir.Mesh.from_file("vault.obj", supports="vault.json")
+    result = voussoir.form_find(mesh, progress=lambda k, eps: print(k, eps))
+    result.positions          # (n, 3) float64: the self-supporting shape
+
+`Mesh` holds a validated triangle mesh with its supports and loads; `analyse` finds the best
+compressive stress of a shape as it stands, `form_find` the nearest self-supporting shape.
+Both take the library's settings as keyword arguments (see `Settings`; `defaults()` lists
+every default) and release the GIL while they solve. Bad input raises `VoussoirError`, a
+`ValueError`, with the library's one-line message naming the argument at fault.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Union
+
+import numpy as np
+
+from . import _voussoir as _native
+from ._results import FormFindResult, StressResult
+from ._settings import Settings
+
+if TYPE_CHECKING:
+    from typing_extensions import Unpack
+
+VoussoirError = _native.VoussoirError
+__version__: str = _native.__version__
+
+__all__ = [
+    "Mesh",
+    "analyse",
+    "form_find",
+    "defaults",
+    "FormFindResult",
+    "StressResult",
+    "Settings",
+    "VoussoirError",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Progress = Callable[[int, float], Optional[bool]]
+
+
+def _floats(name: str, value: Any) -> Optional[np.ndarray]:
+    if value is None:
+        return None
+    try:
+        return np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise VoussoirError(f"argument `{name}`: is not an array of numbers ({e})") from None
+
+
+def _ids(name: str, value: Any) -> np.ndarray:
+    array = np.asarray(value)
+    if array.size == 0:
+        return np.zeros(array.shape, dtype=np.int64)
+    if array.dtype.kind not in "iu":
+        raise VoussoirError(
+            f"argument `{name}`: holds {array.dtype} values, expected integer ids"
+        )
+    if array.dtype.kind == "u" and array.size and array.max() > np.iinfo(np.int64).max:
+        raise VoussoirError(f"argument `{name}`: holds an id beyond 2^63")
+    return np.ascontiguousarray(array, dtype=np.int64)
+
+
+def _required(name: str, value: Any) -> Any:
+    if value is None:
+        raise VoussoirError(f"argument `{name}` is None")
+    return value
+
+
+class Mesh:
+    """A validated triangle mesh (x, y plan, z up), its anchored vertices and its loads.
+
+    Args:
+        vertices: (n, 3) float64 positions.
+        faces: (m, 3) integer vertex ids per triangle (either orientation).
+        anchored: (k,) integer ids of the supported vertices.
+        face_density: (m,) weight per unit area of each face (density x thickness x g),
+            finite and >= 0; default 1.
+        extra_loads: (n,) extra vertical load per vertex (downward positive); default 0.
+        horizontal_forces: (n, 2) prescribed horizontal force per vertex, non-zero only at
+            free boundary vertices; default 0.
+        prescribed_tau: (n,) inward normal push per free boundary vertex, used with
+            ``tau="prescribed"``; finite and >= 0; default 0.
+
+    Raises:
+        VoussoirError: the mesh or a load is invalid; the message names the argument, and the
+            vertex, face or edge at fault.
+    """
+
+    _native: _native.Mesh
+
+    def __init__(
+        self,
+        vertices: Any,
+        faces: Any,
+        anchored: Any,
+        *,
+        face_density: Any = None,
+        extra_loads: Any = None,
+        horizontal_forces: Any = None,
+        prescribed_tau: Any = None,
+    ) -> None:
+        self._native = _native.Mesh(
+            _floats("vertices", _required("vertices", vertices)),
+            _ids("faces", _required("faces", faces)),
+            _ids("anchored", _required("anchored", anchored)),
+            _floats("face_density", face_density),
+            _floats("extra_loads", extra_loads),
+            _floats("horizontal_forces", horizontal_forces),
+            _floats("prescribed_tau", prescribed_tau),
+        )
+
+    @classmethod
+    def from_file(
+        cls,
+        path: PathLike,
+        supports: Optional[PathLike] = None,
+        *,
+        anchored: Any = None,
+        weld_tolerance: Optional[float] = None,
+        repair_tolerance: Optional[float] = None,
+        face_density: Any = None,
+        extra_loads: Any = None,
+        horizontal_forces: Any = None,
+        prescribed_tau: Any = None,
+    ) -> "Mesh":
+        """Reads an OBJ, OFF, STL or PLY file (by its extension; polygons split into fans).
+
+        Args:
+            path: the mesh file.
+            supports: a JSON file of anchored vertex ids (``{"anchored": [ids]}`` or
+                ``[ids]``), the file's own 0-based vertex ids; or None to give `anchored`.
+            anchored: anchored file vertex ids when `supports` is None.
+            weld_tolerance: vertices closer than this x the bounding-box diagonal are merged
+                (0: only equal positions); default ``voussoir.WELD_TOLERANCE``.
+            repair_tolerance: faces whose plan area is below this x the median plan area are
+                mended by plan edge flips or the smallest plan move of a vertex (0: none,
+                such faces are rejected); default ``voussoir.REPAIR_TOLERANCE``.
+            face_density, extra_loads, horizontal_forces, prescribed_tau: as for `Mesh`,
+                per vertex of the mesh read (after welding).
+        """
+        mesh = cls.__new__(cls)
+        mesh._native = _native.Mesh.read(
+            os.fspath(_required("path", path)),
+            None if supports is None else os.fspath(supports),
+            None if anchored is None else _ids("anchored", anchored),
+            _native.WELD_TOLERANCE if weld_tolerance is None else float(weld_tolerance),
+            _native.REPAIR_TOLERANCE if repair_tolerance is None else float(repair_tolerance),
+            _floats("face_density", face_density),
+            _floats("extra_loads", extra_loads),
+            _floats("horizontal_forces", horizontal_forces),
+            _floats("prescribed_tau", prescribed_tau),
+        )
+        return mesh
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(n, 3) float64 vertex positions."""
+        return self._native.vertices
+
+    @property
+    def faces(self) -> np.ndarray:
+        """(m, 3) uint32 faces, in the orientation given."""
+        return self._native.faces
+
+    @property
+    def anchored(self) -> np.ndarray:
+        """(k,) uint32 anchored vertex ids, sorted."""
+        return self._native.anchored
+
+    @property
+    def edges(self) -> np.ndarray:
+        """(E, 2) uint32 edges, smaller id first, sorted (the rows of per-edge results)."""
+        return self._native.edges
+
+    @property
+    def welded_ids(self) -> np.ndarray:
+        """(n_file,) uint32: the mesh vertex of each vertex of the file read."""
+        return self._native.welded_ids
+
+    @property
+    def plan_repairs(self) -> List[str]:
+        """The plan repairs made while reading, one sentence each."""
+        return self._native.plan_repairs
+
+    @property
+    def n_holes(self) -> int:
+        """The number of holes (inner boundary loops)."""
+        return self._native.n_holes
+
+    @property
+    def face_density(self) -> np.ndarray:
+        """(m,) float64 weight per unit area of each face."""
+        return self._native.face_density
+
+    @property
+    def extra_loads(self) -> np.ndarray:
+        """(n,) float64 extra vertical load per vertex."""
+        return self._native.extra_loads
+
+    @property
+    def horizontal_forces(self) -> np.ndarray:
+        """(n, 2) float64 prescribed horizontal force per vertex."""
+        return self._native.horizontal_forces
+
+    @property
+    def prescribed_tau(self) -> np.ndarray:
+        """(n,) float64 prescribed normal push per vertex."""
+        return self._native.prescribed_tau
+
+    def write(self, path: PathLike, positions: Any = None) -> None:
+        """Writes `positions` (default: the mesh's own) with the faces to `path`: .obj, .off,
+        .ply (every bit kept) or .stl (single precision), all or nothing."""
+        points = self.vertices if positions is None else _floats("positions", positions)
+        _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
+
+    def __repr__(self) -> str:
+        return (
+            f"Mesh({len(self.vertices)} vertices, {len(self.faces)} faces, "
+            f"{len(self.anchored)} anchored, {self.n_holes} holes)"
+        )
+
+
+def _check_mesh(mesh: Any) -> _native.Mesh:
+    if not isinstance(mesh, Mesh):
+        raise VoussoirError(f"argument `mesh`: is a {type(mesh).__name__}, not a voussoir.Mesh")
+    return mesh._native
+
+
+def defaults() -> Dict[str, Any]:
+    """Every setting with its default, read from the Rust library's `Default` impls."""
+    return dict(_native.defaults())
+
+
+def analyse(mesh: Mesh, **settings: "Unpack[Settings]") -> StressResult:
+    """The best compressive stress of `mesh` as it stands (no shape change).
+
+    Settings are keyword arguments (see `Settings`; form-finding-only ones are checked and
+    ignored). The GIL is released while it solves.
+
+    Raises:
+        VoussoirError: a setting is invalid, or the loads are zero.
+    """
+    fields = _native.analyse(_check_mesh(mesh), settings)
+    return StressResult._from_native(fields)
+
+
+def form_find(
+    mesh: Mesh, progress: Optional[Progress] = None, **settings: "Unpack[Settings]"
+) -> FormFindResult:
+    """The nearest self-supporting shape to `mesh` (or the paper's loop: ``method="paper"``).
+
+    Args:
+        mesh: the vault.
+        progress: called as ``progress(iteration, eps_inf)`` after every stress step (0-based
+            iteration; eps_inf dimensionless). Returning False (any false value but None)
+            stops the loop: the result then reports ``termination == "cancelled"`` and holds
+            the state reached. An exception it raises stops the loop too and propagates.
+        **settings: see `Settings`; omitted ones keep `defaults()`.
+
+    The GIL is released while it solves; Ctrl-C (KeyboardInterrupt) stops a running solve
+    within one iteration and propagates.
+
+    Raises:
+        VoussoirError: a setting is invalid, or the loads are zero.
+    """
+    fields = _native.form_find(_check_mesh(mesh), settings, progress)
+    return FormFindResult._from_native(fields)
+
+
+WELD_TOLERANCE: float = _native.WELD_TOLERANCE
+REPAIR_TOLERANCE: float = _native.REPAIR_TOLERANCE
