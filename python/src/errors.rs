@@ -41,7 +41,7 @@ pub fn from_error(arg: &str, e: Error) -> PyErr {
         | InconsistentOrientation { .. }
         | HoleNotCuttable { .. } => "faces",
         InvalidAnchor { .. } | UnsupportedComponent { .. } | NoSupports => "anchored",
-        Numerical { .. } | Io { .. } | Parse { .. } | Malformed { .. } => arg,
+        _ => arg,
     };
     invalid(arg, e)
 }

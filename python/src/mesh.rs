@@ -5,7 +5,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use voussoir::io::{read_mesh, read_supports, weld};
-use voussoir::mesh::repair::{repair_plan, PlanRepair};
+use voussoir::{repair_plan, PlanRepair};
 use voussoir::{Mesh as RustMesh, Problem};
 
 /// A validated triangle mesh with its supports and loads (native half of `voussoir.Mesh`).

@@ -27,6 +27,7 @@ fn status_name(s: StressStatus) -> &'static str {
         StressStatus::Infeasible => "infeasible",
         StressStatus::MaxIterations => "max_iterations",
         StressStatus::NumericalError => "numerical_error",
+        _ => "unknown",
     }
 }
 
@@ -97,6 +98,7 @@ fn termination(t: &Termination) -> (&'static str, Vec<u32>, Option<String>) {
         Termination::Blocked { vertices, hint } => {
             ("blocked", vertices.clone(), Some(hint.clone()))
         }
+        other => ("unknown", vec![], Some(other.to_string())),
     }
 }
 

@@ -130,8 +130,9 @@ pub fn from_kwargs(kwargs: &Bound<'_, PyDict>) -> PyResult<FormFindSettings> {
         apply(&mut f, &key, &value, q_min_relative, q_max_relative)?;
     }
     if get("q_min")?.is_none() && get("q_min_kind")?.is_some() {
-        let (QBound::Absolute(v) | QBound::Relative(v)) = f.stress.q_min;
-        f.stress.q_min = bound(v, q_min_relative);
+        if let QBound::Absolute(v) | QBound::Relative(v) = f.stress.q_min {
+            f.stress.q_min = bound(v, q_min_relative);
+        }
     }
     f.stress.validate().map_err(|e| match e {
         voussoir::Error::InvalidArgument { name, reason } => invalid(name, reason),
@@ -268,6 +269,7 @@ fn split(b: Option<QBound>) -> (Option<f64>, &'static str) {
         None => (None, "relative"),
         Some(QBound::Relative(v)) => (Some(v), "relative"),
         Some(QBound::Absolute(v)) => (Some(v), "absolute"),
+        Some(_) => (None, "other"),
     }
 }
 
