@@ -10,6 +10,7 @@ pub mod mesh;
 pub mod problem;
 pub mod shape;
 pub mod smooth;
+mod solid;
 pub mod solve;
 pub mod stress;
 
@@ -17,6 +18,7 @@ pub use error::{Error, Result};
 pub use geometry::loads::LoadRule;
 pub use mesh::Mesh;
 pub use problem::Problem;
+pub use solid::{signed_volume, thicken, Solid, Thickness};
 pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{

@@ -190,3 +190,35 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
         "voussoir_version": env!("CARGO_PKG_VERSION"),
     })
 }
+
+/// The printable solid of `--solid`: its size, volume and thickness range.
+pub fn solid(solid: &voussoir::Solid, outcome: &Outcome) -> Value {
+    let t = &solid.vertex_thickness;
+    let area: f64 = outcome
+        .model
+        .mesh
+        .faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| outcome.positions[v as usize]);
+            let (u, w) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let n = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0
+        })
+        .sum();
+    json!({
+        "vertices": solid.positions.len(),
+        "faces": solid.faces.len(),
+        "volume": solid.volume(),
+        "mid_surface_area": area,
+        "thickness_min": t.iter().copied().fold(f64::INFINITY, f64::min),
+        "thickness_max": t.iter().copied().fold(0.0, f64::max),
+    })
+}

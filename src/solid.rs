@@ -1,0 +1,322 @@
+//! A printable solid: the shell thickened along its vertex normals and closed by side walls.
+//!
+//! Each referenced vertex `p` with unit normal `n` (the area-weighted mean of its faces'
+//! normals, pointing up) and thickness `t` (the area-weighted mean of its faces') gives an
+//! upper vertex `p + d/2 n` and a lower one `p - d/2 n`, where `d` is `t` divided by the
+//! area-weighted mean cosine between `n` and the faces' normals (at most `2t`): each face
+//! then keeps its thickness across a crease, and the volume is close to Σ area × thickness. The upper faces keep the mesh's counter-clockwise (upward) orientation, the
+//! lower ones are reversed, and every boundary edge, outer or around a hole, gets a wall of
+//! two triangles: the result is closed, every edge is shared by exactly two faces in opposite
+//! directions, and the faces point outwards.
+
+use crate::mesh::Mesh;
+use crate::{Error, Result};
+
+/// How thick the solid is: the same everywhere or per face (one entry per face of the mesh).
+///
+/// Per-face thicknesses become per-vertex ones as the area-weighted mean over each vertex's
+/// faces. [`Thickness::from_density`] derives them from the per-face density (weight per
+/// unit area) that the form finding used.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Thickness {
+    /// One thickness, in the units of the positions.
+    Uniform(f64),
+    /// One thickness per face, in the mesh's face order.
+    PerFace(Vec<f64>),
+}
+
+impl Thickness {
+    /// `density[f] / unit_weight` per face: density is thickness × unit weight (weight per
+    /// unit volume). `unit_weight` must be finite and > 0.
+    pub fn from_density(density: &[f64], unit_weight: f64) -> Result<Thickness> {
+        if !(unit_weight.is_finite() && unit_weight > 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "unit_weight",
+                reason: format!("{unit_weight} is not a finite number > 0"),
+            });
+        }
+        Ok(Thickness::PerFace(
+            density.iter().map(|d| d / unit_weight).collect(),
+        ))
+    }
+}
+
+/// A closed triangle mesh: vertex positions and outward-oriented triangles (0-based).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct Solid {
+    /// The upper vertices (one per referenced mesh vertex, in id order), then the lower ones
+    /// in the same order.
+    pub positions: Vec<[f64; 3]>,
+    /// The upper faces (the mesh's faces in order), the lower faces (reversed), then two wall
+    /// triangles per boundary edge.
+    pub faces: Vec<[u32; 3]>,
+    /// The distance between the upper and lower copy of each referenced mesh vertex, in id
+    /// order: its thickness divided by the mean cosine between its normal and its faces'.
+    pub vertex_thickness: Vec<f64>,
+}
+
+impl Solid {
+    /// The enclosed volume (positive: the faces point outwards).
+    pub fn volume(&self) -> f64 {
+        signed_volume(&self.positions, &self.faces)
+    }
+}
+
+/// The signed volume enclosed by `faces` (positive when a closed mesh's faces point
+/// outwards).
+pub fn signed_volume(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> f64 {
+    faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|i| positions[i as usize]);
+            dot(a, cross(b, c)) / 6.0
+        })
+        .sum()
+}
+
+/// The smallest mean cosine by which a vertex's offset is divided: at most a doubling, at
+/// creases sharper than 120°.
+const MIN_MEAN_COSINE: f64 = 0.5;
+
+/// Fraction of its base face's area below which an offset face counts as turned over: a
+/// face that thin is a sliver about to flip.
+const MIN_OFFSET_AREA: f64 = 1e-2;
+
+/// Thickens the shell `mesh` with vertex `positions` (the form-found ones, or
+/// `mesh.positions`) into a [`Solid`]: half the thickness above the surface, half below,
+/// along area-weighted vertex normals, with walls along every boundary loop.
+///
+/// Errors ([`Error::InvalidArgument`]): `positions` of another length than the mesh's
+/// vertices or not finite; a thickness that is not finite and > 0 (naming the face); a
+/// vertex whose faces' normals cancel (naming it); a thickness so large that an offset face
+/// turns over against its base face (or keeps less than 1 % of its area), which would make
+/// the solid intersect itself: the message names the face, its vertices and the largest
+/// thickness that face allows.
+pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Result<Solid> {
+    check_positions(mesh, positions)?;
+    let face_thickness = face_thickness(mesh, thickness)?;
+    let (normals, vertex_thickness) =
+        vertex_normals_and_thickness(mesh, positions, &face_thickness)?;
+    let referenced: Vec<usize> = (0..mesh.n_vertices())
+        .filter(|&v| mesh.referenced[v])
+        .collect();
+    let mut new_id = vec![u32::MAX; mesh.n_vertices()];
+    for (k, &v) in referenced.iter().enumerate() {
+        new_id[v] = k as u32;
+    }
+    let offset = |v: usize, side: f64| -> [f64; 3] {
+        let h = side * vertex_thickness[v] / 2.0;
+        let (p, n) = (positions[v], normals[v]);
+        [p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]]
+    };
+    check_no_flips(mesh, positions, &face_thickness, &|v, side| offset(v, side))?;
+    let n = referenced.len() as u32;
+    let mut out_positions: Vec<[f64; 3]> = referenced.iter().map(|&v| offset(v, 1.0)).collect();
+    out_positions.extend(referenced.iter().map(|&v| offset(v, -1.0)));
+    let mut faces: Vec<[u32; 3]> = mesh
+        .faces
+        .iter()
+        .map(|f| f.map(|v| new_id[v as usize]))
+        .collect();
+    faces.extend(
+        mesh.faces
+            .iter()
+            .map(|f| [f[0], f[2], f[1]].map(|v| new_id[v as usize] + n)),
+    );
+    for [a, b] in boundary_edges(mesh) {
+        let (a, b) = (new_id[a as usize], new_id[b as usize]);
+        faces.push([b, a, a + n]);
+        faces.push([b, a + n, b + n]);
+    }
+    Ok(Solid {
+        positions: out_positions,
+        faces,
+        vertex_thickness: referenced.iter().map(|&v| vertex_thickness[v]).collect(),
+    })
+}
+
+fn check_positions(mesh: &Mesh, positions: &[[f64; 3]]) -> Result<()> {
+    if positions.len() != mesh.n_vertices() {
+        return Err(Error::InvalidArgument {
+            name: "positions",
+            reason: format!(
+                "has {} entries, expected one per vertex ({})",
+                positions.len(),
+                mesh.n_vertices()
+            ),
+        });
+    }
+    match positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        Some(v) => Err(Error::InvalidArgument {
+            name: "positions",
+            reason: format!("vertex {v} has a NaN or infinite coordinate"),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// One finite, positive thickness per face.
+fn face_thickness(mesh: &Mesh, thickness: &Thickness) -> Result<Vec<f64>> {
+    let per_face = match thickness {
+        Thickness::Uniform(t) => vec![*t; mesh.n_faces()],
+        Thickness::PerFace(t) if t.len() != mesh.n_faces() => {
+            return Err(Error::InvalidArgument {
+                name: "thickness",
+                reason: format!(
+                    "has {} entries, expected one per face ({})",
+                    t.len(),
+                    mesh.n_faces()
+                ),
+            })
+        }
+        Thickness::PerFace(t) => t.clone(),
+    };
+    match per_face.iter().position(|t| !(t.is_finite() && *t > 0.0)) {
+        Some(f) => Err(Error::InvalidArgument {
+            name: "thickness",
+            reason: format!("{} at face {f} is not a finite number > 0", per_face[f]),
+        }),
+        None => Ok(per_face),
+    }
+}
+
+/// Unit area-weighted normal and offset distance per vertex (zero for vertices no face
+/// refers to).
+fn vertex_normals_and_thickness(
+    mesh: &Mesh,
+    positions: &[[f64; 3]],
+    face_thickness: &[f64],
+) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
+    let nv = mesh.n_vertices();
+    let (mut normals, mut weighted, mut area) = (vec![[0.0; 3]; nv], vec![0.0; nv], vec![0.0; nv]);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let n = face_normal(positions, face);
+        let a = norm(n) / 2.0;
+        for &v in face {
+            let v = v as usize;
+            normals[v] = add(normals[v], n);
+            weighted[v] += a * face_thickness[f];
+            area[v] += a;
+        }
+    }
+    for v in (0..nv).filter(|&v| mesh.referenced[v]) {
+        let len = norm(normals[v]);
+        if !(len > 0.0 && area[v] > 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "positions",
+                reason: format!("vertex {v} has no normal: its faces' normals cancel"),
+            });
+        }
+        // |Σ 2A n_f| / Σ 2A is the area-weighted mean cosine between the vertex normal and
+        // its faces' normals: dividing by it keeps the faces' own thickness at a crease.
+        let mean_cosine = len / (2.0 * area[v]);
+        normals[v] = normals[v].map(|c| c / len);
+        weighted[v] /= area[v] * mean_cosine.max(MIN_MEAN_COSINE);
+    }
+    Ok((normals, weighted))
+}
+
+/// Refuses an offset face (upper or lower) that turns over against its base face or shrinks
+/// below [`MIN_OFFSET_AREA`] of it, naming the face and the largest thickness it allows.
+fn check_no_flips(
+    mesh: &Mesh,
+    positions: &[[f64; 3]],
+    face_thickness: &[f64],
+    offset: &dyn Fn(usize, f64) -> [f64; 3],
+) -> Result<()> {
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let base = face_normal(positions, face);
+        let base2 = dot(base, base);
+        for (side, name) in [(1.0, "upper"), (-1.0, "lower")] {
+            let moved = face.map(|v| offset(v as usize, side));
+            let n = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
+            if dot(n, base) > MIN_OFFSET_AREA * base2 {
+                continue;
+            }
+            let allowed = allowed_fraction(positions, face, &moved, base);
+            let here = face_thickness[f];
+            let [a, b, c] = *face;
+            return Err(Error::InvalidArgument {
+                name: "thickness",
+                reason: format!(
+                    "{here:.4e} is too large at face {f} (vertices {a}, {b}, {c}): its {name} \
+                     offset face turns over, so the solid would intersect itself; the \
+                     shell's curvature allows at most {:.4e} there",
+                    allowed * here
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The largest `s` in (0, 1] for which the face offset by `s` times its offset vectors keeps
+/// [`MIN_OFFSET_AREA`] of its area: the smallest root of a quadratic in `s`.
+fn allowed_fraction(
+    positions: &[[f64; 3]],
+    face: &[u32; 3],
+    moved: &[[f64; 3]; 3],
+    base: [f64; 3],
+) -> f64 {
+    let p = face.map(|v| positions[v as usize]);
+    let d = [0, 1, 2].map(|k| sub(moved[k], p[k]));
+    let (u0, v0) = (sub(p[1], p[0]), sub(p[2], p[0]));
+    let (u1, v1) = (sub(d[1], d[0]), sub(d[2], d[0]));
+    // (u0 + s u1) × (v0 + s v1) · base = c0 + c1 s + c2 s².
+    let c0 = dot(cross(u0, v0), base) * (1.0 - MIN_OFFSET_AREA);
+    let c1 = dot(add(cross(u0, v1), cross(u1, v0)), base);
+    let c2 = dot(cross(u1, v1), base);
+    let roots: Vec<f64> = if c2.abs() < 1e-300 {
+        vec![-c0 / c1]
+    } else {
+        let disc = (c1 * c1 - 4.0 * c2 * c0).max(0.0).sqrt();
+        vec![(-c1 - disc) / (2.0 * c2), (-c1 + disc) / (2.0 * c2)]
+    };
+    roots
+        .into_iter()
+        .filter(|s| *s > 0.0 && s.is_finite())
+        .fold(1.0, f64::min)
+}
+
+/// Boundary edges as directed in their face (the surface on the left in plan).
+fn boundary_edges(mesh: &Mesh) -> impl Iterator<Item = [u32; 2]> + '_ {
+    mesh.edges.iter().filter_map(|e| match (e.left, e.right) {
+        (Some(_), None) => Some([e.v[0], e.v[1]]),
+        (None, Some(_)) => Some([e.v[1], e.v[0]]),
+        _ => None,
+    })
+}
+
+fn face_normal(positions: &[[f64; 3]], face: &[u32; 3]) -> [f64; 3] {
+    let [a, b, c] = face.map(|v| positions[v as usize]);
+    cross(sub(b, a), sub(c, a))
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
