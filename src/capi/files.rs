@@ -17,7 +17,7 @@ use crate::problem::Problem;
 ///
 /// # Safety
 /// When non-NULL, `ptr` must point to a NUL-terminated string.
-unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
+pub(super) unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
     if ptr.is_null() {
         return Err(Failure::null(name));
     }
