@@ -221,8 +221,11 @@ fn vertex_normals_and_thickness(
     Ok((normals, weighted))
 }
 
-/// Refuses an offset face (upper or lower) that turns over against its base face or shrinks
-/// below [`MIN_OFFSET_AREA`] of it, naming the face and the largest thickness it allows.
+/// Refuses a thickness at which the layer swept by a face, from the surface to its upper or
+/// lower offset, folds over: at each corner, the swept face must keep an orientation that
+/// agrees with the corner's offset direction and at least [`MIN_OFFSET_AREA`] of its
+/// initial extent (the Jacobian of the sweep is linear across the face, so its corners
+/// decide). Names the face, its vertices and the largest thickness it allows.
 fn check_no_flips(
     mesh: &Mesh,
     positions: &[[f64; 3]],
@@ -230,15 +233,16 @@ fn check_no_flips(
     offset: &dyn Fn(usize, f64) -> [f64; 3],
 ) -> Result<()> {
     for (f, face) in mesh.faces.iter().enumerate() {
-        let base = face_normal(positions, face);
-        let base2 = dot(base, base);
+        let p = face.map(|v| positions[v as usize]);
+        let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
         for (side, name) in [(1.0, "upper"), (-1.0, "lower")] {
-            let moved = face.map(|v| offset(v as usize, side));
-            let n = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
-            if dot(n, base) > MIN_OFFSET_AREA * base2 {
-                continue;
-            }
-            let allowed = allowed_fraction(positions, face, &moved, base);
+            let d = [0, 1, 2].map(|k| sub(offset(face[k] as usize, side), p[k]));
+            let (de1, de2) = (sub(d[1], d[0]), sub(d[2], d[0]));
+            let limit = d
+                .iter()
+                .filter_map(|dk| sweep_limit([e1, e2], [de1, de2], dk.map(|c| side * c)))
+                .fold(None, |a: Option<f64>, s| Some(a.map_or(s, |a| a.min(s))));
+            let Some(fraction) = limit else { continue };
             let here = face_thickness[f];
             let [a, b, c] = *face;
             return Err(Error::InvalidArgument {
@@ -247,7 +251,7 @@ fn check_no_flips(
                     "{here:.4e} is too large at face {f} (vertices {a}, {b}, {c}): its {name} \
                      offset face turns over, so the solid would intersect itself; the \
                      shell's curvature allows at most {:.4e} there",
-                    allowed * here
+                    fraction * here
                 ),
             });
         }
@@ -255,32 +259,32 @@ fn check_no_flips(
     Ok(())
 }
 
-/// The largest `s` in (0, 1] for which the face offset by `s` times its offset vectors keeps
-/// [`MIN_OFFSET_AREA`] of its area: the smallest root of a quadratic in `s`.
-fn allowed_fraction(
-    positions: &[[f64; 3]],
-    face: &[u32; 3],
-    moved: &[[f64; 3]; 3],
-    base: [f64; 3],
-) -> f64 {
-    let p = face.map(|v| positions[v as usize]);
-    let d = [0, 1, 2].map(|k| sub(moved[k], p[k]));
-    let (u0, v0) = (sub(p[1], p[0]), sub(p[2], p[0]));
-    let (u1, v1) = (sub(d[1], d[0]), sub(d[2], d[0]));
-    // (u0 + s u1) × (v0 + s v1) · base = c0 + c1 s + c2 s².
-    let c0 = dot(cross(u0, v0), base) * (1.0 - MIN_OFFSET_AREA);
-    let c1 = dot(add(cross(u0, v1), cross(u1, v0)), base);
-    let c2 = dot(cross(u1, v1), base);
-    let roots: Vec<f64> = if c2.abs() < 1e-300 {
-        vec![-c0 / c1]
+/// The smallest `s` in [0, 1] at which the face with edges `e + s de` keeps less than
+/// [`MIN_OFFSET_AREA`] of its initial extent along `n`: `q(s) = ((e1 + s de1) × (e2 + s de2))
+/// · n` is quadratic in `s`. `None` when it never does.
+fn sweep_limit(e: [[f64; 3]; 2], de: [[f64; 3]; 2], n: [f64; 3]) -> Option<f64> {
+    let c0 = dot(cross(e[0], e[1]), n);
+    if c0 <= 0.0 {
+        return Some(0.0);
+    }
+    let c1 = dot(add(cross(e[0], de[1]), cross(de[0], e[1])), n);
+    let c2 = dot(cross(de[0], de[1]), n);
+    let a0 = c0 * (1.0 - MIN_OFFSET_AREA);
+    let roots: Vec<f64> = if c2.abs() <= 1e-12 * (c0.abs() + c1.abs()) {
+        vec![-a0 / c1]
     } else {
-        let disc = (c1 * c1 - 4.0 * c2 * c0).max(0.0).sqrt();
-        vec![(-c1 - disc) / (2.0 * c2), (-c1 + disc) / (2.0 * c2)]
+        let disc = c1 * c1 - 4.0 * c2 * a0;
+        if disc < 0.0 {
+            return None;
+        }
+        let r = disc.sqrt();
+        vec![(-c1 - r) / (2.0 * c2), (-c1 + r) / (2.0 * c2)]
     };
+    // q(0) > 0, so the first root in [0, 1] is where the face first gets too thin.
     roots
         .into_iter()
-        .filter(|s| *s > 0.0 && s.is_finite())
-        .fold(1.0, f64::min)
+        .filter(|s| s.is_finite() && (0.0..=1.0).contains(s))
+        .reduce(f64::min)
 }
 
 /// Boundary edges as directed in their face (the surface on the left in plan).
