@@ -90,10 +90,13 @@ const MIN_OFFSET_AREA: f64 = 1e-2;
 ///
 /// Errors ([`Error::InvalidArgument`]): `positions` of another length than the mesh's
 /// vertices or not finite; a thickness that is not finite and > 0 (naming the face); a
-/// vertex whose faces' normals cancel (naming it); a thickness so large that an offset face
-/// turns over against its base face (or keeps less than 1 % of its area), which would make
-/// the solid intersect itself: the message names the face, its vertices and the largest
-/// thickness that face allows.
+/// vertex whose faces' normals cancel, or whose normal points away from one of its faces (a
+/// fold sharper than a right angle, where no thickness fits), naming it; a thickness so
+/// large that the layer between a face and its offset folds over (the offset face turns
+/// over or keeps less than 1 % of its area), which would make the solid intersect itself:
+/// the message names the face that allows the least thickness, its vertices and that
+/// thickness. Parts of the shell far apart along the surface but close in space (nearer
+/// than half the thickness) are not compared.
 pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Result<Solid> {
     check_positions(mesh, positions)?;
     let face_thickness = face_thickness(mesh, thickness)?;
@@ -225,38 +228,54 @@ fn vertex_normals_and_thickness(
 /// lower offset, folds over: at each corner, the swept face must keep an orientation that
 /// agrees with the corner's offset direction and at least [`MIN_OFFSET_AREA`] of its
 /// initial extent (the Jacobian of the sweep is linear across the face, so its corners
-/// decide). Names the face, its vertices and the largest thickness it allows.
+/// decide). Of the faces that fold, names the one that allows the least thickness, with its
+/// vertices and that thickness.
 fn check_no_flips(
     mesh: &Mesh,
     positions: &[[f64; 3]],
     face_thickness: &[f64],
     offset: &dyn Fn(usize, f64) -> [f64; 3],
 ) -> Result<()> {
+    // (thickness that fits, face, side) of the tightest face that folds.
+    let mut tightest: Option<(f64, usize, &str)> = None;
     for (f, face) in mesh.faces.iter().enumerate() {
         let p = face.map(|v| positions[v as usize]);
         let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
         for (side, name) in [(1.0, "upper"), (-1.0, "lower")] {
             let d = [0, 1, 2].map(|k| sub(offset(face[k] as usize, side), p[k]));
             let (de1, de2) = (sub(d[1], d[0]), sub(d[2], d[0]));
-            let limit = d
-                .iter()
-                .filter_map(|dk| sweep_limit([e1, e2], [de1, de2], dk.map(|c| side * c)))
-                .fold(None, |a: Option<f64>, s| Some(a.map_or(s, |a| a.min(s))));
-            let Some(fraction) = limit else { continue };
-            let here = face_thickness[f];
-            let [a, b, c] = *face;
-            return Err(Error::InvalidArgument {
-                name: "thickness",
-                reason: format!(
-                    "{here:.4e} is too large at face {f} (vertices {a}, {b}, {c}): its {name} \
-                     offset face turns over, so the solid would intersect itself; the \
-                     shell's curvature allows at most {:.4e} there",
-                    fraction * here
-                ),
-            });
+            let limits = d.map(|dk| sweep_limit([e1, e2], [de1, de2], dk.map(|c| side * c)));
+            if let Some(k) = (0..3).find(|&k| limits[k] == Some(0.0)) {
+                return Err(Error::InvalidArgument {
+                    name: "positions",
+                    reason: format!(
+                        "the shell folds too sharply at vertex {} for a solid: its normal \
+                         points away from face {f}, so no thickness fits there",
+                        face[k]
+                    ),
+                });
+            }
+            let fraction = limits.into_iter().flatten().reduce(f64::min);
+            if let Some(fits) = fraction.map(|s| s * face_thickness[f]) {
+                if tightest.is_none_or(|(t, _, _)| fits < t) {
+                    tightest = Some((fits, f, name));
+                }
+            }
         }
     }
-    Ok(())
+    let Some((fits, f, name)) = tightest else {
+        return Ok(());
+    };
+    let [a, b, c] = mesh.faces[f];
+    Err(Error::InvalidArgument {
+        name: "thickness",
+        reason: format!(
+            "{:.4e} is too large at face {f} (vertices {a}, {b}, {c}): its {name} offset face \
+             turns over, so the solid would intersect itself; the shell's curvature allows at \
+             most {fits:.4e} there",
+            face_thickness[f]
+        ),
+    })
 }
 
 /// The smallest `s` in [0, 1] at which the face with edges `e + s de` keeps less than
