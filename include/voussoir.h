@@ -602,8 +602,8 @@ VsrStatus vsr_mesh_welded_ids(const struct VsrMesh *mesh, uint32_t *out, size_t 
  * plan is undone).
  *
  * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
- * the mesh, an unknown extension, or a file that cannot be written
- * (`VSR_STATUS_INVALID_ARGUMENT`).
+ * the mesh, an unknown extension, `.3mf` (3MF holds closed solids: see
+ * `vsr_result_write_solid`), or a file that cannot be written (`VSR_STATUS_INVALID_ARGUMENT`).
  *
  * # Safety
  * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
@@ -1358,11 +1358,12 @@ VsrStatus vsr_settings_set_progress(struct VsrSettings *settings, VsrProgressFn 
  * `.3mf` (a 3MF package: closed meshes only, in millimetres); `.stl` is binary, single
  * precision. All or nothing, as `vsr_result_write`.
  *
- * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not finite and
- * > 0, a thickness so large that an offset face would turn over (the solid would intersect
- * itself; the message names the face, its vertices and the largest thickness it allows), a
- * result with another vertex count than the mesh, an unknown extension, or a file that cannot
- * be written (`VSR_STATUS_INVALID_ARGUMENT`).
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not a finite
+ * number above 0, a thickness so large that an offset face would turn over (the solid would
+ * intersect itself; the message names the face, its vertices and the largest thickness it
+ * allows) or a fold sharper than a right angle (naming the vertex), a result with another
+ * vertex count than the mesh, an unknown extension, or a file that cannot be written
+ * (`VSR_STATUS_INVALID_ARGUMENT`).
  *
  * # Safety
  * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.

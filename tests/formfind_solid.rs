@@ -147,3 +147,46 @@ fn help_documents_solid_and_ascii() {
         assert!(text.contains(option), "--help lacks {option}");
     }
 }
+
+#[test]
+fn shared_model_solid_with_holes_is_closed() {
+    let Some(models) = models_dir() else { return };
+    let dir = Scratch::new("solid-hex");
+    let (obj, json) = (models.join("hex.obj"), models.join("hex.json"));
+    let args = [
+        obj.to_str().unwrap(),
+        "--supports",
+        json.to_str().unwrap(),
+        "--report",
+        "r.json",
+        "--pictures",
+        "p",
+        "--out",
+        "hex.off",
+        "--solid",
+        "0.01",
+        "hex-solid.stl",
+    ];
+    let out = run(&dir.0, &args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report = read_json(&dir.path("r.json"));
+    assert_eq!(report["mesh"]["holes"], 3);
+    let (p, f) = io::read_mesh(&dir.path("hex-solid.stl")).unwrap();
+    let w = io::weld(&p, &f, io::DEFAULT_WELD_TOLERANCE).unwrap();
+    assert!(watertight(&w.faces));
+    let volume = voussoir::signed_volume(&w.positions, &w.faces);
+    let reported = report["solid"]["volume"].as_f64().unwrap();
+    assert!(
+        (volume / reported - 1.0).abs() < 1e-4,
+        "{volume} vs {reported}"
+    );
+    let expected = report["solid"]["mid_surface_area"].as_f64().unwrap() * 0.01;
+    assert!(
+        (volume / expected - 1.0).abs() < 1e-2,
+        "{volume} vs {expected}"
+    );
+}

@@ -57,11 +57,12 @@ unsafe fn write_solid(
 /// `.3mf` (a 3MF package: closed meshes only, in millimetres); `.stl` is binary, single
 /// precision. All or nothing, as `vsr_result_write`.
 ///
-/// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not finite and
-/// > 0, a thickness so large that an offset face would turn over (the solid would intersect
-/// itself; the message names the face, its vertices and the largest thickness it allows), a
-/// result with another vertex count than the mesh, an unknown extension, or a file that cannot
-/// be written (`VSR_STATUS_INVALID_ARGUMENT`).
+/// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not a finite
+/// number above 0, a thickness so large that an offset face would turn over (the solid would
+/// intersect itself; the message names the face, its vertices and the largest thickness it
+/// allows) or a fold sharper than a right angle (naming the vertex), a result with another
+/// vertex count than the mesh, an unknown extension, or a file that cannot be written
+/// (`VSR_STATUS_INVALID_ARGUMENT`).
 ///
 /// # Safety
 /// `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
