@@ -322,3 +322,34 @@ fn three_mf_refuses_an_open_mesh() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A gable roof over [-1, 1] x [0, 1], its ridge along x = 0 cut by a slit `gap` wide: the
+/// lower offsets of the two slopes move towards each other under the slit.
+fn slit_roof(gap: f64) -> Mesh {
+    use voussoir::generate::{lift, rectangle, triangulate, Domain};
+    let g = gap / 2.0;
+    let domain = Domain {
+        outer: rectangle(-1.0, 0.0, 1.0, 1.0, 20, 10),
+        holes: vec![vec![[-g, 0.2], [g, 0.2], [g, 0.8], [-g, 0.8]]],
+    };
+    let (points, triangles) = triangulate(&domain, 0.002).unwrap();
+    lift(
+        &points,
+        &triangles,
+        |[x, _]| -1.5 * x.abs(),
+        |_, outer| outer,
+    )
+    .unwrap()
+}
+
+#[test]
+fn parts_that_meet_across_a_slit_are_refused() {
+    let mesh = slit_roof(0.005);
+    let thin = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.002)).unwrap();
+    assert_watertight(&thin.faces);
+    let err = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.0075))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("would intersect itself where"), "{err}");
+    assert!(err.contains("crosses"), "{err}");
+}

@@ -60,7 +60,8 @@ unsafe fn write_solid(
 /// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not a finite
 /// number above 0, a thickness so large that an offset face would turn over (the solid would
 /// intersect itself; the message names the face, its vertices and the largest thickness it
-/// allows) or a fold sharper than a right angle (naming the vertex), a result with another
+/// allows), a fold no offset direction clears (naming the vertex), parts of the shell so near
+/// each other that the solid would cross itself (naming them), a result with another
 /// vertex count than the mesh, an unknown extension, or a file that cannot be written
 /// (`VSR_STATUS_INVALID_ARGUMENT`).
 ///

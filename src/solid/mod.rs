@@ -9,6 +9,8 @@
 //! two triangles: the result is closed, every edge is shared by exactly two faces in opposite
 //! directions, and the faces point outwards.
 
+mod crossing;
+
 use crate::mesh::Mesh;
 use crate::{Error, Result};
 
@@ -80,6 +82,14 @@ pub fn signed_volume(positions: &[[f64; 3]], faces: &[[u32; 3]]) -> f64 {
 /// creases sharper than 120°.
 const MIN_MEAN_COSINE: f64 = 0.5;
 
+/// Below this cosine between a vertex's area-weighted normal and one of its faces' normals
+/// (60°), the offset direction is turned to widen the smallest angle.
+const SHARP_COSINE: f64 = 0.5;
+
+/// Steps of the search for that direction; its smallest cosine is within a few percent of
+/// the best after these.
+const CONE_ITERATIONS: usize = 200;
+
 /// Fraction of its base face's area below which an offset face counts as turned over: a
 /// face that thin is a sliver about to flip.
 const MIN_OFFSET_AREA: f64 = 1e-2;
@@ -95,8 +105,8 @@ const MIN_OFFSET_AREA: f64 = 1e-2;
 /// large that the layer between a face and its offset folds over (the offset face turns
 /// over or keeps less than 1 % of its area), which would make the solid intersect itself:
 /// the message names the face that allows the least thickness, its vertices and that
-/// thickness. Parts of the shell far apart along the surface but close in space (nearer
-/// than half the thickness) are not compared.
+/// thickness; then any other crossing of the solid with itself (parts of the shell far apart
+/// along the surface but near in space), naming the two parts that cross.
 pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Result<Solid> {
     check_positions(mesh, positions)?;
     let face_thickness = face_thickness(mesh, thickness)?;
@@ -128,10 +138,32 @@ pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Re
             .iter()
             .map(|f| [f[0], f[2], f[1]].map(|v| new_id[v as usize] + n)),
     );
-    for [a, b] in boundary_edges(mesh) {
+    let walls: Vec<[u32; 2]> = boundary_edges(mesh).collect();
+    for &[a, b] in &walls {
         let (a, b) = (new_id[a as usize], new_id[b as usize]);
         faces.push([b, a, a + n]);
         faces.push([b, a + n, b + n]);
+    }
+    if let Some((s, t)) = crossing::first_crossing(&out_positions, &faces) {
+        let part = |i: usize| match i {
+            i if i < mesh.n_faces() => format!("the upper surface at face {i}"),
+            i if i < 2 * mesh.n_faces() => {
+                format!("the lower surface at face {}", i - mesh.n_faces())
+            }
+            i => {
+                let [a, b] = walls[(i - 2 * mesh.n_faces()) / 2];
+                format!("the wall along boundary edge {a}-{b}")
+            }
+        };
+        return Err(Error::InvalidArgument {
+            name: "thickness",
+            reason: format!(
+                "too large: the solid would intersect itself where {} crosses {}; parts of \
+                 the shell there are nearer to each other than the thickness allows",
+                part(s),
+                part(t)
+            ),
+        });
     }
     Ok(Solid {
         positions: out_positions,
@@ -188,21 +220,25 @@ fn face_thickness(mesh: &Mesh, thickness: &Thickness) -> Result<Vec<f64>> {
     }
 }
 
-/// Unit area-weighted normal and offset distance per vertex (zero for vertices no face
-/// refers to).
+/// Unit offset direction and offset distance per vertex (zero for vertices no face refers
+/// to).
 fn vertex_normals_and_thickness(
     mesh: &Mesh,
     positions: &[[f64; 3]],
     face_thickness: &[f64],
 ) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
     let nv = mesh.n_vertices();
+    let face_normals: Vec<[f64; 3]> = mesh
+        .faces
+        .iter()
+        .map(|f| face_normal(positions, f))
+        .collect();
     let (mut normals, mut weighted, mut area) = (vec![[0.0; 3]; nv], vec![0.0; nv], vec![0.0; nv]);
     for (f, face) in mesh.faces.iter().enumerate() {
-        let n = face_normal(positions, face);
-        let a = norm(n) / 2.0;
+        let a = norm(face_normals[f]) / 2.0;
         for &v in face {
             let v = v as usize;
-            normals[v] = add(normals[v], n);
+            normals[v] = add(normals[v], face_normals[f]);
             weighted[v] += a * face_thickness[f];
             area[v] += a;
         }
@@ -215,13 +251,68 @@ fn vertex_normals_and_thickness(
                 reason: format!("vertex {v} has no normal: its faces' normals cancel"),
             });
         }
-        // |Σ 2A n_f| / Σ 2A is the area-weighted mean cosine between the vertex normal and
-        // its faces' normals: dividing by it keeps the faces' own thickness at a crease.
-        let mean_cosine = len / (2.0 * area[v]);
         normals[v] = normals[v].map(|c| c / len);
+    }
+    widen_sharp_normals(mesh, &face_normals, &mut normals);
+    // Σ A (n · n_f) / Σ A is the area-weighted mean cosine between the offset direction and
+    // the faces' normals: dividing by it keeps the faces' own thickness at a crease.
+    let mut cosine_area = vec![0.0; nv];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in face {
+            cosine_area[v as usize] += dot(normals[v as usize], face_normals[f]) / 2.0;
+        }
+    }
+    for v in (0..nv).filter(|&v| mesh.referenced[v]) {
+        let mean_cosine = cosine_area[v] / area[v];
         weighted[v] /= area[v] * mean_cosine.max(MIN_MEAN_COSINE);
     }
     Ok((normals, weighted))
+}
+
+/// Where the area-weighted normal makes more than 60° with one of the vertex's faces (at a
+/// sharp crease, or where a large face outweighs a steep small one), turns it towards the
+/// axis of the narrowest cone around the faces' normals, which maximises the smallest cosine:
+/// iterations of the Bădoiu–Clarkson kind, each a step towards the worst face's normal.
+fn widen_sharp_normals(mesh: &Mesh, face_normals: &[[f64; 3]], normals: &mut [[f64; 3]]) {
+    let unit: Vec<[f64; 3]> = face_normals
+        .iter()
+        .map(|n| n.map(|c| c / norm(*n)))
+        .collect();
+    let mut faces_of: std::collections::HashMap<usize, Vec<usize>> = Default::default();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in face {
+            if dot(normals[v as usize], unit[f]) < SHARP_COSINE {
+                faces_of.entry(v as usize).or_default();
+            }
+        }
+    }
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in face {
+            if let Some(list) = faces_of.get_mut(&(v as usize)) {
+                list.push(f);
+            }
+        }
+    }
+    for (v, faces) in faces_of {
+        let worst = |n: [f64; 3]| {
+            faces
+                .iter()
+                .map(|&f| (dot(n, unit[f]), f))
+                .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a })
+        };
+        let (mut n, mut best) = (normals[v], worst(normals[v]).0);
+        let mut current = n;
+        for k in 0..CONE_ITERATIONS {
+            let (_, f) = worst(current);
+            let step = add(current, unit[f].map(|c| c / (k as f64 + 2.0)));
+            current = step.map(|c| c / norm(step));
+            let (cosine, _) = worst(current);
+            if cosine > best {
+                (n, best) = (current, cosine);
+            }
+        }
+        normals[v] = n;
+    }
 }
 
 /// Refuses a thickness at which the layer swept by a face, from the surface to its upper or
