@@ -67,6 +67,20 @@ if [ -d ../shared/data/models ]; then
       --report "$formfind_dir/$1.json" --pictures "$formfind_dir/$1-pictures" >/dev/null
     echo "$1 $2" >>"$formfind_dir/manifest.txt"
   done
+  # The thickest solid formfind accepts: asked for far too much, it names the most that fits
+  # (`allows at most X there`); 97% of that must still be free of self-intersections.
+  mkdir -p "$formfind_dir/edge"
+  for m in lilium hex four_holes three_pillar; do
+    run=("$models/$m.obj" --supports "$models/$m.json" --out "$formfind_dir/edge/$m.off"
+         --report "$formfind_dir/edge/$m.json" --pictures "$formfind_dir/edge/$m-pictures")
+    limit=$({ target/debug/examples/formfind "${run[@]}" --solid 1e6 "$formfind_dir/edge/x.off" \
+                2>&1 >/dev/null || true; } | sed -n 's/.*allows at most \([0-9.e+-]*\) there.*/\1/p')
+    [ -n "$limit" ] || { echo "formfind named no largest thickness for $m" >&2; exit 1; }
+    t=$(awk -v l="$limit" 'BEGIN { printf "%.6g", 0.97 * l }')
+    target/debug/examples/formfind "${run[@]}" --solid "$t" "$formfind_dir/edge/$m-solid.off" \
+      >/dev/null
+    echo "$m $t" >>"$formfind_dir/edge/manifest.txt"
+  done
   echo "wrote $formfind_dir"
 fi
 

@@ -1,8 +1,9 @@
 // Meshes formfind writes, read back by CGAL: the form-found shape as OFF (its equilibrium
 // recomputed here from the force densities of formfind's report) and the printable solid of `--solid` and of
 // vsr_result_write_solid_from_density (closed, free of self-intersections, bounding a volume
-// of area x thickness). .ci/cpp-tests.sh runs formfind on shared models into
-// VSR_FORMFIND_DIR and lists `model thickness` per line in its manifest.txt.
+// of area x thickness), also at 97% of the largest thickness formfind accepts.
+// .ci/cpp-tests.sh runs formfind on shared models into VSR_FORMFIND_DIR and lists
+// `model thickness` per line in its manifest.txt (edge/manifest.txt for the thickest).
 #include "support.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -35,10 +36,10 @@ constexpr double kTolerance = 1e-6;   // formfind's default tolerance on eps_inf
 
 std::string formfind_dir() { return VSR_FORMFIND_DIR; }
 
-// (model, thickness) per line of the manifest; empty when there is none.
-std::vector<std::pair<std::string, double>> manifest() {
+// (model, thickness) per line of the manifest in `dir`; empty when there is none.
+std::vector<std::pair<std::string, double>> manifest(const std::string &dir = formfind_dir()) {
     std::vector<std::pair<std::string, double>> out;
-    std::ifstream in(formfind_dir() + "/manifest.txt");
+    std::ifstream in(dir + "/manifest.txt");
     std::string name;
     double thickness = 0;
     while (in >> name >> thickness) out.emplace_back(name, thickness);
@@ -169,6 +170,22 @@ TEST_F(Formfind, SolidIsClosedAndBoundsAreaTimesThickness) {
     for (const auto &[name, thickness] : manifest()) {
         const SurfaceMesh mid = read_cgal(formfind_dir() + "/" + name + ".off");
         check_solid(formfind_dir() + "/" + name + "-solid.off", mid, thickness);
+    }
+}
+
+// At 97% of the largest thickness formfind names when asked for too much (edge/manifest.txt):
+// the solid is still closed and free of self-intersections, so the refusal comes in time.
+TEST_F(Formfind, ThickestAcceptedSolidDoesNotIntersectItself) {
+    const std::string edge = formfind_dir() + "/edge";
+    ASSERT_FALSE(manifest(edge).empty()) << edge << "/manifest.txt";
+    for (const auto &[name, thickness] : manifest(edge)) {
+        const std::string path = edge + "/" + name + "-solid.off";
+        const SurfaceMesh solid = read_cgal(path);
+        ASSERT_TRUE(CGAL::is_closed(solid)) << path;
+        ASSERT_FALSE(PMP::does_self_intersect(solid)) << path;
+        ASSERT_TRUE(PMP::does_bound_a_volume(solid)) << path;
+        std::printf("%s: thickness %.6g, closed, bounds a volume, no self-intersection\n",
+                    path.c_str(), thickness);
     }
 }
 
