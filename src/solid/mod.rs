@@ -1,13 +1,16 @@
-//! A printable solid: the shell thickened along its vertex normals and closed by side walls.
+//! A printable solid: the shell thickened along its vertex normals and closed by side walls
+//! (docs/method.md §15).
 //!
 //! Each referenced vertex `p` with unit normal `n` (the area-weighted mean of its faces'
-//! normals, pointing up) and thickness `t` (the area-weighted mean of its faces') gives an
-//! upper vertex `p + d/2 n` and a lower one `p - d/2 n`, where `d` is `t` divided by the
-//! area-weighted mean cosine between `n` and the faces' normals (at most `2t`): each face
-//! then keeps its thickness across a crease, and the volume is close to Σ area × thickness. The upper faces keep the mesh's counter-clockwise (upward) orientation, the
-//! lower ones are reversed, and every boundary edge, outer or around a hole, gets a wall of
-//! two triangles: the result is closed, every edge is shared by exactly two faces in opposite
-//! directions, and the faces point outwards.
+//! normals, pointing up; turned towards the narrowest cone around them at a crease sharper
+//! than 60°) and thickness `t` (the area-weighted mean of its faces') gives an upper vertex
+//! `p + d/2 n` and a lower one `p - d/2 n`, where `d` is `t` divided by the area-weighted mean
+//! cosine between `n` and the faces' normals (at most `2t`): each face then keeps its
+//! thickness across a crease, and the volume is close to Σ area × thickness. The upper faces
+//! keep the mesh's counter-clockwise (upward) orientation, the lower ones are reversed, and
+//! every boundary edge, outer or around a hole, gets a wall of two triangles: the result is
+//! closed, every edge is shared by exactly two faces in opposite directions, and the faces
+//! point outwards. A thickness at which it would cross itself is refused.
 
 mod crossing;
 
@@ -100,8 +103,8 @@ const MIN_OFFSET_AREA: f64 = 1e-2;
 ///
 /// Errors ([`Error::InvalidArgument`]): `positions` of another length than the mesh's
 /// vertices or not finite; a thickness that is not finite and > 0 (naming the face); a
-/// vertex whose faces' normals cancel, or whose normal points away from one of its faces (a
-/// fold sharper than a right angle, where no thickness fits), naming it; a thickness so
+/// vertex whose faces' normals cancel, or whose offset direction points away from one of its
+/// faces (a fold no direction clears, where no thickness fits), naming it; a thickness so
 /// large that the layer between a face and its offset folds over (the offset face turns
 /// over or keeps less than 1 % of its area), which would make the solid intersect itself:
 /// the message names the face that allows the least thickness, its vertices and that
@@ -144,32 +147,37 @@ pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Re
         faces.push([b, a, a + n]);
         faces.push([b, a + n, b + n]);
     }
-    if let Some((s, t)) = crossing::first_crossing(&out_positions, &faces) {
-        let part = |i: usize| match i {
-            i if i < mesh.n_faces() => format!("the upper surface at face {i}"),
-            i if i < 2 * mesh.n_faces() => {
-                format!("the lower surface at face {}", i - mesh.n_faces())
-            }
-            i => {
-                let [a, b] = walls[(i - 2 * mesh.n_faces()) / 2];
-                format!("the wall along boundary edge {a}-{b}")
-            }
-        };
-        return Err(Error::InvalidArgument {
-            name: "thickness",
-            reason: format!(
-                "too large: the solid would intersect itself where {} crosses {}; parts of \
-                 the shell there are nearer to each other than the thickness allows",
-                part(s),
-                part(t)
-            ),
-        });
+    if let Some(pair) = crossing::first_crossing(&out_positions, &faces) {
+        let thickest = face_thickness.iter().copied().fold(0.0, f64::max);
+        return Err(crossing_error(mesh, &walls, pair, thickest));
     }
     Ok(Solid {
         positions: out_positions,
         faces,
         vertex_thickness: referenced.iter().map(|&v| vertex_thickness[v]).collect(),
     })
+}
+
+/// The error for solid faces `s` and `t` crossing: which parts of the solid they are.
+fn crossing_error(mesh: &Mesh, walls: &[[u32; 2]], (s, t): (usize, usize), thickest: f64) -> Error {
+    let nf = mesh.n_faces();
+    let part = |i: usize| match i {
+        i if i < nf => format!("the upper surface at face {i}"),
+        i if i < 2 * nf => format!("the lower surface at face {}", i - nf),
+        i => {
+            let [a, b] = walls[(i - 2 * nf) / 2];
+            format!("the wall along boundary edge {a}-{b}")
+        }
+    };
+    Error::InvalidArgument {
+        name: "thickness",
+        reason: format!(
+            "{thickest:.4e} is too large: the solid would intersect itself where {} crosses {}; \
+             parts of the shell there are nearer to each other than the thickness",
+            part(s),
+            part(t)
+        ),
+    }
 }
 
 fn check_positions(mesh: &Mesh, positions: &[[f64; 3]]) -> Result<()> {
