@@ -91,10 +91,11 @@ are replaced only when every output is written; two outputs may not share a path
   --pictures DIR         SVG pictures                   [formfind-out/pictures]
   --solid T OUT          also a printable solid: the result thickened by T (half above,
                          half below, along vertex normals), closed by walls along every
-                         boundary; OUT is .stl, .3mf, .off, .obj or .ply. T is a length
-                         in the mesh's units, or `density`: --density / --solid-unit-weight.
-                         Exit 2 (nothing written) if T is so large that the solid would
-                         intersect itself (the message names the face)
+                         boundary; OUT is .stl, .3mf (read as millimetres), .off, .obj or
+                         .ply. T is a length in the mesh's units, or `density`: --density
+                         / --solid-unit-weight. Exit 2 (nothing written) if T is so large
+                         that the solid would intersect itself (the message names where,
+                         and the largest T that fits there)
   --solid-unit-weight W  weight per unit volume, for --solid density
   --ascii                write STL and PLY outputs as ASCII text, not binary
   Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
