@@ -50,6 +50,7 @@ fn solid_in_every_format_is_closed_outward_and_as_thick_as_asked() {
             "{name}: volume {volume}, area x thickness {expected}"
         );
         assert_eq!(solid["faces"].as_u64().unwrap() as usize, w.faces.len());
+        assert_eq!(solid["thickness"], 0.08);
     }
     run_default(&dir, &["--solid", "0.08", "s.3mf"]);
     let bytes = fs::read(dir.path("s.3mf")).unwrap();
@@ -73,6 +74,7 @@ fn solid_from_density_and_unit_weight() {
         ],
     );
     assert!(r["solid"]["volume"].as_f64().unwrap() > 0.0);
+    assert_eq!(r["solid"]["thickness"]["unit_weight"], 40.0);
     let (a, b) = (
         io::read_mesh(&dir.path("a.off")).unwrap(),
         io::read_mesh(&dir.path("b.off")).unwrap(),

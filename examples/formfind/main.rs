@@ -177,7 +177,7 @@ fn formfind() -> Result<ExitCode, Failure> {
         Some(thickness) => {
             let solid = voussoir::thicken(&outcome.model.mesh, &outcome.positions, &thickness)
                 .map_err(|e| bad_input(format!("--solid: {e}")))?;
-            report["solid"] = report::solid(&solid, &outcome);
+            report["solid"] = report::solid(&solid, &outcome, &o);
             Some(solid)
         }
         None => None,

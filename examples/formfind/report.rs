@@ -191,8 +191,9 @@ pub fn build(o: &Options, outcome: &Outcome) -> Value {
     })
 }
 
-/// The printable solid of `--solid`: its size, volume and thickness range.
-pub fn solid(solid: &voussoir::Solid, outcome: &Outcome) -> Value {
+/// The printable solid of `--solid`: the thickness asked for, its size, volume and the range
+/// of the distances between the upper and lower copies of a vertex.
+pub fn solid(solid: &voussoir::Solid, outcome: &Outcome, o: &Options) -> Value {
     let t = &solid.vertex_thickness;
     let area: f64 = outcome
         .model
@@ -213,12 +214,18 @@ pub fn solid(solid: &voussoir::Solid, outcome: &Outcome) -> Value {
             (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0
         })
         .sum();
+    let thickness = match &o.solid {
+        Some((crate::args::SolidThickness::Uniform(t), _)) => json!(t),
+        _ => json!({ "density": o.density, "unit_weight": o.solid_unit_weight }),
+    };
     json!({
+        "thickness": thickness,
         "vertices": solid.positions.len(),
         "faces": solid.faces.len(),
         "volume": solid.volume(),
         "mid_surface_area": area,
-        "thickness_min": t.iter().copied().fold(f64::INFINITY, f64::min),
-        "thickness_max": t.iter().copied().fold(0.0, f64::max),
+        // Thickness over the mean cosine between a vertex's offset and its faces' normals.
+        "vertex_offset_min": t.iter().copied().fold(f64::INFINITY, f64::min),
+        "vertex_offset_max": t.iter().copied().fold(0.0, f64::max),
     })
 }
