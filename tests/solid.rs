@@ -353,3 +353,24 @@ fn parts_that_meet_across_a_slit_are_refused() {
     assert!(err.contains("would intersect itself where"), "{err}");
     assert!(err.contains("crosses"), "{err}");
 }
+
+#[test]
+fn clockwise_input_and_unreferenced_vertices_still_give_an_outward_closed_solid() {
+    let dome = cap_dome(0.9, 100).unwrap();
+    let anchored: Vec<u32> = (0..dome.n_vertices() as u32)
+        .filter(|&v| dome.anchored[v as usize])
+        .collect();
+    let mut positions = dome.positions.clone();
+    positions.push([5.0, 5.0, 5.0]);
+    let clockwise: Vec<[u32; 3]> = dome.faces.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let mesh = Mesh::new(positions, clockwise, &anchored).unwrap();
+    assert!(mesh.reversed);
+    let solid = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.05)).unwrap();
+    assert_eq!(
+        solid.positions.len(),
+        2 * dome.n_vertices(),
+        "the lone vertex is left out"
+    );
+    assert_watertight(&solid.faces);
+    assert!(volume(&solid.positions, &solid.faces) > 0.0);
+}
