@@ -57,15 +57,16 @@ mkdir -p "$formfind_dir"
 if [ -d ../shared/data/models ]; then
   # `cargo test` has built it already; on its own this builds the example once.
   cargo build --quiet --locked --example formfind
+  formfind=${CARGO_TARGET_DIR:-$root/target}/debug/examples/formfind
   models=$(cd ../shared/data/models && pwd)
   # model and thickness (0.5% to 2% of its plan diagonal); cheese and hex have holes,
   # whose rims get walls too.
   for entry in "lilium 0.02" "neumunster 0.3" "cheese 0.02" "hex 0.01" "dome_with_doors 0.15"; do
-    set -- $entry
-    target/debug/examples/formfind "$models/$1.obj" --supports "$models/$1.json" \
-      --out "$formfind_dir/$1.off" --solid "$2" "$formfind_dir/$1-solid.off" \
-      --report "$formfind_dir/$1.json" --pictures "$formfind_dir/$1-pictures" >/dev/null
-    echo "$1 $2" >>"$formfind_dir/manifest.txt"
+    read -r m t <<<"$entry"
+    "$formfind" "$models/$m.obj" --supports "$models/$m.json" \
+      --out "$formfind_dir/$m.off" --solid "$t" "$formfind_dir/$m-solid.off" \
+      --report "$formfind_dir/$m.json" --pictures "$formfind_dir/$m-pictures" >/dev/null
+    echo "$m $t" >>"$formfind_dir/manifest.txt"
   done
   # The thickest solid formfind accepts: asked for far too much, it names the most that fits
   # (`allows at most X there`); 97% of that must still be free of self-intersections.
@@ -73,12 +74,11 @@ if [ -d ../shared/data/models ]; then
   for m in lilium hex four_holes three_pillar; do
     run=("$models/$m.obj" --supports "$models/$m.json" --out "$formfind_dir/edge/$m.off"
          --report "$formfind_dir/edge/$m.json" --pictures "$formfind_dir/edge/$m-pictures")
-    limit=$({ target/debug/examples/formfind "${run[@]}" --solid 1e6 "$formfind_dir/edge/x.off" \
-                2>&1 >/dev/null || true; } | sed -n 's/.*allows at most \([0-9.e+-]*\) there.*/\1/p')
+    limit=$({ "$formfind" "${run[@]}" --solid 1e6 "$formfind_dir/edge/x.off" 2>&1 >/dev/null \
+                || true; } | sed -n 's/.*allows at most \([0-9.e+-]*\) there.*/\1/p')
     [ -n "$limit" ] || { echo "formfind named no largest thickness for $m" >&2; exit 1; }
     t=$(awk -v l="$limit" 'BEGIN { printf "%.6g", 0.97 * l }')
-    target/debug/examples/formfind "${run[@]}" --solid "$t" "$formfind_dir/edge/$m-solid.off" \
-      >/dev/null
+    "$formfind" "${run[@]}" --solid "$t" "$formfind_dir/edge/$m-solid.off" >/dev/null
     echo "$m $t" >>"$formfind_dir/edge/manifest.txt"
   done
   echo "wrote $formfind_dir"
