@@ -602,8 +602,8 @@ VsrStatus vsr_mesh_welded_ids(const struct VsrMesh *mesh, uint32_t *out, size_t 
  * plan is undone).
  *
  * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
- * the mesh, an unknown extension, or a file that cannot be written
- * (`VSR_STATUS_INVALID_ARGUMENT`).
+ * the mesh, an unknown extension, `.3mf` (3MF holds closed solids: see
+ * `vsr_result_write_solid`), or a file that cannot be written (`VSR_STATUS_INVALID_ARGUMENT`).
  *
  * # Safety
  * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
@@ -1345,6 +1345,45 @@ VsrStatus vsr_settings_set_odt_free_boundary(struct VsrSettings *settings, uint3
  * `VsrProgressFn` signature.
  */
 VsrStatus vsr_settings_set_progress(struct VsrSettings *settings, VsrProgressFn callback, void *user);
+
+/**
+ * Writes a printable solid of the result's shape to `path`: the surface thickened by
+ * `thickness` (a length in the units of the positions; half above, half below, along
+ * area-weighted vertex normals, divided by the mean cosine to the faces' normals so that
+ * creases keep their thickness) and closed by walls along every boundary loop, outer and
+ * holes. The solid is one closed triangle mesh, every edge shared by two faces in opposite
+ * directions, faces pointing outwards: upper vertices first (one per mesh vertex that a face
+ * uses, in id order), then the lower ones, then the faces of the upper surface, of the lower
+ * surface and of the walls. The format follows the extension as in `vsr_result_write`, plus
+ * `.3mf` (a 3MF package: closed meshes only, in millimetres); `.stl` is binary, single
+ * precision. All or nothing, as `vsr_result_write`.
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a `thickness` that is not a finite
+ * number above 0, a thickness so large that an offset face would turn over (the solid would
+ * intersect itself; the message names the face, its vertices and the largest thickness it
+ * allows), a fold no offset direction clears (naming the vertex), parts of the shell so near
+ * each other that the solid would cross itself (naming them), a result with another
+ * vertex count than the mesh, an unknown extension, or a file that cannot be written
+ * (`VSR_STATUS_INVALID_ARGUMENT`).
+ *
+ * # Safety
+ * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
+ */
+VsrStatus vsr_result_write_solid(const struct VsrResult *result, const struct VsrMesh *mesh, double thickness, const char *path);
+
+/**
+ * As `vsr_result_write_solid`, with a thickness per face derived from the mesh's face
+ * densities (`vsr_mesh_set_face_density`, default 1): density / `unit_weight`, density
+ * being weight per unit area and `unit_weight` weight per unit volume. A vertex takes the
+ * area-weighted mean of its faces' thicknesses.
+ *
+ * Errors: those of `vsr_result_write_solid`; a `unit_weight` that is not finite and > 0, or
+ * a face of density 0 (`VSR_STATUS_INVALID_ARGUMENT`, naming the face).
+ *
+ * # Safety
+ * `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
+ */
+VsrStatus vsr_result_write_solid_from_density(const struct VsrResult *result, const struct VsrMesh *mesh, double unit_weight, const char *path);
 
 /**
  * Stress analysis of the mesh as given: the best compressive force densities for its fixed

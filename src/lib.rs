@@ -26,6 +26,7 @@ mod problem;
 mod setters;
 mod shape;
 mod smooth;
+mod solid;
 mod solve;
 mod stress;
 
@@ -36,6 +37,7 @@ pub use mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 pub use mesh::{BoundaryLoop, Edge, Mesh, Side, MAX_COORDINATE, MIN_PLAN_EXTENT};
 pub use problem::Problem;
 pub use shape::Schedule;
+pub use solid::{signed_volume, thicken, Solid, Thickness};
 pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Progress, Termination};
 pub use stress::airy::HoleMode;
 pub use stress::{

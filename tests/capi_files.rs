@@ -424,3 +424,129 @@ fn plan_slivers_are_repaired_and_listed_unless_the_tolerance_is_zero() {
     );
     unsafe { vsr_mesh_destroy(mesh) };
 }
+
+/// Every directed edge of `faces` once, and its reverse once.
+fn is_watertight(faces: &[[u32; 3]]) -> bool {
+    let mut directed = std::collections::HashMap::new();
+    for f in faces {
+        for k in 0..3 {
+            *directed.entry((f[k], f[(k + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    directed
+        .iter()
+        .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+}
+
+#[test]
+fn result_write_solid_writes_a_closed_solid_in_every_format() {
+    let dir = TempDir::new("solid");
+    let file = dir.path("m.obj");
+    io::write_mesh(&file, &POSITIONS, &TRIANGLES).unwrap();
+    let (s, mesh, _) = read(&file, None, &[0, 1, 2, 3], 0.0);
+    assert_ok(s);
+    let result = form_find(mesh);
+    let shape = positions(result);
+    for name in ["s.off", "s.obj", "s.ply", "s.stl", "s.3mf"] {
+        let out = c(&dir.path(name));
+        assert_ok(unsafe { vsr_result_write_solid(result, mesh, 0.02, out.as_ptr()) });
+        assert!(dir.path(name).is_file(), "{name}");
+        if name == "s.3mf" {
+            continue;
+        }
+        let (p, f) = io::read_mesh(&dir.path(name)).unwrap();
+        let w = io::weld(&p, &f, 1e-9).unwrap();
+        assert_eq!(w.positions.len(), 2 * POSITIONS.len(), "{name}");
+        assert!(is_watertight(&w.faces), "{name}");
+        let volume = voussoir::signed_volume(&w.positions, &w.faces);
+        let area: f64 = TRIANGLES
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| shape[v as usize]);
+                let (u, v) = (
+                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+                );
+                let n = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() / 2.0
+            })
+            .sum();
+        assert!(
+            (volume / (area * 0.02) - 1.0).abs() < 0.05,
+            "{name}: {volume}"
+        );
+    }
+    // Density 1 everywhere and unit weight 50: thickness 0.02 again.
+    let out = c(&dir.path("d.off"));
+    assert_ok(unsafe { vsr_result_write_solid_from_density(result, mesh, 50.0, out.as_ptr()) });
+    let from_density = io::read_mesh(&dir.path("d.off")).unwrap();
+    assert_eq!(from_density, io::read_mesh(&dir.path("s.off")).unwrap());
+    unsafe {
+        vsr_result_destroy(result);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
+#[test]
+fn result_write_solid_rejects_hostile_arguments_and_writes_nothing() {
+    let dir = TempDir::new("solid-bad");
+    let file = dir.path("m.obj");
+    io::write_mesh(&file, &POSITIONS, &TRIANGLES).unwrap();
+    let (s, mesh, _) = read(&file, None, &[0, 1, 2, 3], 0.0);
+    assert_ok(s);
+    let result = form_find(mesh);
+    let out = c(&dir.path("s.stl"));
+    unsafe {
+        assert_failed(
+            vsr_result_write_solid(null(), mesh, 0.1, out.as_ptr()),
+            S::NullPointer,
+            "result",
+        );
+        assert_failed(
+            vsr_result_write_solid(result, null(), 0.1, out.as_ptr()),
+            S::NullPointer,
+            "mesh",
+        );
+        assert_failed(
+            vsr_result_write_solid(result, mesh, 0.1, null()),
+            S::NullPointer,
+            "path",
+        );
+        for t in [0.0, -1.0, f64::NAN, f64::INFINITY, 50.0] {
+            assert_failed(
+                vsr_result_write_solid(result, mesh, t, out.as_ptr()),
+                S::InvalidArgument,
+                "thickness",
+            );
+        }
+        assert!(last_error().contains("turns over"), "{}", last_error());
+        for w in [0.0, -2.0, f64::NAN] {
+            assert_failed(
+                vsr_result_write_solid_from_density(result, mesh, w, out.as_ptr()),
+                S::InvalidArgument,
+                "unit_weight",
+            );
+        }
+        let unknown = c(&dir.path("s.xyz"));
+        assert_failed(
+            vsr_result_write_solid(result, mesh, 0.1, unknown.as_ptr()),
+            S::InvalidArgument,
+            "path",
+        );
+        let surface = c(&dir.path("s.3mf"));
+        assert_failed(
+            vsr_result_write(result, mesh, surface.as_ptr()),
+            S::InvalidArgument,
+            "path",
+        );
+    }
+    assert_eq!(fs::read_dir(&dir.0).unwrap().count(), 1, "only the input");
+    unsafe {
+        vsr_result_destroy(result);
+        vsr_mesh_destroy(mesh);
+    }
+}

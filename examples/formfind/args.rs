@@ -64,6 +64,7 @@ Usage:
   formfind MESH.obj --supports S.json [options]
   formfind MESH.obj --anchor-boundary [options]
   formfind MESH.off --anchor-lowest 0.01 --out OUT.ply [options]
+  formfind MESH.obj --supports S.json --solid 0.1 SOLID.3mf [options]
 
 Inputs:
   MESH                   .obj, .off, .stl or .ply: vertices (x, y plan; z up) and faces;
@@ -95,6 +96,15 @@ are replaced only when every output is written; two outputs may not share a path
                          azimuth −60° and 30° above the horizon, shaded, the
                          faces coloured by height change; about 70 bytes per
                          face and view (14 MB for 100k faces)
+  --solid T OUT          also a printable solid: the result thickened by T (half above,
+                         half below, along vertex normals), closed by walls along every
+                         boundary; OUT is .stl, .3mf (read as millimetres), .off, .obj or
+                         .ply. T is a length in the mesh's units, or `density`: --density
+                         / --solid-unit-weight. Exit 2 (nothing written) if T is so large
+                         that the solid would intersect itself (the message names where,
+                         and the largest T that fits there)
+  --solid-unit-weight W  weight per unit volume, for --solid density
+  --ascii                write STL and PLY outputs as ASCII text, not binary
   Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
   and NAME-supports.json, to try other options on.
 
@@ -167,10 +177,50 @@ pub struct Options {
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
+    /// `--solid`: the thickness and the output path.
+    pub solid: Option<(SolidThickness, PathBuf)>,
+    pub solid_unit_weight: Option<f64>,
+    /// `--ascii`: STL and PLY outputs as text.
+    pub ascii: bool,
     pub stress_only: bool,
     pub odt: Option<usize>,
     pub density: f64,
     pub settings: FormFindSettings,
+}
+
+/// The thickness of `--solid`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SolidThickness {
+    /// A length, in the mesh's units.
+    Uniform(f64),
+    /// Per face, density / unit weight (`--solid density`).
+    FromDensity,
+}
+
+impl Options {
+    /// The thickness of the solid, if one is asked for.
+    pub fn thickness(&self) -> Option<voussoir::Thickness> {
+        match self.solid.as_ref()?.0 {
+            SolidThickness::Uniform(t) => Some(voussoir::Thickness::Uniform(t)),
+            SolidThickness::FromDensity => {
+                let w = self.solid_unit_weight?;
+                Some(voussoir::Thickness::Uniform(self.density / w))
+            }
+        }
+    }
+}
+
+/// `--solid`'s thickness: a number > 0 or `density`.
+fn solid_thickness(text: &str) -> Result<SolidThickness, String> {
+    if text == "density" {
+        return Ok(SolidThickness::FromDensity);
+    }
+    match number("--solid", text) {
+        Ok(t) if t > 0.0 => Ok(SolidThickness::Uniform(t)),
+        _ => Err(format!(
+            "--solid: expected a thickness > 0 or `density` before the output path, got `{text}`"
+        )),
+    }
 }
 
 /// What `parse` found: options to run with, or a request for help.
@@ -240,6 +290,9 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         out: None,
         report: None,
         pictures: None,
+        solid: None,
+        solid_unit_weight: None,
+        ascii: false,
         stress_only: false,
         odt: None,
         density: 1.0,
@@ -285,6 +338,19 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
+            "--solid" => {
+                let thickness = solid_thickness(&value()?)?;
+                let out = value().map_err(|_| "--solid: expected THICKNESS OUT".to_string())?;
+                o.solid = Some((thickness, out.into()));
+            }
+            "--solid-unit-weight" => {
+                let w = number(&flag, &value()?)?;
+                if w <= 0.0 {
+                    return Err(format!("{flag}: must be > 0, got {w}"));
+                }
+                o.solid_unit_weight = Some(w);
+            }
+            "--ascii" => o.ascii = true,
             "--stress-only" => o.stress_only = true,
             "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
             "--fairness" => {
@@ -359,6 +425,26 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
     Ok(Parsed::Run(Box::new(o)))
 }
 
+/// `--solid` and `--solid-unit-weight` together or not at all.
+fn check_solid(o: &Options) -> Result<(), String> {
+    match (&o.solid, o.solid_unit_weight) {
+        (Some((SolidThickness::FromDensity, _)), None) => {
+            return Err("--solid density needs --solid-unit-weight W".into())
+        }
+        (Some((SolidThickness::Uniform(_), _)), Some(_)) => {
+            return Err(
+                "--solid-unit-weight goes with --solid density, not with a thickness".into(),
+            )
+        }
+        (None, Some(_)) => return Err("--solid-unit-weight needs --solid density OUT".into()),
+        _ => {}
+    }
+    if let Some((_, out)) = &o.solid {
+        voussoir::io::MeshFormat::from_path(out).map_err(|e| format!("--solid: {e}"))?;
+    }
+    Ok(())
+}
+
 /// Combinations of options that cannot work.
 fn check(o: &Options) -> Result<(), String> {
     let ways = [
@@ -384,8 +470,16 @@ fn check(o: &Options) -> Result<(), String> {
         }
     }
     if let Some(out) = &o.out {
-        voussoir::io::MeshFormat::from_path(out).map_err(|e| format!("--out: {e}"))?;
+        let format = voussoir::io::MeshFormat::from_path(out).map_err(|e| format!("--out: {e}"))?;
+        if format == voussoir::io::MeshFormat::ThreeMf {
+            return Err(
+                "--out: 3MF holds closed solids, not the open shell: write a solid with \
+                 --solid T OUT.3mf, or the shell as .obj, .off, .ply or .stl"
+                    .into(),
+            );
+        }
     }
+    check_solid(o)?;
     o.settings.stress.validate().map_err(|e| {
         e.to_string()
             .replace("`q_min`", "--qmin")

@@ -102,6 +102,8 @@ struct Paths {
     out: PathBuf,
     report: PathBuf,
     pictures: PathBuf,
+    /// `--solid`'s output.
+    solid: Option<PathBuf>,
     /// Where the embedded input and its supports are copied (without MESH.obj).
     input_copy: Option<(PathBuf, PathBuf)>,
 }
@@ -120,6 +122,7 @@ impl Paths {
         Paths {
             report: o.report.clone().unwrap_or_else(|| dir.join("report.json")),
             pictures: o.pictures.clone().unwrap_or_else(|| dir.join("pictures")),
+            solid: o.solid.as_ref().map(|(_, path)| path.clone()),
             out,
             input_copy,
         }
@@ -132,6 +135,9 @@ impl Paths {
             path: path.to_path_buf(),
         };
         let mut targets = vec![target("--out", &self.out), target("--report", &self.report)];
+        if let Some(solid) = &self.solid {
+            targets.push(target("--solid", solid));
+        }
         for file in pictures::names(stress_only) {
             targets.push(target("--pictures", &self.pictures.join(file)));
         }
@@ -161,19 +167,34 @@ fn formfind() -> Result<ExitCode, Failure> {
         out,
         report: report_path,
         pictures: pictures_dir,
+        solid: solid_path,
         input_copy,
     } = paths;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
-    let report = report::build(&o, &outcome);
+    let mut report = report::build(&o, &outcome);
+    let solid = match o.thickness() {
+        Some(thickness) => {
+            let solid = voussoir::thicken(&outcome.model.mesh, &outcome.positions, &thickness)
+                .map_err(|e| bad_input(format!("--solid: {e}")))?;
+            report["solid"] = report::solid(&solid, &outcome, &o);
+            Some(solid)
+        }
+        None => None,
+    };
     let pictures = pictures::all(&outcome);
 
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
     let mesh = &outcome.model.mesh;
     staging
-        .write_mesh(&out, &outcome.positions, &outcome.model.faces)
+        .write_mesh(&out, &outcome.positions, &outcome.model.faces, o.ascii)
         .map_err(failed)?;
+    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
+        staging
+            .write_mesh(path, &solid.positions, &solid.faces, o.ascii)
+            .map_err(failed)?;
+    }
     staging
         .write(&report_path, report_text(&report).as_bytes())
         .map_err(failed)?;
@@ -197,6 +218,14 @@ fn formfind() -> Result<ExitCode, Failure> {
     print_summary(&outcome, &report);
     say!("wrote:");
     say!("  {:<40} {}", out.display(), "form-found mesh (same faces)");
+    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
+        say!(
+            "  {:<40} printable solid: {} faces, volume {:.6e}",
+            path.display(),
+            solid.faces.len(),
+            solid.volume()
+        );
+    }
     say!("  {:<40} {}", report_path.display(), "report (JSON)");
     let names: Vec<&str> = pictures.iter().map(|(n, _)| *n).collect();
     say!(

@@ -179,14 +179,19 @@ impl Staging {
         voussoir::io::write_obj(&tmp, positions, faces).map_err(|e| describe(target, e))
     }
 
-    /// Stages a mesh for `target` in the format of its extension, written by the library.
+    /// Stages a mesh for `target` in the format of its extension (STL and PLY as ASCII text
+    /// when `ascii`), written by the library.
     pub fn write_mesh(
         &mut self,
         target: &Path,
         positions: &[[f64; 3]],
         faces: &[[u32; 3]],
+        ascii: bool,
     ) -> Result<(), String> {
-        let format = voussoir::io::MeshFormat::from_path(target).map_err(|e| e.to_string())?;
+        let mut format = voussoir::io::MeshFormat::from_path(target).map_err(|e| e.to_string())?;
+        if ascii {
+            format = format.ascii();
+        }
         let tmp = self.temp_for(target)?;
         voussoir::io::write_mesh_as(&tmp, format, positions, faces).map_err(|e| describe(target, e))
     }

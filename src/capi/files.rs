@@ -17,7 +17,7 @@ use crate::problem::Problem;
 ///
 /// # Safety
 /// When non-NULL, `ptr` must point to a NUL-terminated string.
-unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
+pub(super) unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf> {
     if ptr.is_null() {
         return Err(Failure::null(name));
     }
@@ -177,8 +177,8 @@ pub unsafe extern "C" fn vsr_mesh_welded_ids(
 /// plan is undone).
 ///
 /// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a result with another vertex count than
-/// the mesh, an unknown extension, or a file that cannot be written
-/// (`VSR_STATUS_INVALID_ARGUMENT`).
+/// the mesh, an unknown extension, `.3mf` (3MF holds closed solids: see
+/// `vsr_result_write_solid`), or a file that cannot be written (`VSR_STATUS_INVALID_ARGUMENT`).
 ///
 /// # Safety
 /// `result`, `mesh`: valid handles; `path`: a NUL-terminated string.
@@ -214,7 +214,15 @@ pub unsafe extern "C" fn vsr_result_write(
         } else {
             m.faces.clone()
         };
-        io::write_mesh(&path, positions, &faces).map_err(|e| from_error("path", e))
+        let format = io::MeshFormat::from_path(&path).map_err(|e| from_error("path", e))?;
+        if format == io::MeshFormat::ThreeMf {
+            return Err(Failure::invalid(
+                "path",
+                "3MF holds closed solids: write the surface as .obj, .off, .ply or .stl, or a \
+                 solid with vsr_result_write_solid",
+            ));
+        }
+        io::write_mesh_as(&path, format, positions, &faces).map_err(|e| from_error("path", e))
     })
 }
 

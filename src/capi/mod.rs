@@ -15,6 +15,7 @@ mod files;
 mod mesh;
 mod result;
 mod settings;
+mod solid;
 mod solve;
 mod status;
 
@@ -22,6 +23,7 @@ pub use files::*;
 pub use mesh::*;
 pub use result::*;
 pub use settings::*;
+pub use solid::*;
 pub use solve::*;
 pub use status::{
     VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrQpSolver,

@@ -3,11 +3,11 @@
 use std::fs;
 use std::path::Path;
 
-use super::{io_error, off, ply, read_obj, stl, write_obj, RawMesh};
+use super::{io_error, off, ply, read_obj, stl, threemf, write_obj, RawMesh};
 use crate::{Error, Result};
 
 /// A mesh file format. [`MeshFormat::from_path`] picks it from the extension
-/// (case-insensitive): `.obj`, `.off`, `.stl`, `.ply`.
+/// (case-insensitive): `.obj`, `.off`, `.stl`, `.ply`, `.3mf`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum MeshFormat {
@@ -26,6 +26,9 @@ pub enum MeshFormat {
         /// Binary little-endian (`true`) or ASCII (`false`); any encoding is read.
         binary: bool,
     },
+    /// 3MF, a zip package of XML: written only, and only for closed meshes such as a
+    /// [`crate::Solid`] (3MF holds solids).
+    ThreeMf,
 }
 
 impl MeshFormat {
@@ -40,10 +43,12 @@ impl MeshFormat {
             Some("off") => Ok(MeshFormat::Off),
             Some("stl") => Ok(MeshFormat::Stl { binary: true }),
             Some("ply") => Ok(MeshFormat::Ply { binary: true }),
+            Some("3mf") => Ok(MeshFormat::ThreeMf),
             other => Err(Error::InvalidArgument {
                 name: "path",
                 reason: format!(
-                    "{}: {}; the mesh formats are .obj, .off, .stl and .ply",
+                    "{}: {}; the mesh formats are .obj, .off, .stl and .ply (and .3mf, \
+                     written only)",
                     path.display(),
                     match other {
                         Some(e) => format!("unknown extension `.{e}`"),
@@ -80,8 +85,18 @@ impl MeshFormat {
 /// NaN or infinite coordinates.
 pub fn read_mesh(path: &Path) -> Result<RawMesh> {
     let format = MeshFormat::from_path(path)?;
-    if format == MeshFormat::Obj {
-        return read_obj(path);
+    match format {
+        MeshFormat::Obj => return read_obj(path),
+        MeshFormat::ThreeMf => {
+            return Err(Error::InvalidArgument {
+                name: "path",
+                reason: format!(
+                    "{}: 3MF is written, not read; read .obj, .off, .stl or .ply",
+                    path.display()
+                ),
+            })
+        }
+        _ => {}
     }
     let bytes = fs::read(path).map_err(|e| io_error(path, &e))?;
     let label = path.display().to_string();
@@ -104,7 +119,8 @@ pub fn write_mesh(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Re
 /// `f64` (at most 17 significant digits), and PLY binary as `double`, so OBJ, OFF and PLY
 /// keep positions bit for bit. STL stores `f32` by definition: positions are rounded to
 /// single precision (about 7 significant digits), enough to look at or print a shape but
-/// not to keep its equilibrium. The file is written to a temporary file in the same folder
+/// not to keep its equilibrium. 3MF writes shortest decimals too, and needs a closed mesh
+/// (every edge shared by two faces in opposite directions). The file is written to a temporary file in the same folder
 /// and renamed over `path`, so a failure never leaves a half-written file. A face index
 /// `>= positions.len()` or a non-finite coordinate is an [`Error::InvalidArgument`].
 pub fn write_mesh_as(
@@ -120,5 +136,6 @@ pub fn write_mesh_as(
         MeshFormat::Off => off::write_off(path, positions, faces),
         MeshFormat::Stl { binary } => stl::write_stl(path, positions, faces, binary),
         MeshFormat::Ply { binary } => ply::write_ply(path, positions, faces, binary),
+        MeshFormat::ThreeMf => threemf::write_3mf(path, positions, faces),
     }
 }

@@ -1,5 +1,5 @@
 //! Mesh files (OBJ, OFF, STL, PLY, chosen by extension through [`read_mesh`] and
-//! [`write_mesh`]), welding of duplicated vertices ([`weld`]), and a JSON sidecar listing the
+//! [`write_mesh`]; 3MF for closed solids, written only), welding of duplicated vertices ([`weld`]), and a JSON sidecar listing the
 //! anchored (support) vertices.
 //!
 //! ```no_run
@@ -23,6 +23,7 @@ mod stl;
 mod supports;
 #[cfg(test)]
 mod tests;
+mod threemf;
 mod weld;
 #[cfg(test)]
 mod weld_tests;

@@ -274,6 +274,22 @@ int main(void) {
         EXPECT(vsr_result_write(result, read, "vsr_hostile_no_such_dir/out.off"),
                VSR_STATUS_INVALID_ARGUMENT, "path");
         EXPECT(vsr_result_write(result, read, "vsr_hostile_out.off"), VSR_STATUS_OK, "");
+        EXPECT(vsr_result_write_solid(NULL, read, 0.01, "vsr_hostile_solid.stl"),
+               VSR_STATUS_NULL_POINTER, "result");
+        EXPECT(vsr_result_write_solid(result, read, 0.01, NULL), VSR_STATUS_NULL_POINTER, "path");
+        EXPECT(vsr_result_write_solid(result, read, -1.0, "vsr_hostile_solid.stl"),
+               VSR_STATUS_INVALID_ARGUMENT, "thickness");
+        EXPECT(vsr_result_write_solid_from_density(result, read, 0.0, "vsr_hostile_solid.stl"),
+               VSR_STATUS_INVALID_ARGUMENT, "unit_weight");
+        f = fopen("vsr_hostile_solid.stl", "r");
+        TRUE(f == NULL);
+        if (f) fclose(f);
+        EXPECT(vsr_result_write_solid(result, read, 0.01, "vsr_hostile_solid.stl"), VSR_STATUS_OK,
+               "");
+        f = fopen("vsr_hostile_solid.stl", "r");
+        TRUE(f != NULL);
+        if (f) fclose(f);
+        remove("vsr_hostile_solid.stl");
         f = fopen("vsr_hostile_out.off", "r");
         TRUE(f != NULL);
         if (f) fclose(f);
