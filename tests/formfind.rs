@@ -474,6 +474,7 @@ fn help_lists_every_option() {
         "--odt",
         "--density",
         "--load",
+        "--up",
     ] {
         assert!(text.contains(flag), "--help lacks {flag}");
     }
@@ -587,4 +588,61 @@ fn holes_option_is_honoured_and_reported() {
         affine < constant * (1.0 - 1e-3),
         "affine {affine} vs constant {constant}"
     );
+}
+
+/// A 4 × 4 grid of quads as a Y-up modeller writes it: heights along the second axis, the
+/// plan in the first and third (z = −y of the Z-up frame).
+fn y_up_grid() -> String {
+    let mut obj = String::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            let inner = (1..3).contains(&i) && (1..3).contains(&j);
+            obj += &format!("v {i} {} {}\n", if inner { 0.8 } else { 0.0 }, -j);
+        }
+    }
+    for j in 0..3 {
+        for i in 0..3 {
+            let v = |di: usize, dj: usize| (j + dj) * 4 + i + di + 1;
+            obj += &format!("f {} {} {} {}\n", v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+        }
+    }
+    obj
+}
+
+#[test]
+fn a_y_up_mesh_is_refused_with_a_hint_and_read_with_up_y() {
+    rejects(
+        &[("y.obj", &y_up_grid())],
+        &["y.obj", "--anchor-boundary"],
+        "try --up y",
+    );
+    rejects(&[], &["--up", "y"], "--up y needs a MESH");
+    let dir = Scratch::new("y-up");
+    fs::write(dir.path("y.obj"), y_up_grid()).unwrap();
+    let out = run(&dir.0, &["y.obj", "--anchor-boundary", "--up", "y"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let od = dir.path("formfind-out");
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["settings"]["up"], "y");
+    assert_eq!(r["anchored"].as_array().unwrap().len(), 12);
+    // The output keeps the file's axes: the plan (x, z) as read, heights along y.
+    let input: Vec<Vec<f64>> = (y_up_grid().lines())
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split(' ').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let (output, _) = read_obj(&od.join("y-formfound.obj"));
+    for (a, b) in input.iter().zip(&output) {
+        assert_eq!((a[0], a[2]), (b[0], b[2]), "plan moved: {a:?} -> {b:?}");
+        let inner = a[1] > 0.0;
+        assert!(
+            !inner || b[1] > 0.0,
+            "an inner vertex went below its supports: {b:?}"
+        );
+        assert!(inner || b[1] == 0.0, "a support moved: {b:?}");
+    }
+    assert_eq!(input.len(), output.len());
 }

@@ -171,8 +171,17 @@ fn formfind() -> Result<ExitCode, Failure> {
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
     let mesh = &outcome.model.mesh;
+    let positions: Vec<[f64; 3]> = if o.y_up {
+        outcome
+            .positions
+            .iter()
+            .map(|&p| model::to_y_up(p))
+            .collect()
+    } else {
+        outcome.positions.clone()
+    };
     staging
-        .write_mesh(&out, &outcome.positions, &outcome.model.faces)
+        .write_mesh(&out, &positions, &outcome.model.faces)
         .map_err(failed)?;
     staging
         .write(&report_path, report_text(&report).as_bytes())

@@ -93,11 +93,57 @@ pub struct WeldSummary {
     pub collapsed_faces: Vec<usize>,
 }
 
-/// Reads `mesh_path` (any format), welds it unless `--no-weld` (STL always, at the default
-/// tolerance if need be), and anchors the vertices of `--supports` (input ids, mapped onto
-/// welded ones), of `--anchor-lowest` or every boundary vertex.
-pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
-    let (positions, faces) = io::read_mesh(mesh_path)?;
+/// Reads `mesh_path` (any format), turns it Z-up for `--up y`, welds it unless `--no-weld` (STL
+/// always, at the default tolerance if need be), and anchors the vertices of `--supports`
+/// (input ids, mapped onto welded ones), of `--anchor-lowest` or every boundary vertex. A mesh
+/// whose plan is invalid but would be valid seen Y-up gets a hint to `--up y` in its error.
+pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
+    let (positions, faces) = io::read_mesh(mesh_path).map_err(|e| e.to_string())?;
+    let read = |y_up: bool| {
+        let positions = if y_up {
+            positions.iter().map(|&p| from_y_up(p)).collect()
+        } else {
+            positions.clone()
+        };
+        build(mesh_path, o, positions, faces.clone())
+    };
+    match read(o.y_up) {
+        Err(e) if !o.y_up && is_plan_error(&e) && read(true).is_ok() => Err(format!(
+            "{e} (seen with y up, as most modellers export, the plan is valid: try --up y)"
+        )),
+        other => other.map_err(|e| e.to_string()),
+    }
+}
+
+/// A position of a Y-up file in the Z-up frame: a quarter turn about the x axis.
+pub fn from_y_up(p: [f64; 3]) -> [f64; 3] {
+    [p[0], -p[2], p[1]]
+}
+
+/// A Z-up position back in a Y-up file's axes (the inverse of [`from_y_up`]).
+pub fn to_y_up(p: [f64; 3]) -> [f64; 3] {
+    [p[0], p[2], -p[1]]
+}
+
+/// Whether `e` says the plan (the projection along z) is not a valid one.
+fn is_plan_error(e: &voussoir::Error) -> bool {
+    matches!(
+        e,
+        voussoir::Error::DegenerateFaces { .. }
+            | voussoir::Error::FlippedFaces { .. }
+            | voussoir::Error::OverlappingPlan { .. }
+            | voussoir::Error::OverlappingFaces { .. }
+    )
+}
+
+/// The model of `positions` and `faces` (already Z-up): welding, supports, plan repair and
+/// validation.
+fn build(
+    mesh_path: &Path,
+    o: &Options,
+    positions: Vec<[f64; 3]>,
+    faces: Vec<[u32; 3]>,
+) -> voussoir::Result<Model> {
     let is_stl = io::MeshFormat::from_path(mesh_path)?.is_single_precision();
     let tolerance = o.weld.or(is_stl.then_some(io::DEFAULT_WELD_TOLERANCE));
     let (positions, faces, welded) = match tolerance {
