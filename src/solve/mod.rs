@@ -145,7 +145,8 @@ pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 #[non_exhaustive]
 pub struct FormFindResult {
     pub termination: Termination,
-    /// Final positions (heights moved; the plan too when ODT is on).
+    /// Final positions (heights moved; the plan too when ODT is on): without convergence, those
+    /// of the lowest-ε∞ state reached.
     pub positions: Vec<[f64; 3]>,
     /// The forces the loop ended with, at `positions` (their residuals certify the result):
     /// the last stress step's, or earlier ones it kept (see `history`). Beyond 20k unknowns the

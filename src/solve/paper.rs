@@ -40,6 +40,7 @@ pub(super) fn paper(
     let mut cache = StressCache::for_form_finding();
     let mut stress_steps = 0;
     let mut solvers = Vec::new();
+    let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
             let t = Instant::now();
@@ -64,6 +65,7 @@ pub(super) fn paper(
         history.push(stress.eps_inf);
         let status = stress.status;
         let eps = stress.eps_inf;
+        lowest.offer(&positions, &stress);
         last = Some(stress);
         if let Some(cb) = progress.as_mut() {
             if !cb(k, eps) {
@@ -108,6 +110,7 @@ pub(super) fn paper(
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
         let certified_eps = certified.eps_inf;
+        lowest.offer(&positions, &certified);
         last = Some(certified);
         if certified_eps < settings.tolerance {
             history.push(certified_eps);
@@ -115,7 +118,12 @@ pub(super) fn paper(
             break;
         }
     }
-    let stress = last.expect("at least one iteration");
+    let mut stress = last.expect("at least one iteration");
+    if termination != Termination::Converged {
+        if let Some((p, s)) = lowest.state {
+            (positions, stress) = (p, s);
+        }
+    }
     Ok(finish(
         problem,
         Run {
@@ -130,6 +138,31 @@ pub(super) fn paper(
         },
         start,
     ))
+}
+
+/// The lowest-ε∞ state reached (heights with the forces certified there), the answer of a loop
+/// that ends without converging: later steps of a stalled loop may have moved further from
+/// balance.
+#[derive(Default)]
+struct Lowest {
+    state: Option<(Vec<[f64; 3]>, StressResult)>,
+}
+
+impl Lowest {
+    fn offer(&mut self, positions: &[[f64; 3]], stress: &StressResult) {
+        let usable = !matches!(
+            stress.status,
+            StressStatus::Infeasible | StressStatus::NumericalError
+        );
+        if usable
+            && self
+                .state
+                .as_ref()
+                .is_none_or(|(_, s)| stress.eps_inf < s.eps_inf)
+        {
+            self.state = Some((positions.to_vec(), stress.clone()));
+        }
+    }
 }
 
 /// The proximal term towards the previous step's forces, when that step was solved.
