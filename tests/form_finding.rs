@@ -321,12 +321,25 @@ fn infeasible_bounds_are_reported_not_hidden() {
     let mut settings = FormFindSettings::default();
     settings.stress.q_min = QBound::Relative(10.0);
     settings.stress.q_max = Some(QBound::Absolute(1e-6));
-    let r = form_find(&problem, &settings, None).unwrap();
-    assert!(
-        matches!(r.termination, Termination::Infeasible { .. }),
-        "{:?}",
-        r.termination
-    );
+    for method in [FormMethod::Nearest, FormMethod::Paper] {
+        settings.method = method;
+        let r = form_find(&problem, &settings, None).unwrap();
+        assert!(
+            matches!(r.termination, Termination::Infeasible { .. }),
+            "{method:?}: {:?}",
+            r.termination
+        );
+        // The answer is the input with the forces of its analysis, not an empty state.
+        let mesh = &problem.mesh;
+        assert_eq!(r.positions, mesh.positions, "{method:?}");
+        assert_eq!(r.stress.loads.len(), mesh.n_vertices(), "{method:?}");
+        assert_eq!(r.stress.residuals.len(), mesh.n_vertices(), "{method:?}");
+        assert_eq!(
+            r.stress.force_densities.len(),
+            mesh.edges.len(),
+            "{method:?}"
+        );
+    }
 }
 
 #[test]

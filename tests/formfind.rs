@@ -646,3 +646,22 @@ fn a_y_up_mesh_is_refused_with_a_hint_and_read_with_up_y() {
     }
     assert_eq!(input.len(), output.len());
 }
+
+#[test]
+fn infeasible_bounds_write_outputs_and_exit_3() {
+    let dir = Scratch::new("infeasible");
+    let out = run(&dir.0, &["--qmin", "10", "--qmax", "1e-6abs"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("not converged (infeasible)"), "{stderr}");
+    let r = read_json(&dir.path("formfind-out/report.json"));
+    assert_eq!(r["termination"], "infeasible");
+    assert_eq!(r["iterations"], 1);
+    let loads = numbers(&r["loads"]);
+    assert_eq!(
+        loads.len(),
+        r["mesh"]["vertices"].as_u64().unwrap() as usize
+    );
+    assert!(dir.path("formfind-out/vault-formfound.obj").is_file());
+}

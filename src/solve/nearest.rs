@@ -199,10 +199,14 @@ impl<'a, 'p> Nearest<'a, 'p> {
     fn run(&mut self) -> Result<Termination> {
         let first = self.stress_step(None)?;
         self.held = first;
-        if let Some(t) = self.after_stress_step() {
+        // The input's analysis is recorded whatever ends the loop here, so that even an
+        // infeasible or cancelled run answers forces for its positions.
+        let ended = self.after_stress_step();
+        let settled = self.record();
+        if let Some(t) = ended {
             return Ok(t);
         }
-        if self.record() {
+        if settled {
             return Ok(Termination::Converged);
         }
         self.w = match self.initial_weight() {
