@@ -511,3 +511,58 @@ fn a_loop_that_stalls_returns_its_lowest_residual_state() {
     let eps = recomputed_eps("stalled hanging cap", &problem, &r);
     assert!((eps - lowest).abs() <= 1e-6 * lowest, "{eps} vs {lowest}");
 }
+
+/// A latitude-longitude dome of `rings` × `sectors` quads, each split along the diagonal from
+/// its first corner (as a fan split of a modeller's quads does) or, with `alternate`, along
+/// alternating diagonals around each ring; the rim is anchored.
+fn lat_long_dome(rings: usize, sectors: usize, alternate: bool) -> Mesh {
+    let mut positions = vec![[0.0, 0.0, 0.6]];
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            positions.push([rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr * rr)]);
+        }
+    }
+    let id = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
+    let mut faces: Vec<[u32; 3]> = (0..sectors).map(|s| [0, id(1, s), id(1, s + 1)]).collect();
+    for r in 1..rings {
+        for s in 0..sectors {
+            let [a, b, c, d] = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            if alternate && s % 2 == 1 {
+                faces.extend([[a, b, d], [b, c, d]]);
+            } else {
+                faces.extend([[a, b, c], [a, c, d]]);
+            }
+        }
+    }
+    let rim: Vec<u32> = (0..sectors).map(|s| id(rings, s)).collect();
+    Mesh::new(positions, faces, &rim).unwrap()
+}
+
+/// Rings of quads all split along the same diagonal admit no strictly convex stress function:
+/// no network has q ≥ q_min > 0 on every edge, and the termination says so; alternating
+/// diagonals, or q_min = 0, admit one.
+#[test]
+fn twisted_rings_of_split_quads_are_named_when_infeasible() {
+    let settings = FormFindSettings::default();
+    let twisted = Problem::new(lat_long_dome(5, 24, false));
+    let r = form_find(&twisted, &settings, None).unwrap();
+    let Termination::Infeasible { constraint } = &r.termination else {
+        panic!("{:?}", r.termination);
+    };
+    assert!(
+        constraint.contains("latitude-longitude dome"),
+        "{constraint}"
+    );
+    assert!(!constraint.contains("free edge"), "{constraint}");
+    let alternating = Problem::new(lat_long_dome(5, 24, true));
+    let r = form_find(&alternating, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("alternating diagonals", &alternating, &r);
+    let mut no_q_min = settings.clone();
+    no_q_min.stress.q_min = QBound::Relative(0.0);
+    let r = form_find(&twisted, &no_q_min, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("twisted, q_min = 0", &twisted, &r);
+}

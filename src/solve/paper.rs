@@ -73,7 +73,7 @@ pub(super) fn paper(
                 break;
             }
         }
-        if let Some(failed) = failure(status, settings) {
+        if let Some(failed) = failure(status, problem, settings) {
             termination = failed;
             break;
         }
@@ -209,10 +209,14 @@ fn keep_better(
 }
 
 /// The termination for a stress step that failed, if it did.
-fn failure(status: StressStatus, settings: &FormFindSettings) -> Option<Termination> {
+fn failure(
+    status: StressStatus,
+    problem: &Problem,
+    settings: &FormFindSettings,
+) -> Option<Termination> {
     match status {
         StressStatus::Infeasible => Some(Termination::Infeasible {
-            constraint: infeasibility_hint(&settings.stress),
+            constraint: infeasibility_hint(&problem.mesh, &settings.stress),
         }),
         StressStatus::NumericalError => Some(Termination::NumericalError {
             what: "stress QP failed".into(),
