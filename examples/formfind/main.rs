@@ -297,7 +297,8 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.before.eps_inf
             );
             let detail = &report["termination_detail"];
-            if !detail.is_null() {
+            // A stall with no vertex to name has nothing to add to its own line.
+            if !detail.is_null() && *detail != serde_json::json!({ "vertices": [] }) {
                 say!("  details: {detail}");
             }
             say!(
