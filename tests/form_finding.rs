@@ -566,3 +566,50 @@ fn twisted_rings_of_split_quads_are_named_when_infeasible() {
     assert_eq!(r.termination, Termination::Converged);
     certify("twisted, q_min = 0", &twisted, &r);
 }
+
+/// The quads' diagonals marked as such, q_min binds the quads' edges only: the twisted
+/// latitude-longitude dome converges with the default q_min, which its quad edges carry.
+#[test]
+fn marked_polygon_diagonals_free_twisted_rings_from_q_min() {
+    let (rings, sectors) = (5, 24);
+    let mut mesh = lat_long_dome(rings, sectors, false);
+    // A cone, not the paraboloid: its straight meridians carry no load, form finding has
+    // to move it.
+    for p in mesh.positions.iter_mut() {
+        p[2] = 0.6 * (1.0 - p[0].hypot(p[1]));
+    }
+    let id = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
+    let diagonals: Vec<[u32; 2]> = (1..rings)
+        .flat_map(|r| (0..sectors).map(move |s| [id(r, s), id(r + 1, s + 1)]))
+        .collect();
+    let problem = Problem::new(mesh)
+        .with_polygon_diagonals(&diagonals)
+        .unwrap();
+    let settings = FormFindSettings::default();
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("marked diagonals", &problem, &r);
+    let mesh = &problem.mesh;
+    // q_min = 0.05 p̄ / L₀, L₀ half the plan diagonal of [−1, 1]².
+    let free: Vec<usize> = (0..mesh.n_vertices())
+        .filter(|&v| !mesh.anchored[v])
+        .collect();
+    let p_bar = free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64;
+    let q_min = 0.05 * p_bar / std::f64::consts::SQRT_2;
+    let on_quad_edges = (mesh.edges.iter().enumerate())
+        .filter(|(e, edge)| !edge.is_boundary() && !problem.polygon_diagonal[*e])
+        .map(|(e, _)| r.stress.force_densities[e])
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        on_quad_edges >= q_min * (1.0 - 1e-6),
+        "{on_quad_edges} < {q_min}"
+    );
+    let not_an_edge = Problem::new(lat_long_dome(rings, sectors, false))
+        .with_polygon_diagonals(&[[id(1, 0), id(3, 0)]])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        not_an_edge.contains("is not an interior edge"),
+        "{not_an_edge}"
+    );
+}
