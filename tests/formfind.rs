@@ -689,3 +689,43 @@ fn a_stall_without_vertices_prints_no_empty_details() {
     assert!(stdout.contains("stalled after"), "{stdout}");
     assert!(!stdout.contains("details"), "{stdout}");
 }
+
+/// A latitude-longitude dome in quads, as a modeller builds one: the fan split turns each
+/// ring into quads all split along the same diagonal, which no network with every q ≥ q_min
+/// > 0 balances; q_min binds the quads' edges only, so it form-finds with the defaults.
+#[test]
+fn a_latitude_longitude_quad_dome_form_finds_with_defaults() {
+    let (rings, sectors) = (5, 24);
+    let mut obj = String::from("v 0 0 0.6\n");
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
+        }
+    }
+    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
+    for s in 0..sectors {
+        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
+    }
+    for r in 1..rings {
+        for s in 0..sectors {
+            let quad = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            obj += &format!("f {} {} {} {}\n", quad[0], quad[1], quad[2], quad[3]);
+        }
+    }
+    let dir = Scratch::new("lat-long");
+    fs::write(dir.path("dome.obj"), obj).unwrap();
+    let out = run(&dir.0, &["dome.obj", "--anchor-lowest", "1e-9"]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let od = dir.path("formfind-out");
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["settings"]["polygon_diagonals"], (rings - 1) * sectors);
+    assert_eq!(r["anchored"].as_array().unwrap().len(), sectors);
+    check_equilibrium(&od.join("dome-formfound.obj"), &od.join("report.json"));
+}

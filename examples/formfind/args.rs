@@ -67,7 +67,8 @@ Usage:
 
 Inputs:
   MESH                   .obj, .off, .stl or .ply: vertices (x, y plan; z up) and faces;
-                         polygons are split into fans
+                         polygons are split into fans, whose diagonals --qmin
+                         does not bind
   --supports S.json      anchored vertex ids, 0-based ids of MESH's own vertices (before
                          welding): {{\"anchored\": [ids]}} or [ids]
   --anchor-boundary      anchor every boundary vertex (instead of --supports)

@@ -22,6 +22,8 @@ pub struct Model {
     pub weld: Option<WeldSummary>,
     /// Plan repairs made before validation (none with `--strict`).
     pub repairs: Vec<PlanRepair>,
+    /// The mesh edges that split the file's polygons into triangles (welded ids).
+    pub diagonals: Vec<[u32; 2]>,
 }
 
 /// Plan of the embedded default: a rectangle of half-widths `HALF_X` × `HALF_Y` whose sides bow
@@ -81,6 +83,7 @@ pub fn embedded_default() -> Model {
         faces,
         weld: None,
         repairs: Vec::new(),
+        diagonals: Vec::new(),
     }
 }
 
@@ -98,14 +101,15 @@ pub struct WeldSummary {
 /// (input ids, mapped onto welded ones), of `--anchor-lowest` or every boundary vertex. A mesh
 /// whose plan is invalid but would be valid seen Y-up gets a hint to `--up y` in its error.
 pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
-    let (positions, faces) = io::read_mesh(mesh_path).map_err(|e| e.to_string())?;
+    let ((positions, faces), diagonals) =
+        io::read_mesh_with_diagonals(mesh_path).map_err(|e| e.to_string())?;
     let read = |y_up: bool| {
         let positions = if y_up {
             positions.iter().map(|&p| from_y_up(p)).collect()
         } else {
             positions.clone()
         };
-        build(mesh_path, o, positions, faces.clone())
+        build(mesh_path, o, positions, faces.clone(), &diagonals)
     };
     match read(o.y_up) {
         Err(e) if !o.y_up && is_plan_error(&e) && read(true).is_ok() => Err(format!(
@@ -143,6 +147,7 @@ fn build(
     o: &Options,
     positions: Vec<[f64; 3]>,
     faces: Vec<[u32; 3]>,
+    diagonals: &[[u32; 2]],
 ) -> voussoir::Result<Model> {
     let is_stl = io::MeshFormat::from_path(mesh_path)?.is_single_precision();
     let tolerance = o.weld.or(is_stl.then_some(io::DEFAULT_WELD_TOLERANCE));
@@ -195,6 +200,18 @@ fn build(
         )?
     };
     let mesh = Mesh::new(positions, faces.clone(), &anchored)?;
+    let welded_id = |v: u32| match &welded {
+        Some((w, _)) => w.welded_id[v as usize],
+        None => v,
+    };
+    // Welding or a plan repair's flip may have removed a diagonal: only the edges left count.
+    let diagonals = (diagonals.iter())
+        .map(|d| d.map(welded_id))
+        .filter(|&[a, b]| {
+            mesh.edge_between(a, b)
+                .is_some_and(|e| !mesh.edges[e].is_boundary())
+        })
+        .collect();
     let name = mesh_path
         .file_stem()
         .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
@@ -206,6 +223,7 @@ fn build(
         faces,
         weld: welded.map(|(_, s)| s),
         repairs,
+        diagonals,
     })
 }
 
