@@ -107,7 +107,8 @@ pub unsafe extern "C" fn vsr_mesh_read(
                 ));
             }
         }
-        let (positions, faces) = io::read_mesh(&path).map_err(|e| from_error("path", e))?;
+        let ((positions, faces), diagonals) =
+            io::read_mesh_with_diagonals(&path).map_err(|e| from_error("path", e))?;
         let ids = match &supports_path {
             Some(p) => io::read_supports(p).map_err(|e| from_error("supports_path", e))?,
             None => ids.to_vec(),
@@ -121,8 +122,19 @@ pub unsafe extern "C" fn vsr_mesh_read(
         let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
             .map_err(|e| from_error("path", e))?;
         let mesh = Mesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
+        // q_min does not bind the diagonals of the file's polygons (see
+        // `Problem::with_polygon_diagonals`); welding or a repair's flip may have removed some.
+        let diagonals: Vec<[u32; 2]> = (diagonals.iter())
+            .map(|d| d.map(|v| welded.welded_id[v as usize]))
+            .filter(|&[a, b]| {
+                (mesh.edge_between(a, b)).is_some_and(|e| !mesh.edges[e].is_boundary())
+            })
+            .collect();
+        let problem = Problem::new(mesh)
+            .with_polygon_diagonals(&diagonals)
+            .map_err(|e| from_error("path", e))?;
         let handle = Box::new(VsrMesh {
-            problem: Problem::new(mesh),
+            problem,
             welded_ids: Some(welded.welded_id),
             repairs,
         });
