@@ -118,12 +118,8 @@ pub(super) fn paper(
             break;
         }
     }
-    let mut stress = last.expect("at least one iteration");
-    if termination != Termination::Converged {
-        if let Some((p, s)) = lowest.state {
-            (positions, stress) = (p, s);
-        }
-    }
+    let last = last.expect("at least one iteration");
+    let (positions, stress) = lowest.unless_converged(&termination, positions, last);
     Ok(finish(
         problem,
         Run {
@@ -161,6 +157,19 @@ impl Lowest {
                 .is_none_or(|(_, s)| stress.eps_inf < s.eps_inf)
         {
             self.state = Some((positions.to_vec(), stress.clone()));
+        }
+    }
+
+    /// The state to answer: the lowest-ε∞ one unless the loop converged in its last state.
+    fn unless_converged(
+        self,
+        termination: &Termination,
+        positions: Vec<[f64; 3]>,
+        stress: StressResult,
+    ) -> (Vec<[f64; 3]>, StressResult) {
+        match self.state {
+            Some(lowest) if *termination != Termination::Converged => lowest,
+            _ => (positions, stress),
         }
     }
 }
