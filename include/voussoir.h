@@ -543,7 +543,8 @@ const char *vsr_status_name(uint32_t status);
 /**
  * Creates a mesh from a file: OBJ, OFF, STL (binary or ASCII) or PLY (ASCII or binary),
  * chosen by the extension of `path` (case-insensitive `.obj`, `.off`, `.stl`, `.ply`);
- * polygons are split into fans.
+ * polygons are split into fans, and q_min does not bind the diagonals that splitting adds
+ * (a quad mesh of rings split along one diagonal has no force network with q > 0 on them).
  *
  * - `path`: the mesh file, a NUL-terminated UTF-8 path.
  * - `supports_path`: a JSON file of anchored vertex ids (`{"anchored": [ids]}` or `[ids]`),

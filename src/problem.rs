@@ -17,6 +17,9 @@ pub struct Problem {
     pub horizontal_forces: Vec<[f64; 2]>,
     /// Inward normal push per free boundary vertex, used with `TauMode::Prescribed`.
     pub prescribed_tau: Vec<f64>,
+    /// Per edge: a diagonal that splits a polygon of the model into triangles, which q_min
+    /// does not bind (only q ≥ 0). Default none.
+    pub polygon_diagonal: Vec<bool>,
 }
 
 fn check_len(name: &'static str, len: usize, expected: usize, what: &str) -> Result<()> {
@@ -31,13 +34,14 @@ fn check_len(name: &'static str, len: usize, expected: usize, what: &str) -> Res
 
 impl Problem {
     pub fn new(mesh: Mesh) -> Problem {
-        let (nv, nf) = (mesh.positions.len(), mesh.faces.len());
+        let (nv, nf, ne) = (mesh.positions.len(), mesh.faces.len(), mesh.edges.len());
         Problem {
             mesh,
             face_density: vec![1.0; nf],
             extra_loads: vec![0.0; nv],
             horizontal_forces: vec![[0.0; 2]; nv],
             prescribed_tau: vec![0.0; nv],
+            polygon_diagonal: vec![false; ne],
         }
     }
 
@@ -97,6 +101,28 @@ impl Problem {
             }
         }
         self.horizontal_forces = forces;
+        Ok(self)
+    }
+
+    /// Marks the edges (vertex pairs, either order) that split the model's polygons into
+    /// triangles, as [`crate::io::read_mesh_with_diagonals`] lists them: a force network on a
+    /// polygon mesh needs no force along them, so q_min does not bind them. Such a split can
+    /// leave no network with every q ≥ q_min > 0 (rings of quads all split along the same
+    /// diagonal, as in a latitude-longitude dome). A pair that is no interior edge of the mesh
+    /// is an error naming it.
+    pub fn with_polygon_diagonals(mut self, diagonals: &[[u32; 2]]) -> Result<Problem> {
+        let mesh = &self.mesh;
+        for (k, &[a, b]) in diagonals.iter().enumerate() {
+            match mesh.edge_between(a, b) {
+                Some(e) if !mesh.edges[e].is_boundary() => self.polygon_diagonal[e] = true,
+                _ => {
+                    return Err(Error::InvalidArgument {
+                        name: "diagonals",
+                        reason: format!("pair {k} ({a}, {b}) is not an interior edge of the mesh"),
+                    })
+                }
+            }
+        }
         Ok(self)
     }
 

@@ -140,6 +140,46 @@ fn every_format_reads_form_finds_and_writes_back_every_bit() {
     }
 }
 
+/// A latitude-longitude dome in quads: each ring is split along the same diagonal, which no
+/// network with every q >= q_min > 0 balances; q_min does not bind the diagonals of a file's
+/// polygons, so it form-finds with the default settings.
+#[test]
+fn a_quad_dome_read_from_a_file_form_finds_with_defaults() {
+    let (rings, sectors) = (4, 16);
+    let mut obj = String::from("v 0 0 0.6\n");
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
+        }
+    }
+    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
+    for s in 0..sectors {
+        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
+    }
+    for r in 1..rings {
+        for s in 0..sectors {
+            let q = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+        }
+    }
+    let dir = TempDir::new("quads");
+    let file = dir.path("dome.obj");
+    fs::write(&file, obj).unwrap();
+    let rim: Vec<u32> = (0..sectors).map(|s| id(rings, s) as u32 - 1).collect();
+    let (s, mesh, _) = read(&file, None, &rim, 1e-9);
+    assert_ok(s);
+    let result = form_find(mesh);
+    let (mut termination, mut iterations) = (VsrTermination::Cancelled, 0);
+    assert_ok(unsafe { vsr_result_termination(result, &mut termination, &mut iterations) });
+    assert_eq!(termination, VsrTermination::Converged);
+    unsafe {
+        vsr_result_destroy(result);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
 #[test]
 fn stl_is_welded_and_ids_refer_to_its_own_vertices() {
     let dir = TempDir::new("stl");

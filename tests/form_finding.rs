@@ -7,8 +7,21 @@ use common::{load_model, polar_cap, MODELS};
 use voussoir::generate::{self, Domain};
 use voussoir::*;
 
-/// Independent certificate: returns ε∞ after asserting q ≥ 0 and horizontal balance.
+/// Independent certificate: returns ε∞ (below 1e-6) after asserting q ≥ 0 and horizontal
+/// balance.
 fn certify(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
+    let eps = recomputed_eps(label, problem, r);
+    assert!(
+        eps < 1e-6,
+        "{label}: independently recomputed eps_inf {eps:e} ({:?})",
+        r.termination
+    );
+    eps
+}
+
+/// ε∞ of `r` recomputed from its positions and forces, after asserting q ≥ 0 and horizontal
+/// balance.
+fn recomputed_eps(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
     let mesh = &problem.mesh;
     let x = &r.positions;
     let q = &r.stress.force_densities;
@@ -59,11 +72,6 @@ fn certify(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
             h / p_bar
         );
     }
-    assert!(
-        eps < 1e-6,
-        "{label}: independently recomputed eps_inf {eps:e} ({:?})",
-        r.termination
-    );
     eps
 }
 
@@ -313,12 +321,25 @@ fn infeasible_bounds_are_reported_not_hidden() {
     let mut settings = FormFindSettings::default();
     settings.stress.q_min = QBound::Relative(10.0);
     settings.stress.q_max = Some(QBound::Absolute(1e-6));
-    let r = form_find(&problem, &settings, None).unwrap();
-    assert!(
-        matches!(r.termination, Termination::Infeasible { .. }),
-        "{:?}",
-        r.termination
-    );
+    for method in [FormMethod::Nearest, FormMethod::Paper] {
+        settings.method = method;
+        let r = form_find(&problem, &settings, None).unwrap();
+        assert!(
+            matches!(r.termination, Termination::Infeasible { .. }),
+            "{method:?}: {:?}",
+            r.termination
+        );
+        // The answer is the input with the forces of its analysis, not an empty state.
+        let mesh = &problem.mesh;
+        assert_eq!(r.positions, mesh.positions, "{method:?}");
+        assert_eq!(r.stress.loads.len(), mesh.n_vertices(), "{method:?}");
+        assert_eq!(r.stress.residuals.len(), mesh.n_vertices(), "{method:?}");
+        assert_eq!(
+            r.stress.force_densities.len(),
+            mesh.edges.len(),
+            "{method:?}"
+        );
+    }
 }
 
 #[test]
@@ -467,4 +488,128 @@ fn dual_length_smoothing_gives_lilium_a_smoother_force_diagram() {
         );
         assert!(v1 < factor * v0, "{method:?}: dual variation {v0} -> {v1}");
     }
+}
+
+/// A hanging (concave-up) cap, the cap turned upside down: the paper's loop stalls on it,
+/// moving away from balance after its first steps. Its answer is the lowest-ε∞ state it
+/// reached, certified as such.
+#[test]
+fn a_loop_that_stalls_returns_its_lowest_residual_state() {
+    let mut mesh = generate::cap_dome(0.8, 300).unwrap();
+    mesh.positions.iter_mut().for_each(|p| p[2] = -p[2]);
+    let problem = Problem::new(mesh);
+    let mut settings = FormFindSettings::default();
+    settings.method = FormMethod::Paper;
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert!(
+        matches!(r.termination, Termination::Stalled { .. }),
+        "{:?}",
+        r.termination
+    );
+    let lowest = r.history.iter().copied().fold(f64::INFINITY, f64::min);
+    assert_eq!(r.stress.eps_inf, lowest, "history {:?}", r.history);
+    let eps = recomputed_eps("stalled hanging cap", &problem, &r);
+    assert!((eps - lowest).abs() <= 1e-6 * lowest, "{eps} vs {lowest}");
+}
+
+/// A latitude-longitude dome of `rings` × `sectors` quads, each split along the diagonal from
+/// its first corner (as a fan split of a modeller's quads does) or, with `alternate`, along
+/// alternating diagonals around each ring; the rim is anchored.
+fn lat_long_dome(rings: usize, sectors: usize, alternate: bool) -> Mesh {
+    let mut positions = vec![[0.0, 0.0, 0.6]];
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            positions.push([rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr * rr)]);
+        }
+    }
+    let id = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
+    let mut faces: Vec<[u32; 3]> = (0..sectors).map(|s| [0, id(1, s), id(1, s + 1)]).collect();
+    for r in 1..rings {
+        for s in 0..sectors {
+            let [a, b, c, d] = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            if alternate && s % 2 == 1 {
+                faces.extend([[a, b, d], [b, c, d]]);
+            } else {
+                faces.extend([[a, b, c], [a, c, d]]);
+            }
+        }
+    }
+    let rim: Vec<u32> = (0..sectors).map(|s| id(rings, s)).collect();
+    Mesh::new(positions, faces, &rim).unwrap()
+}
+
+/// Rings of quads all split along the same diagonal admit no strictly convex stress function:
+/// no network has q ≥ q_min > 0 on every edge, and the termination says so; alternating
+/// diagonals, or q_min = 0, admit one.
+#[test]
+fn twisted_rings_of_split_quads_are_named_when_infeasible() {
+    let settings = FormFindSettings::default();
+    let twisted = Problem::new(lat_long_dome(5, 24, false));
+    let r = form_find(&twisted, &settings, None).unwrap();
+    let Termination::Infeasible { constraint } = &r.termination else {
+        panic!("{:?}", r.termination);
+    };
+    assert!(
+        constraint.contains("latitude-longitude dome"),
+        "{constraint}"
+    );
+    assert!(!constraint.contains("free edge"), "{constraint}");
+    let alternating = Problem::new(lat_long_dome(5, 24, true));
+    let r = form_find(&alternating, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("alternating diagonals", &alternating, &r);
+    let mut no_q_min = settings.clone();
+    no_q_min.stress.q_min = QBound::Relative(0.0);
+    let r = form_find(&twisted, &no_q_min, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("twisted, q_min = 0", &twisted, &r);
+}
+
+/// The quads' diagonals marked as such, q_min binds the quads' edges only: the twisted
+/// latitude-longitude dome converges with the default q_min, which its quad edges carry.
+#[test]
+fn marked_polygon_diagonals_free_twisted_rings_from_q_min() {
+    let (rings, sectors) = (5, 24);
+    let mut mesh = lat_long_dome(rings, sectors, false);
+    // A cone, not the paraboloid: its straight meridians carry no load, form finding has
+    // to move it.
+    for p in mesh.positions.iter_mut() {
+        p[2] = 0.6 * (1.0 - p[0].hypot(p[1]));
+    }
+    let id = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
+    let diagonals: Vec<[u32; 2]> = (1..rings)
+        .flat_map(|r| (0..sectors).map(move |s| [id(r, s), id(r + 1, s + 1)]))
+        .collect();
+    let problem = Problem::new(mesh)
+        .with_polygon_diagonals(&diagonals)
+        .unwrap();
+    let settings = FormFindSettings::default();
+    let r = form_find(&problem, &settings, None).unwrap();
+    assert_eq!(r.termination, Termination::Converged);
+    certify("marked diagonals", &problem, &r);
+    let mesh = &problem.mesh;
+    // q_min = 0.05 p̄ / L₀, L₀ half the plan diagonal of [−1, 1]².
+    let free: Vec<usize> = (0..mesh.n_vertices())
+        .filter(|&v| !mesh.anchored[v])
+        .collect();
+    let p_bar = free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64;
+    let q_min = 0.05 * p_bar / std::f64::consts::SQRT_2;
+    let on_quad_edges = (mesh.edges.iter().enumerate())
+        .filter(|(e, edge)| !edge.is_boundary() && !problem.polygon_diagonal[*e])
+        .map(|(e, _)| r.stress.force_densities[e])
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        on_quad_edges >= q_min * (1.0 - 1e-6),
+        "{on_quad_edges} < {q_min}"
+    );
+    let not_an_edge = Problem::new(lat_long_dome(rings, sectors, false))
+        .with_polygon_diagonals(&[[id(1, 0), id(3, 0)]])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        not_an_edge.contains("is not an interior edge"),
+        "{not_an_edge}"
+    );
 }

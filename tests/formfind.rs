@@ -474,6 +474,7 @@ fn help_lists_every_option() {
         "--odt",
         "--density",
         "--load",
+        "--up",
     ] {
         assert!(text.contains(flag), "--help lacks {flag}");
     }
@@ -587,4 +588,144 @@ fn holes_option_is_honoured_and_reported() {
         affine < constant * (1.0 - 1e-3),
         "affine {affine} vs constant {constant}"
     );
+}
+
+/// A 4 × 4 grid of quads as a Y-up modeller writes it: heights along the second axis, the
+/// plan in the first and third (z = −y of the Z-up frame).
+fn y_up_grid() -> String {
+    let mut obj = String::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            let inner = (1..3).contains(&i) && (1..3).contains(&j);
+            obj += &format!("v {i} {} {}\n", if inner { 0.8 } else { 0.0 }, -j);
+        }
+    }
+    for j in 0..3 {
+        for i in 0..3 {
+            let v = |di: usize, dj: usize| (j + dj) * 4 + i + di + 1;
+            obj += &format!("f {} {} {} {}\n", v(0, 0), v(1, 0), v(1, 1), v(0, 1));
+        }
+    }
+    obj
+}
+
+#[test]
+fn a_y_up_mesh_is_refused_with_a_hint_and_read_with_up_y() {
+    rejects(
+        &[("y.obj", &y_up_grid())],
+        &["y.obj", "--anchor-boundary"],
+        "try --up y",
+    );
+    rejects(&[], &["--up", "y"], "--up y needs a MESH");
+    let dir = Scratch::new("y-up");
+    fs::write(dir.path("y.obj"), y_up_grid()).unwrap();
+    let out = run(&dir.0, &["y.obj", "--anchor-boundary", "--up", "y"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let od = dir.path("formfind-out");
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["settings"]["up"], "y");
+    assert_eq!(r["anchored"].as_array().unwrap().len(), 12);
+    // The output keeps the file's axes: the plan (x, z) as read, heights along y.
+    let input: Vec<Vec<f64>> = (y_up_grid().lines())
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split(' ').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let (output, _) = read_obj(&od.join("y-formfound.obj"));
+    for (a, b) in input.iter().zip(&output) {
+        assert_eq!((a[0], a[2]), (b[0], b[2]), "plan moved: {a:?} -> {b:?}");
+        let inner = a[1] > 0.0;
+        assert!(
+            !inner || b[1] > 0.0,
+            "an inner vertex went below its supports: {b:?}"
+        );
+        assert!(inner || b[1] == 0.0, "a support moved: {b:?}");
+    }
+    assert_eq!(input.len(), output.len());
+}
+
+#[test]
+fn infeasible_bounds_write_outputs_and_exit_3() {
+    let dir = Scratch::new("infeasible");
+    let out = run(&dir.0, &["--qmin", "10", "--qmax", "1e-6abs"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("not converged (infeasible)"), "{stderr}");
+    let r = read_json(&dir.path("formfind-out/report.json"));
+    assert_eq!(r["termination"], "infeasible");
+    assert_eq!(r["iterations"], 1);
+    let loads = numbers(&r["loads"]);
+    assert_eq!(
+        loads.len(),
+        r["mesh"]["vertices"].as_u64().unwrap() as usize
+    );
+    assert!(dir.path("formfind-out/vault-formfound.obj").is_file());
+}
+
+/// A hanging cap (concave up) stalls the paper's loop without a vertex to blame: the summary
+/// says so in its one line, without an empty list of details.
+#[test]
+fn a_stall_without_vertices_prints_no_empty_details() {
+    let dir = Scratch::new("hanging");
+    let mut cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
+    cap.positions.iter_mut().for_each(|p| p[2] = -p[2]);
+    voussoir::io::write_obj(&dir.path("hanging.obj"), &cap.positions, &cap.faces).unwrap();
+    let anchored: Vec<usize> = (0..cap.n_vertices()).filter(|&v| cap.anchored[v]).collect();
+    let supports = serde_json::json!({ "anchored": anchored }).to_string();
+    fs::write(dir.path("s.json"), supports).unwrap();
+    let out = run(
+        &dir.0,
+        &["hanging.obj", "--supports", "s.json", "--method", "paper"],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(3), "{stdout}");
+    let r = read_json(&dir.path("formfind-out/report.json"));
+    assert_eq!(r["termination"], "stalled");
+    assert_eq!(r["termination_detail"]["vertices"], serde_json::json!([]));
+    assert!(stdout.contains("stalled after"), "{stdout}");
+    assert!(!stdout.contains("details"), "{stdout}");
+}
+
+/// A latitude-longitude dome in quads, as a modeller builds one: the fan split turns each
+/// ring into quads all split along the same diagonal, which no network with every q ≥ q_min
+/// > 0 balances; q_min binds the quads' edges only, so it form-finds with the defaults.
+#[test]
+fn a_latitude_longitude_quad_dome_form_finds_with_defaults() {
+    let (rings, sectors) = (5, 24);
+    let mut obj = String::from("v 0 0 0.6\n");
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
+        }
+    }
+    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
+    for s in 0..sectors {
+        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
+    }
+    for r in 1..rings {
+        for s in 0..sectors {
+            let quad = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            obj += &format!("f {} {} {} {}\n", quad[0], quad[1], quad[2], quad[3]);
+        }
+    }
+    let dir = Scratch::new("lat-long");
+    fs::write(dir.path("dome.obj"), obj).unwrap();
+    let out = run(&dir.0, &["dome.obj", "--anchor-lowest", "1e-9"]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let od = dir.path("formfind-out");
+    let r = read_json(&od.join("report.json"));
+    assert_eq!(r["settings"]["polygon_diagonals"], (rings - 1) * sectors);
+    assert_eq!(r["anchored"].as_array().unwrap().len(), sectors);
+    check_equilibrium(&od.join("dome-formfound.obj"), &od.join("report.json"));
 }

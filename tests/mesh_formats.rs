@@ -107,3 +107,57 @@ fn stl_after_welding_keeps_vertices_in_single_precision_and_connectivity() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+/// Polygons are split into fans; the diagonals the split adds are listed, in every format that
+/// has polygons (none for STL, whose faces are triangles).
+#[test]
+fn polygon_diagonals_are_listed_for_every_polygon_format() {
+    let dir = scratch("diagonals");
+    let xy = [[0, 0], [1, 0], [2, 0], [2, 1], [1, 1], [0, 1], [1, 2]];
+    let vertices: Vec<String> = xy.iter().map(|[x, y]| format!("{x} {y} 0")).collect();
+    // A quad 0 1 4 5 and a pentagon 1 2 3 6 4.
+    let (quad, pentagon) = ([0u32, 1, 4, 5], [1u32, 2, 3, 6, 4]);
+    let list = |p: &[u32], base: u32| {
+        p.iter()
+            .map(|v| (v + base).to_string())
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let obj = format!(
+        "v {}\nf {}\nf {}\n",
+        vertices.join("\nv "),
+        list(&quad, 1),
+        list(&pentagon, 1)
+    );
+    let off = format!(
+        "OFF\n7 2 0\n{}\n4 {}\n5 {}\n",
+        vertices.join("\n"),
+        list(&quad, 0),
+        list(&pentagon, 0)
+    );
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 7\nproperty double x\nproperty double y\n\
+         property double z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n\
+         {}\n4 {}\n5 {}\n",
+        vertices.join("\n"),
+        list(&quad, 0),
+        list(&pentagon, 0)
+    );
+    let expected = vec![[0, 4], [1, 3], [1, 6]];
+    for (name, text) in [("m.obj", obj), ("m.off", off), ("m.ply", ply)] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let ((_, faces), diagonals) = io::read_mesh_with_diagonals(&path).unwrap();
+        assert_eq!(faces.len(), 5, "{name}");
+        assert_eq!(diagonals, expected, "{name}");
+    }
+    let stl = dir.join("m.stl");
+    io::write_mesh(
+        &stl,
+        &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+    )
+    .unwrap();
+    assert!(io::read_mesh_with_diagonals(&stl).unwrap().1.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}

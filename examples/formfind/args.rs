@@ -68,7 +68,8 @@ Usage:
 
 Inputs:
   MESH                   .obj, .off, .stl or .ply: vertices (x, y plan; z up) and faces;
-                         polygons are split into fans
+                         polygons are split into fans, whose diagonals --qmin
+                         does not bind
   --supports S.json      anchored vertex ids, 0-based ids of MESH's own vertices (before
                          welding): {{\"anchored\": [ids]}} or [ids]
   --anchor-boundary      anchor every boundary vertex (instead of --supports)
@@ -76,6 +77,8 @@ Inputs:
                          relative to the bounding box diagonal, or TOLabs absolute
   --weld TOL             merge vertices closer than TOL x the bounding box diagonal; the
                          mesh is then numbered in first-occurrence order     [{weld:e}]
+  --up A                 z | y: the axis that points up in MESH; y for the Y-up files
+                         most modellers export (OUT keeps MESH's axes)       [z]
   --strict               reject plan slivers (faces of almost no plan area, or slightly
                          inverted) instead of mending them by edge flips or the smallest
                          plan move of a non-anchored vertex (listed in the report)
@@ -174,6 +177,8 @@ pub struct Options {
     pub weld: Option<f64>,
     /// `--strict`: no plan repair.
     pub strict: bool,
+    /// `--up y`: MESH is Y-up (heights along its second axis).
+    pub y_up: bool,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -287,6 +292,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         anchor_lowest: None,
         weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
         strict: false,
+        y_up: false,
         out: None,
         report: None,
         pictures: None,
@@ -335,6 +341,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             }
             "--no-weld" => o.weld = None,
             "--strict" => o.strict = true,
+            "--up" => o.y_up = choice(&flag, &value()?, &[("z", false), ("y", true)])?,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
@@ -468,6 +475,9 @@ fn check(o: &Options) -> Result<(), String> {
                 "give one of --supports, --anchor-boundary and --anchor-lowest, not several".into(),
             )
         }
+    }
+    if o.y_up && o.mesh.is_none() {
+        return Err("--up y needs a MESH (the embedded vault is Z-up)".into());
     }
     if let Some(out) = &o.out {
         let format = voussoir::io::MeshFormat::from_path(out).map_err(|e| format!("--out: {e}"))?;

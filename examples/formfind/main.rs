@@ -187,12 +187,26 @@ fn formfind() -> Result<ExitCode, Failure> {
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
     let mesh = &outcome.model.mesh;
+    // Written meshes keep the input's axes.
+    let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        if o.y_up {
+            positions.iter().map(|&p| model::to_y_up(p)).collect()
+        } else {
+            positions.to_vec()
+        }
+    };
+    let positions = axes_of_input(&outcome.positions);
     staging
-        .write_mesh(&out, &outcome.positions, &outcome.model.faces, o.ascii)
+        .write_mesh(&out, &positions, &outcome.model.faces, o.ascii)
         .map_err(failed)?;
     if let (Some(solid), Some(path)) = (&solid, &solid_path) {
         staging
-            .write_mesh(path, &solid.positions, &solid.faces, o.ascii)
+            .write_mesh(
+                path,
+                &axes_of_input(&solid.positions),
+                &solid.faces,
+                o.ascii,
+            )
             .map_err(failed)?;
     }
     staging
@@ -317,7 +331,8 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.before.eps_inf
             );
             let detail = &report["termination_detail"];
-            if !detail.is_null() {
+            // A stall with no vertex to name has nothing to add to its own line.
+            if !detail.is_null() && *detail != serde_json::json!({ "vertices": [] }) {
                 say!("  details: {detail}");
             }
             say!(

@@ -22,6 +22,8 @@ pub struct Model {
     pub weld: Option<WeldSummary>,
     /// Plan repairs made before validation (none with `--strict`).
     pub repairs: Vec<PlanRepair>,
+    /// The mesh edges that split the file's polygons into triangles (welded ids).
+    pub diagonals: Vec<[u32; 2]>,
 }
 
 /// Plan of the embedded default: a rectangle of half-widths `HALF_X` × `HALF_Y` whose sides bow
@@ -81,6 +83,7 @@ pub fn embedded_default() -> Model {
         faces,
         weld: None,
         repairs: Vec::new(),
+        diagonals: Vec::new(),
     }
 }
 
@@ -93,11 +96,59 @@ pub struct WeldSummary {
     pub collapsed_faces: Vec<usize>,
 }
 
-/// Reads `mesh_path` (any format), welds it unless `--no-weld` (STL always, at the default
-/// tolerance if need be), and anchors the vertices of `--supports` (input ids, mapped onto
-/// welded ones), of `--anchor-lowest` or every boundary vertex.
-pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
-    let (positions, faces) = io::read_mesh(mesh_path)?;
+/// Reads `mesh_path` (any format), turns it Z-up for `--up y`, welds it unless `--no-weld` (STL
+/// always, at the default tolerance if need be), and anchors the vertices of `--supports`
+/// (input ids, mapped onto welded ones), of `--anchor-lowest` or every boundary vertex. A mesh
+/// whose plan is invalid but would be valid seen Y-up gets a hint to `--up y` in its error.
+pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
+    let ((positions, faces), diagonals) =
+        io::read_mesh_with_diagonals(mesh_path).map_err(|e| e.to_string())?;
+    let read = |y_up: bool| {
+        let positions = if y_up {
+            positions.iter().map(|&p| from_y_up(p)).collect()
+        } else {
+            positions.clone()
+        };
+        build(mesh_path, o, positions, faces.clone(), &diagonals)
+    };
+    match read(o.y_up) {
+        Err(e) if !o.y_up && is_plan_error(&e) && read(true).is_ok() => Err(format!(
+            "{e} (seen with y up, as most modellers export, the plan is valid: try --up y)"
+        )),
+        other => other.map_err(|e| e.to_string()),
+    }
+}
+
+/// A position of a Y-up file in the Z-up frame: a quarter turn about the x axis.
+pub fn from_y_up(p: [f64; 3]) -> [f64; 3] {
+    [p[0], -p[2], p[1]]
+}
+
+/// A Z-up position back in a Y-up file's axes (the inverse of [`from_y_up`]).
+pub fn to_y_up(p: [f64; 3]) -> [f64; 3] {
+    [p[0], p[2], -p[1]]
+}
+
+/// Whether `e` says the plan (the projection along z) is not a valid one.
+fn is_plan_error(e: &voussoir::Error) -> bool {
+    matches!(
+        e,
+        voussoir::Error::DegenerateFaces { .. }
+            | voussoir::Error::FlippedFaces { .. }
+            | voussoir::Error::OverlappingPlan { .. }
+            | voussoir::Error::OverlappingFaces { .. }
+    )
+}
+
+/// The model of `positions` and `faces` (already Z-up): welding, supports, plan repair and
+/// validation.
+fn build(
+    mesh_path: &Path,
+    o: &Options,
+    positions: Vec<[f64; 3]>,
+    faces: Vec<[u32; 3]>,
+    diagonals: &[[u32; 2]],
+) -> voussoir::Result<Model> {
     let is_stl = io::MeshFormat::from_path(mesh_path)?.is_single_precision();
     let tolerance = o.weld.or(is_stl.then_some(io::DEFAULT_WELD_TOLERANCE));
     let (positions, faces, welded) = match tolerance {
@@ -149,6 +200,12 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
         )?
     };
     let mesh = Mesh::new(positions, faces.clone(), &anchored)?;
+    let welded_id = |v: u32| match &welded {
+        Some((w, _)) => w.welded_id[v as usize],
+        None => v,
+    };
+    // Welding or a plan repair's flip may have removed a diagonal: only the edges left count.
+    let diagonals = mesh.interior_edges_among(diagonals.iter().map(|d| d.map(welded_id)));
     let name = mesh_path
         .file_stem()
         .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
@@ -160,6 +217,7 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> voussoir::Result<Model> {
         faces,
         weld: welded.map(|(_, s)| s),
         repairs,
+        diagonals,
     })
 }
 

@@ -94,6 +94,8 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
         "supports": outcome.model.supports,
         "weld": weld(outcome),
         "strict": o.strict,
+        "up": if o.y_up { "y" } else { "z" },
+        "polygon_diagonals": outcome.model.diagonals.len(),
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),
         "qp_solver": name_of(&QP_SOLVERS, st.solver),

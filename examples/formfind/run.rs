@@ -82,7 +82,9 @@ pub fn mean_load(model: &Model, loads: &[f64]) -> f64 {
 
 pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
     let density = vec![o.density; model.mesh.n_faces()];
-    let problem = Problem::new(model.mesh.clone()).with_face_density(density)?;
+    let problem = Problem::new(model.mesh.clone())
+        .with_face_density(density)?
+        .with_polygon_diagonals(&model.diagonals)?;
     let settings = &o.settings;
     let before = analyse(&problem, &settings.stress)?;
     let mut outcome = if o.stress_only {

@@ -4,7 +4,7 @@ use crate::errors::{from_error, invalid, VoussoirError};
 use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use voussoir::io::{read_mesh, read_supports, weld};
+use voussoir::io::{read_mesh_with_diagonals, read_supports, weld};
 use voussoir::{repair_plan, PlanRepair};
 use voussoir::{Mesh as RustMesh, Problem};
 
@@ -230,7 +230,8 @@ impl Mesh {
         }
         let weld_tolerance = tolerance("weld_tolerance", weld_tolerance)?;
         let repair_tolerance = tolerance("repair_tolerance", repair_tolerance)?;
-        let (positions, faces) = read_mesh(&path).map_err(|e| from_error("path", e))?;
+        let ((positions, faces), diagonals) =
+            read_mesh_with_diagonals(&path).map_err(|e| from_error("path", e))?;
         let ids = match &supports {
             Some(p) => read_supports(p).map_err(|e| from_error("supports", e))?,
             None => given,
@@ -243,8 +244,15 @@ impl Mesh {
         let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
             .map_err(|e| from_error("path", e))?;
         let mesh = RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
+        // q_min does not bind the file's polygon diagonals, as in `vsr_mesh_read`.
+        let diagonals = mesh.interior_edges_among(
+            (diagonals.iter()).map(|d| d.map(|v| welded.welded_id[v as usize])),
+        );
+        let problem = Problem::new(mesh)
+            .with_polygon_diagonals(&diagonals)
+            .map_err(|e| from_error("path", e))?;
         let problem = with_loads(
-            Problem::new(mesh),
+            problem,
             face_density,
             extra_loads,
             horizontal_forces,

@@ -30,7 +30,8 @@ pub(super) unsafe fn path_arg(name: &str, ptr: *const c_char) -> CResult<PathBuf
 
 /// Creates a mesh from a file: OBJ, OFF, STL (binary or ASCII) or PLY (ASCII or binary),
 /// chosen by the extension of `path` (case-insensitive `.obj`, `.off`, `.stl`, `.ply`);
-/// polygons are split into fans.
+/// polygons are split into fans, and q_min does not bind the diagonals that splitting adds
+/// (a quad mesh of rings split along one diagonal has no force network with q > 0 on them).
 ///
 /// - `path`: the mesh file, a NUL-terminated UTF-8 path.
 /// - `supports_path`: a JSON file of anchored vertex ids (`{"anchored": [ids]}` or `[ids]`),
@@ -107,7 +108,8 @@ pub unsafe extern "C" fn vsr_mesh_read(
                 ));
             }
         }
-        let (positions, faces) = io::read_mesh(&path).map_err(|e| from_error("path", e))?;
+        let ((positions, faces), diagonals) =
+            io::read_mesh_with_diagonals(&path).map_err(|e| from_error("path", e))?;
         let ids = match &supports_path {
             Some(p) => io::read_supports(p).map_err(|e| from_error("supports_path", e))?,
             None => ids.to_vec(),
@@ -121,8 +123,16 @@ pub unsafe extern "C" fn vsr_mesh_read(
         let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
             .map_err(|e| from_error("path", e))?;
         let mesh = Mesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
+        // q_min does not bind the diagonals of the file's polygons (see
+        // `Problem::with_polygon_diagonals`); welding or a repair's flip may have removed some.
+        let diagonals = mesh.interior_edges_among(
+            (diagonals.iter()).map(|d| d.map(|v| welded.welded_id[v as usize])),
+        );
+        let problem = Problem::new(mesh)
+            .with_polygon_diagonals(&diagonals)
+            .map_err(|e| from_error("path", e))?;
         let handle = Box::new(VsrMesh {
-            problem: Problem::new(mesh),
+            problem,
             welded_ids: Some(welded.welded_id),
             repairs,
         });

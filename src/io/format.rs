@@ -3,7 +3,7 @@
 use std::fs;
 use std::path::Path;
 
-use super::{io_error, off, ply, read_obj, stl, threemf, write_obj, RawMesh};
+use super::{io_error, obj, off, ply, stl, threemf, write_obj, RawMesh};
 use crate::{Error, Result};
 
 /// A mesh file format. [`MeshFormat::from_path`] picks it from the extension
@@ -84,9 +84,15 @@ impl MeshFormat {
 /// truncated files, garbage, counts that disagree with the content, indices out of range,
 /// NaN or infinite coordinates.
 pub fn read_mesh(path: &Path) -> Result<RawMesh> {
+    read_mesh_with_diagonals(path).map(|(mesh, _)| mesh)
+}
+
+/// [`read_mesh`], plus the diagonals that split the file's polygons into triangles, as vertex
+/// pairs (none for STL): edges of the triangulation that are not edges of the model.
+pub fn read_mesh_with_diagonals(path: &Path) -> Result<(RawMesh, Vec<[u32; 2]>)> {
     let format = MeshFormat::from_path(path)?;
     match format {
-        MeshFormat::Obj => return read_obj(path),
+        MeshFormat::Obj => return obj::read_obj_split(path),
         MeshFormat::ThreeMf => {
             return Err(Error::InvalidArgument {
                 name: "path",
@@ -101,9 +107,9 @@ pub fn read_mesh(path: &Path) -> Result<RawMesh> {
     let bytes = fs::read(path).map_err(|e| io_error(path, &e))?;
     let label = path.display().to_string();
     match format {
-        MeshFormat::Off => off::parse_off(&bytes, &label),
-        MeshFormat::Stl { .. } => stl::parse_stl(&bytes, &label),
-        _ => ply::parse_ply(&bytes, &label),
+        MeshFormat::Off => off::parse_off_split(&bytes, &label),
+        MeshFormat::Stl { .. } => Ok((stl::parse_stl(&bytes, &label)?, Vec::new())),
+        _ => ply::parse_ply_split(&bytes, &label),
     }
 }
 

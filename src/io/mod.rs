@@ -32,7 +32,7 @@ use std::path::Path;
 
 use crate::{Mesh, Result};
 
-pub use format::{read_mesh, write_mesh, write_mesh_as, MeshFormat};
+pub use format::{read_mesh, read_mesh_with_diagonals, write_mesh, write_mesh_as, MeshFormat};
 pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
 pub use off::parse_off;
 pub use ply::parse_ply;
@@ -43,6 +43,20 @@ pub use weld::{weld, Welded, DEFAULT_WELD_TOLERANCE};
 /// Vertex positions (x, y plan; z height) and triangles (0-based vertex ids), as read from a
 /// file, before validation by [`Mesh::new`].
 pub type RawMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+/// A [`RawMesh`] and the diagonals that split its polygons (vertex pairs).
+type SplitMesh = (RawMesh, Vec<[u32; 2]>);
+
+/// Appends the fan `(p0, p[i], p[i+1])` of `polygon` to `faces` and the diagonals `(p0, p[i])`,
+/// 2 ≤ i ≤ n − 2, that the split adds to `diagonals`.
+fn split_fan(polygon: &[u32], faces: &mut Vec<[u32; 3]>, diagonals: &mut Vec<[u32; 2]>) {
+    for k in 1..polygon.len() - 1 {
+        faces.push([polygon[0], polygon[k], polygon[k + 1]]);
+        if k > 1 {
+            diagonals.push([polygon[0], polygon[k]]);
+        }
+    }
+}
 
 /// Reads an OBJ mesh and its JSON supports file, and validates them with [`Mesh::new`].
 pub fn load_model(obj: &Path, supports: &Path) -> Result<Mesh> {

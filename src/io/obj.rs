@@ -3,14 +3,19 @@
 use std::fs;
 use std::path::Path;
 
-use super::{io_error, RawMesh};
+use super::{io_error, split_fan, RawMesh};
 use crate::{Error, Result};
 
 /// Reads the vertices and faces of an OBJ file (see [`parse_obj`]). Bytes that are not
 /// UTF-8 are replaced (they can only occur in comments or malformed lines).
 pub fn read_obj(path: &Path) -> Result<RawMesh> {
+    read_obj_split(path).map(|(mesh, _)| mesh)
+}
+
+/// [`read_obj`], plus the diagonals that split its polygons.
+pub(crate) fn read_obj_split(path: &Path) -> Result<(RawMesh, Vec<[u32; 2]>)> {
     let bytes = fs::read(path).map_err(|e| io_error(path, &e))?;
-    parse_obj(
+    parse_obj_split(
         &String::from_utf8_lossy(&bytes),
         &path.display().to_string(),
     )
@@ -33,6 +38,11 @@ pub const IGNORED_KEYWORDS: [&str; 9] = ["vn", "vt", "vp", "g", "o", "s", "usemt
 /// with fewer than 3 vertices, an index that is not an integer, is 0, or refers past the last
 /// vertex of the file (or, when negative, before the first vertex).
 pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
+    parse_obj_split(text, path_label).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_obj`], plus the diagonals that split its polygons (vertex pairs).
+pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, Vec<[u32; 2]>)> {
     let err = |line: usize, reason: String| Error::Parse {
         path: path_label.to_string(),
         line,
@@ -43,6 +53,7 @@ pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
     // Faces referring to vertices not yet read: (line, largest 0-based index), checked at the end.
     let mut forward_refs: Vec<(usize, u64)> = Vec::new();
     let mut polygon: Vec<u32> = Vec::new();
+    let mut diagonals: Vec<[u32; 2]> = Vec::new();
 
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (i, raw) in text.lines().enumerate() {
@@ -82,9 +93,7 @@ pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
                 if largest >= positions.len() as u64 {
                     forward_refs.push((line, largest));
                 }
-                for k in 1..polygon.len() - 1 {
-                    faces.push([polygon[0], polygon[k], polygon[k + 1]]);
-                }
+                split_fan(&polygon, &mut faces, &mut diagonals);
             }
             Some(keyword) if IGNORED_KEYWORDS.contains(&keyword) => {}
             Some(keyword) => {
@@ -110,7 +119,7 @@ pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
             ),
         ));
     }
-    Ok((positions, faces))
+    Ok(((positions, faces), diagonals))
 }
 
 /// The 0-based vertex index of one face token (`i`, `i/t`, `i//n`, `i/t/n`), given the

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::atomic::write_atomically;
-use super::RawMesh;
+use super::{split_fan, RawMesh};
 use crate::{Error, Result};
 
 /// Parses OFF text. The keyword is `OFF` with the optional prefixes `ST` (texture
@@ -18,6 +18,11 @@ use crate::{Error, Result};
 /// fewer than 3 vertices, fewer indices than it declares or an index out of range, a file
 /// that ends before the declared vertices and faces, or content after them.
 pub fn parse_off(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
+    parse_off_split(bytes, path_label).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_off`], plus the diagonals that split its polygons (vertex pairs).
+pub(crate) fn parse_off_split(bytes: &[u8], path_label: &str) -> Result<(RawMesh, Vec<[u32; 2]>)> {
     let text = String::from_utf8_lossy(bytes);
     let mut lines = text
         .lines()
@@ -40,12 +45,13 @@ pub fn parse_off(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
         };
         positions.push(parse_vertex(content, v).map_err(|r| err(line, r))?);
     }
-    let mut faces = Vec::new();
+    let (mut faces, mut diagonals) = (Vec::new(), Vec::new());
     for f in 0..n_faces {
         let Some((line, content)) = lines.next() else {
             return Err(eof(format!("face {f} (it declares {n_faces})")));
         };
-        parse_face(content, f, n_vertices, &mut faces).map_err(|r| err(line, r))?;
+        let polygon = parse_face(content, f, n_vertices).map_err(|r| err(line, r))?;
+        split_fan(&polygon, &mut faces, &mut diagonals);
     }
     if let Some((line, _)) = lines.next() {
         return Err(err(
@@ -55,7 +61,7 @@ pub fn parse_off(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
             ),
         ));
     }
-    Ok((positions, faces))
+    Ok(((positions, faces), diagonals))
 }
 
 type Lines<'a> = dyn Iterator<Item = (usize, &'a str)> + 'a;
@@ -138,12 +144,8 @@ fn parse_vertex(content: &str, v: usize) -> std::result::Result<[f64; 3], String
     Ok(p)
 }
 
-fn parse_face(
-    content: &str,
-    f: usize,
-    n_vertices: usize,
-    faces: &mut Vec<[u32; 3]>,
-) -> std::result::Result<(), String> {
+/// The vertex ids of face `f`.
+fn parse_face(content: &str, f: usize, n_vertices: usize) -> std::result::Result<Vec<u32>, String> {
     let mut tokens = content.split_whitespace();
     let first = tokens.next().unwrap_or("");
     let n: usize = first
@@ -167,10 +169,7 @@ fn parse_face(
         }
         polygon.push(index);
     }
-    for k in 1..n - 1 {
-        faces.push([polygon[0], polygon[k], polygon[k + 1]]);
-    }
-    Ok(())
+    Ok(polygon)
 }
 
 /// Writes `OFF`, the counts, one `x y z` line per vertex (shortest round-trip decimals) and

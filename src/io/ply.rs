@@ -8,7 +8,7 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, ElementDef, Encoding, Header, Property};
 
 use super::atomic::write_atomically;
-use super::{one_line, RawMesh};
+use super::{one_line, split_fan, RawMesh, SplitMesh};
 use crate::{Error, Result};
 
 /// Parses a PLY file in any of its encodings (ASCII, binary little- or big-endian). The
@@ -22,6 +22,11 @@ use crate::{Error, Result};
 /// a bad number, a NaN or infinite coordinate, a face with fewer than 3 vertices or an index
 /// out of range, content after the declared elements.
 pub fn parse_ply(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
+    parse_ply_split(bytes, path_label).map(|(mesh, _)| mesh)
+}
+
+/// [`parse_ply`], plus the diagonals that split its polygons (vertex pairs).
+pub(crate) fn parse_ply_split(bytes: &[u8], path_label: &str) -> Result<(RawMesh, Vec<[u32; 2]>)> {
     let parse_err = |line: usize, reason: String| Error::Parse {
         path: path_label.to_string(),
         line,
@@ -111,12 +116,12 @@ impl PlyMesh {
     }
 
     /// Checks the polygons against the vertex count and splits them into fans.
-    fn finish(self, header: &Header) -> std::result::Result<RawMesh, (String, String)> {
+    fn finish(self, header: &Header) -> std::result::Result<SplitMesh, (String, String)> {
         if !header.elements.contains_key("vertex") {
             return Err(("header".into(), "no `vertex` element".into()));
         }
         let n = self.positions.len();
-        let mut faces = Vec::new();
+        let (mut faces, mut diagonals) = (Vec::new(), Vec::new());
         for (name, list) in &self.polygons {
             if list.len() < 3 {
                 return Err((
@@ -130,11 +135,10 @@ impl PlyMesh {
                     format!("refers to vertex {i}, but the file has {n} vertices"),
                 ));
             }
-            for k in 1..list.len() - 1 {
-                faces.push([list[0] as u32, list[k] as u32, list[k + 1] as u32]);
-            }
+            let polygon: Vec<u32> = list.iter().map(|&i| i as u32).collect();
+            split_fan(&polygon, &mut faces, &mut diagonals);
         }
-        Ok((self.positions, faces))
+        Ok(((self.positions, faces), diagonals))
     }
 }
 

@@ -4,6 +4,18 @@ use super::Mesh;
 use crate::geometry::Frame;
 
 impl Mesh {
+    /// The vertex pairs among `pairs` that are interior edges of this mesh: the polygon
+    /// diagonals of a file that welding or a plan repair's flip left in place (for
+    /// [`crate::Problem::with_polygon_diagonals`]).
+    pub fn interior_edges_among(&self, pairs: impl IntoIterator<Item = [u32; 2]>) -> Vec<[u32; 2]> {
+        pairs
+            .into_iter()
+            .filter(|&[a, b]| {
+                (self.edge_between(a, b)).is_some_and(|e| !self.edges[e].is_boundary())
+            })
+            .collect()
+    }
+
     /// L₀, the length unit of relative force-density bounds ([`crate::QBound::Relative`]):
     /// half the plan bounding-box diagonal of the referenced vertices at `positions`.
     pub fn plan_scale(&self, positions: &[[f64; 3]]) -> f64 {

@@ -145,7 +145,8 @@ pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 #[non_exhaustive]
 pub struct FormFindResult {
     pub termination: Termination,
-    /// Final positions (heights moved; the plan too when ODT is on).
+    /// Final positions (heights moved; the plan too when ODT is on): without convergence, those
+    /// of the lowest-ε∞ state reached.
     pub positions: Vec<[f64; 3]>,
     /// The forces the loop ended with, at `positions` (their residuals certify the result):
     /// the last stress step's, or earlier ones it kept (see `history`). Beyond 20k unknowns the
@@ -318,10 +319,26 @@ fn falls_short(new: &StressResult, coarse: bool, held: &StressResult) -> bool {
     short && held.eps_inf < new.eps_inf
 }
 
-fn infeasibility_hint(s: &StressSettings) -> String {
+/// The settings to relax when the stress constraints admit no solution, each with the mesh
+/// features that make it bind: straight free edges, and rings of quads split along one
+/// diagonal (a triangulation with no strictly convex stress function, so no network with every
+/// q ≥ q_min > 0).
+fn infeasibility_hint(mesh: &crate::mesh::Mesh, s: &StressSettings) -> String {
     let mut parts = Vec::new();
     if !matches!(s.q_min, QBound::Absolute(v) | QBound::Relative(v) if v == 0.0) {
-        parts.push("q_min (a straight free edge cannot carry q_min > 0 without τ)");
+        let free_edges = mesh
+            .edges
+            .iter()
+            .any(|e| e.is_boundary() && e.v.iter().any(|&v| !mesh.anchored[v as usize]));
+        parts.push(if free_edges {
+            "q_min (a straight free edge cannot carry q_min > 0 without τ; nor can every edge \
+             of a ring of quads all split along the same diagonal, as in a latitude-longitude \
+             dome, unless the diagonals are marked: Problem::with_polygon_diagonals)"
+        } else {
+            "q_min (not every edge of a ring of quads all split along the same diagonal, as in \
+             a latitude-longitude dome, can carry q_min > 0 unless the diagonals are marked: \
+             Problem::with_polygon_diagonals)"
+        });
     }
     if s.q_max.is_some() {
         parts.push("q_max");

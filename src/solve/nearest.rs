@@ -199,10 +199,14 @@ impl<'a, 'p> Nearest<'a, 'p> {
     fn run(&mut self) -> Result<Termination> {
         let first = self.stress_step(None)?;
         self.held = first;
-        if let Some(t) = self.after_stress_step() {
+        // The input's analysis is recorded whatever ends the loop here, so that even an
+        // infeasible or cancelled run answers forces for its positions.
+        let ended = self.after_stress_step();
+        let settled = self.record();
+        if let Some(t) = ended {
             return Ok(t);
         }
-        if self.record() {
+        if settled {
             return Ok(Termination::Converged);
         }
         self.w = match self.initial_weight() {
@@ -319,13 +323,14 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let unit = p_bar / self.l0;
         let q_min = st.q_min.physical(unit);
         let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
-        mesh.edges.iter().zip(&s.force_densities).all(|(edge, &q)| {
+        let diagonal = &self.problem.polygon_diagonal;
+        (mesh.edges.iter().zip(&s.force_densities).zip(diagonal)).all(|((edge, &q), &diagonal)| {
             let active = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
             if !active {
                 return true;
             }
             let interior = !edge.is_boundary();
-            let scoped = st.q_min_scope == EdgeScope::All || interior;
+            let scoped = (st.q_min_scope == EdgeScope::All || interior) && !diagonal;
             let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
             if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
                 let [a, b] = edge.v.map(|v| self.positions[v as usize]);
@@ -445,7 +450,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         match self.held.status {
             StressStatus::Infeasible => {
                 return Some(Termination::Infeasible {
-                    constraint: infeasibility_hint(&self.settings.stress),
+                    constraint: infeasibility_hint(&self.problem.mesh, &self.settings.stress),
                 })
             }
             StressStatus::NumericalError => {

@@ -40,6 +40,7 @@ pub(super) fn paper(
     let mut cache = StressCache::for_form_finding();
     let mut stress_steps = 0;
     let mut solvers = Vec::new();
+    let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
             let t = Instant::now();
@@ -64,6 +65,7 @@ pub(super) fn paper(
         history.push(stress.eps_inf);
         let status = stress.status;
         let eps = stress.eps_inf;
+        lowest.offer(&positions, &stress);
         last = Some(stress);
         if let Some(cb) = progress.as_mut() {
             if !cb(k, eps) {
@@ -71,7 +73,7 @@ pub(super) fn paper(
                 break;
             }
         }
-        if let Some(failed) = failure(status, settings) {
+        if let Some(failed) = failure(status, problem, settings) {
             termination = failed;
             break;
         }
@@ -108,6 +110,7 @@ pub(super) fn paper(
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
         let certified_eps = certified.eps_inf;
+        lowest.offer(&positions, &certified);
         last = Some(certified);
         if certified_eps < settings.tolerance {
             history.push(certified_eps);
@@ -115,7 +118,8 @@ pub(super) fn paper(
             break;
         }
     }
-    let stress = last.expect("at least one iteration");
+    let last = last.expect("at least one iteration");
+    let (positions, stress) = lowest.unless_converged(&termination, positions, last);
     Ok(finish(
         problem,
         Run {
@@ -130,6 +134,44 @@ pub(super) fn paper(
         },
         start,
     ))
+}
+
+/// The lowest-ε∞ state reached (heights with the forces certified there), the answer of a loop
+/// that ends without converging: later steps of a stalled loop may have moved further from
+/// balance.
+#[derive(Default)]
+struct Lowest {
+    state: Option<(Vec<[f64; 3]>, StressResult)>,
+}
+
+impl Lowest {
+    fn offer(&mut self, positions: &[[f64; 3]], stress: &StressResult) {
+        let usable = !matches!(
+            stress.status,
+            StressStatus::Infeasible | StressStatus::NumericalError
+        );
+        if usable
+            && self
+                .state
+                .as_ref()
+                .is_none_or(|(_, s)| stress.eps_inf < s.eps_inf)
+        {
+            self.state = Some((positions.to_vec(), stress.clone()));
+        }
+    }
+
+    /// The state to answer: the lowest-ε∞ one unless the loop converged in its last state.
+    fn unless_converged(
+        self,
+        termination: &Termination,
+        positions: Vec<[f64; 3]>,
+        stress: StressResult,
+    ) -> (Vec<[f64; 3]>, StressResult) {
+        match self.state {
+            Some(lowest) if *termination != Termination::Converged => lowest,
+            _ => (positions, stress),
+        }
+    }
 }
 
 /// The proximal term towards the previous step's forces, when that step was solved.
@@ -176,10 +218,14 @@ fn keep_better(
 }
 
 /// The termination for a stress step that failed, if it did.
-fn failure(status: StressStatus, settings: &FormFindSettings) -> Option<Termination> {
+fn failure(
+    status: StressStatus,
+    problem: &Problem,
+    settings: &FormFindSettings,
+) -> Option<Termination> {
     match status {
         StressStatus::Infeasible => Some(Termination::Infeasible {
-            constraint: infeasibility_hint(&settings.stress),
+            constraint: infeasibility_hint(&problem.mesh, &settings.stress),
         }),
         StressStatus::NumericalError => Some(Termination::NumericalError {
             what: "stress QP failed".into(),

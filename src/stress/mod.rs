@@ -451,7 +451,7 @@ impl FramedStep {
         let normal = boundary_normals(mesh, &plan.u);
         let (external, tau_normal) = horizontal_terms(problem, settings, &normal, p_bar);
         let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
-        let bounds = edge_bounds(mesh, &plan, settings, unit);
+        let bounds = edge_bounds(problem, &plan, settings, unit);
         let smoothing_pairs = if settings.dual_length_smoothing > 0.0 {
             face_edge_pairs(mesh)
         } else {
@@ -510,14 +510,15 @@ fn horizontal_terms(
 }
 
 /// Per edge, None for an edge without force (boundary, both ends anchored), else its bounds
-/// (lower, upper) on q in frame units: q_min on the edges of its scope, q_max, and the dual
-/// length bounds of interior edges.
+/// (lower, upper) on q in frame units: q_min on the edges of its scope but polygon diagonals,
+/// q_max, and the dual length bounds of interior edges.
 fn edge_bounds(
-    mesh: &Mesh,
+    problem: &Problem,
     plan: &Plan,
     settings: &StressSettings,
     unit: f64,
 ) -> Vec<Option<(f64, f64)>> {
+    let mesh = &problem.mesh;
     let active = |e: usize| {
         let edge = &mesh.edges[e];
         !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize])
@@ -530,7 +531,8 @@ fn edge_bounds(
         .map(|e| {
             active(e).then(|| {
                 let interior = !mesh.edges[e].is_boundary();
-                let scoped = settings.q_min_scope == EdgeScope::All || interior;
+                let scoped = (settings.q_min_scope == EdgeScope::All || interior)
+                    && !problem.polygon_diagonal[e];
                 let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
                 // Dual length d* = q l is p̄ q' l' in frame units: bounds on it are per-edge q bounds.
                 if let (Some((d_lo, d_hi)), true) = (settings.dual_length_bounds, interior) {

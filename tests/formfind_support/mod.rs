@@ -228,8 +228,10 @@ pub fn check_equilibrium(obj: &Path, report_path: &Path) -> f64 {
         "edges do not match the faces of OUT.obj"
     );
 
+    // An edge whose bound is q ≥ 0 comes out of the Airy function at 0 up to round-off.
+    let q_max = q.iter().fold(0.0f64, |a, &b| a.max(b));
     for (e, &qe) in q.iter().enumerate() {
-        assert!(qe >= 0.0, "edge {e}: q = {qe} < 0 (tension)");
+        assert!(qe >= -1e-9 * q_max, "edge {e}: q = {qe} < 0 (tension)");
     }
 
     let mut res = vec![0.0; n];
