@@ -194,19 +194,13 @@ TEST_F(Formfind, CApiSolidFromDensityPassesTheSameChecks) {
     for (const auto &[name, thickness] : manifest()) {
         const std::string off = formfind_dir() + "/" + name + ".off";
         const std::string supports = vsrt::models_dir() + "/" + name + ".json";
-        VsrMesh *raw = nullptr;
-        vsrt::check(vsr_mesh_read(off.c_str(), supports.c_str(), nullptr, 0, 1e-9, 0.0, nullptr,
-                                  &raw),
-                    "vsr_mesh_read");
-        vsrt::MeshPtr mesh(raw);
-        vsrt::SettingsPtr settings = vsrt::make_settings();
-        VsrResult *result_raw = nullptr;
-        vsrt::check(vsr_analyse(mesh.get(), settings.get(), &result_raw), "vsr_analyse");
-        vsrt::ResultPtr result(result_raw);
+        voussoir::ReadOptions options;
+        options.supports_path = supports;
+        options.repair_tolerance = 0.0;
+        const voussoir::Mesh mesh = voussoir::Mesh::read(off, options);
+        const voussoir::Result result = voussoir::analyse(mesh);
         const std::string out = std::string(VSR_OUTPUT_DIR) + "/" + name + "-capi-solid.off";
-        vsrt::check(vsr_result_write_solid_from_density(result.get(), mesh.get(),
-                                                        1.0 / thickness, out.c_str()),
-                    "vsr_result_write_solid_from_density");
+        result.write_solid_from_density(mesh, 1.0 / thickness, out);
         check_solid(out, read_cgal(off), thickness);
     }
 }

@@ -511,6 +511,24 @@ class Result {
     [[nodiscard]] VsrStatus try_write(const Mesh &mesh, const std::string &path) const noexcept {
         return vsr_result_write(get(), mesh.get(), path.c_str());
     }
+    /// Writes the result thickened into a printable solid (vsr_result_write_solid). Throws Error.
+    void write_solid(const Mesh &mesh, double thickness, const std::string &path) const {
+        check(try_write_solid(mesh, thickness, path));
+    }
+    [[nodiscard]] VsrStatus try_write_solid(const Mesh &mesh, double thickness,
+                                            const std::string &path) const noexcept {
+        return vsr_result_write_solid(get(), mesh.get(), thickness, path.c_str());
+    }
+    /// The same with the thickness per face from its density: density / `unit_weight`
+    /// (vsr_result_write_solid_from_density). Throws Error.
+    void write_solid_from_density(const Mesh &mesh, double unit_weight,
+                                  const std::string &path) const {
+        check(try_write_solid_from_density(mesh, unit_weight, path));
+    }
+    [[nodiscard]] VsrStatus try_write_solid_from_density(const Mesh &mesh, double unit_weight,
+                                                         const std::string &path) const noexcept {
+        return vsr_result_write_solid_from_density(get(), mesh.get(), unit_weight, path.c_str());
+    }
 
   private:
     detail::Owner<VsrResult, vsr_result_destroy> owner_;
