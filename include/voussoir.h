@@ -1067,7 +1067,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
  * | formulation | `VSR_FORMULATION_REDUCED` |
  * | QP solver | `VSR_QP_SOLVER_NATIVE` |
- * | regularisation ε | 1e-10 |
+ * | regularisation ε | 1e-16 |
  * | dual edge length bounds | none |
  * | schedule μ₀, β, μ_min, η, pull ν (paper method) | 1, 0.25, 1e-9, 1e-3, 0 |
  * | proximal weight | 1e-6 |
@@ -1227,7 +1227,7 @@ VsrStatus vsr_settings_set_qp_solver(struct VsrSettings *settings, uint32_t solv
 
 /**
  * Sets ε of the regulariser ε Σ (l_e q_e)² (dimensionless, in the solver's frame) that makes
- * the force densities unique. Finite and >= 0. Default 1e-10; the solver retries with ε × 100
+ * the force densities unique. Finite and >= 0. Default 1e-16; the solver retries with ε × 100
  * (twice at most) after a numerical failure and reports the ε used.
  *
  * # Safety

@@ -52,7 +52,7 @@ pub struct VsrSettings {
 /// | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
 /// | formulation | `VSR_FORMULATION_REDUCED` |
 /// | QP solver | `VSR_QP_SOLVER_NATIVE` |
-/// | regularisation ε | 1e-10 |
+/// | regularisation ε | 1e-16 |
 /// | dual edge length bounds | none |
 /// | schedule μ₀, β, μ_min, η, pull ν (paper method) | 1, 0.25, 1e-9, 1e-3, 0 |
 /// | proximal weight | 1e-6 |
@@ -397,7 +397,7 @@ pub unsafe extern "C" fn vsr_settings_set_qp_solver(
 }
 
 /// Sets ε of the regulariser ε Σ (l_e q_e)² (dimensionless, in the solver's frame) that makes
-/// the force densities unique. Finite and >= 0. Default 1e-10; the solver retries with ε × 100
+/// the force densities unique. Finite and >= 0. Default 1e-16; the solver retries with ε × 100
 /// (twice at most) after a numerical failure and reports the ε used.
 ///
 /// # Safety
@@ -667,7 +667,7 @@ mod tests {
         assert_eq!(f.stress.load_rule, LoadRule::Barycentric);
         assert_eq!(f.stress.formulation, Formulation::Reduced);
         assert_eq!(f.stress.solver, QpSolver::Native);
-        assert_eq!(f.stress.regularisation, 1e-10);
+        assert_eq!(f.stress.regularisation, 1e-16);
         let s = f.schedule;
         assert_eq!(
             [s.mu0, s.beta, s.mu_min, s.eta, s.pull],

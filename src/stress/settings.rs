@@ -107,8 +107,10 @@ pub struct StressSettings {
     /// meeting at that face's power centre). μ > 0 trades residual in the stress step for a
     /// smoother force diagram; form finding then shapes the vault to carry it. Default 0.
     pub dual_length_smoothing: f64,
-    /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-10; when the solver
-    /// reports a numerical failure (degenerate problems: straight free edges force q = 0) the
+    /// ε of the regulariser ε Σ (l_e q_e)² (frame units) that makes q unique. Default 1e-16:
+    /// a tie-breaker whose bias on the residual stays far below the equilibrium tolerance (it
+    /// grows with the mesh's conditioning; docs/method.md §8). When the solver reports a
+    /// numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is repeated with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
     pub solver: QpSolver,
@@ -126,7 +128,7 @@ impl Default for StressSettings {
             formulation: Formulation::Reduced,
             dual_length_bounds: None,
             dual_length_smoothing: 0.0,
-            regularisation: 1e-10,
+            regularisation: 1e-16,
             solver: QpSolver::Native,
         }
     }
