@@ -217,7 +217,7 @@ def test_mesh_files(tmp_path, monkeypatch):
     )
     raises(
         "argument `path`: invalid argument `path`: good.xyz: unknown extension `.xyz`; "
-        "the mesh formats are .obj, .off, .stl and .ply",
+        "the mesh formats are .obj, .off, .stl and .ply (and .3mf, written only)",
         read,
         "good.xyz",
         anchored=A,
