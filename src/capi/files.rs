@@ -200,25 +200,9 @@ pub unsafe extern "C" fn vsr_result_write(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        let (result, mesh, path) = unsafe {
-            (
-                handle("result", result)?,
-                handle("mesh", mesh)?,
-                path_arg("path", path)?,
-            )
-        };
+        let (result, mesh, path) = unsafe { write_args(result, mesh, path)? };
         let m = &mesh.problem.mesh;
         let positions = result.positions();
-        if positions.len() != m.n_vertices() {
-            return Err(Failure::invalid(
-                "mesh",
-                format!(
-                    "has {} vertices, the result {}: they do not belong together",
-                    m.n_vertices(),
-                    positions.len()
-                ),
-            ));
-        }
         let faces: Vec<[u32; 3]> = if m.reversed {
             m.faces.iter().map(|&[a, b, c]| [a, c, b]).collect()
         } else {
@@ -234,6 +218,34 @@ pub unsafe extern "C" fn vsr_result_write(
         }
         io::write_mesh_as(&path, format, positions, &faces).map_err(|e| from_error("path", e))
     })
+}
+
+/// The checked arguments of a result writer: both handles, the path, and a mesh whose vertex
+/// count is the result's.
+///
+/// # Safety
+/// `result`, `mesh`: valid handles or NULL; `path`: NULL or a NUL-terminated string.
+pub(super) unsafe fn write_args<'a>(
+    result: *const VsrResult,
+    mesh: *const VsrMesh,
+    path: *const c_char,
+) -> CResult<(&'a VsrResult, &'a VsrMesh, PathBuf)> {
+    // SAFETY: forwarded caller's contract.
+    let (result, mesh, path) = unsafe {
+        (
+            handle("result", result)?,
+            handle("mesh", mesh)?,
+            path_arg("path", path)?,
+        )
+    };
+    let (n, m) = (mesh.problem.mesh.n_vertices(), result.positions().len());
+    if n != m {
+        return Err(Failure::invalid(
+            "mesh",
+            format!("has {n} vertices, the result {m}: they do not belong together"),
+        ));
+    }
+    Ok((result, mesh, path))
 }
 
 /// The plan edge flips `vsr_mesh_read` made, in order: #flips by 6 `uint32_t`, row-major:

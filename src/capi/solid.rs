@@ -3,8 +3,8 @@
 
 use std::ffi::c_char;
 
-use super::boundary::{boundary, from_error, handle, CResult, Failure};
-use super::files::path_arg;
+use super::boundary::{boundary, from_error, CResult};
+use super::files::write_args;
 use super::mesh::VsrMesh;
 use super::result::VsrResult;
 use super::status::VsrStatus;
@@ -21,25 +21,8 @@ unsafe fn write_solid(
     thickness: impl FnOnce(&VsrMesh) -> CResult<Thickness>,
 ) -> CResult {
     // SAFETY: forwarded caller's contract.
-    let (result, mesh, path) = unsafe {
-        (
-            handle("result", result)?,
-            handle("mesh", mesh)?,
-            path_arg("path", path)?,
-        )
-    };
-    let m = &mesh.problem.mesh;
-    let positions = result.positions();
-    if positions.len() != m.n_vertices() {
-        return Err(Failure::invalid(
-            "mesh",
-            format!(
-                "has {} vertices, the result {}: they do not belong together",
-                m.n_vertices(),
-                positions.len()
-            ),
-        ));
-    }
+    let (result, mesh, path) = unsafe { write_args(result, mesh, path)? };
+    let (m, positions) = (&mesh.problem.mesh, result.positions());
     let format = crate::io::MeshFormat::from_path(&path).map_err(|e| from_error("path", e))?;
     let solid = thicken(m, positions, &thickness(mesh)?).map_err(|e| from_error("thickness", e))?;
     crate::io::write_mesh_as(&path, format, &solid.positions, &solid.faces)
