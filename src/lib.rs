@@ -16,6 +16,7 @@
 //! ```
 #![deny(unsafe_code)]
 
+mod assess;
 pub mod capi;
 mod error;
 pub mod generate;
@@ -30,6 +31,7 @@ mod solid;
 mod solve;
 mod stress;
 
+pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;

@@ -9,6 +9,7 @@ pub mod airy;
 mod gauge;
 pub mod holes;
 mod ipm;
+pub(crate) mod linear;
 mod qp;
 pub mod settings;
 pub mod sparse;
