@@ -76,9 +76,6 @@ pub(super) struct StepInput<'a> {
     pub rho_z: f64,
     pub nu: f64,
     pub correction: Option<&'a [f64]>,
-    /// Multipliers of the residual rows from the last step: the bilinear constraints'
-    /// curvature enters the model through them (see `curvature`).
-    pub multipliers: Option<&'a [f64]>,
 }
 
 /// A step and its model's figures.
@@ -91,7 +88,7 @@ pub(super) struct Step {
     pub dt: f64,
     /// Σ (e⁺ + e⁻): the linearised ℓ1 infeasibility after the step.
     pub slack: f64,
-    /// The objective's model at the step, with the curvature term ½ dᵀ B d.
+    /// The objective's model at the step.
     pub model_objective: f64,
     /// Multipliers μ of the residual rows (|μ| ≤ ν).
     pub multipliers: Vec<f64>,
@@ -155,9 +152,6 @@ pub(super) fn solve_step(
     let (x, z) = run_clarabel(layout.n, p, &c, rows)?;
     let multipliers = z[first_residual_row..first_residual_row + model.residual.len()].to_vec();
     let mut step = read_step(model, layout, state, &x);
-    step.model_objective += input
-        .multipliers
-        .map_or(0.0, |mu| curvature_value(model, mu, &step));
     step.multipliers = multipliers;
     Some(step)
 }
@@ -196,9 +190,6 @@ fn objective(
         } else {
             -1.0
         };
-    }
-    if let Some(mu) = input.multipliers {
-        curvature(model, layout, mu, &mut p);
     }
     for k in 0..model.residual.len() {
         c[layout.e_plus + k] = input.nu;
@@ -460,52 +451,4 @@ fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
         model_objective,
         multipliers: Vec::new(),
     }
-}
-
-/// The pairs (edge e, end v with a height unknown) of the Lagrangian's Hessian
-/// Σ_k μ_k ∇²c_k, whose only entries are ∂²/∂q_e∂z_v = μ_v − μ_w (w the other end, μ = 0
-/// off the residual rows), with that entry h.
-fn hessian_pairs<'m>(
-    model: &'m Model,
-    multipliers: &'m [f64],
-) -> impl Iterator<Item = (usize, usize, f64)> + 'm {
-    let mut mu = vec![0.0; model.z_start.len()];
-    for (k, &v) in model.residual.iter().enumerate() {
-        mu[v as usize] = multipliers[k];
-    }
-    let edges = &model.problem.mesh.edges;
-    (0..edges.len())
-        .filter(|&e| model.stress.bounds[e].is_some())
-        .flat_map(move |e| {
-            let [a, b] = edges[e].v.map(|v| v as usize);
-            [(e, a, mu[a] - mu[b]), (e, b, mu[b] - mu[a])]
-        })
-        .filter(|&(_, v, h)| model.variable[v] && h != 0.0)
-}
-
-/// The convexified curvature B: each pair's block [0 h; h 0] plus [l|h| 0; 0 |h|/l], which
-/// is positive semidefinite (its determinant is 0), l the edge's plan length balancing the
-/// units of dq and dz.
-fn curvature(model: &Model, layout: &Layout, multipliers: &[f64], p: &mut Triplets) {
-    for (e, v, h) in hessian_pairs(model, multipliers) {
-        let (qc, zc) = (
-            layout.q_col[e].expect("edge with force"),
-            layout.z_col[v].expect("unknown height"),
-        );
-        let l = model.stress.plan.length[e];
-        p.push(qc, qc, l * h.abs());
-        p.push(zc, zc, h.abs() / l);
-        p.push(qc.min(zc), qc.max(zc), h);
-    }
-}
-
-/// ½ dᵀ B d along a step.
-fn curvature_value(model: &Model, multipliers: &[f64], step: &Step) -> f64 {
-    hessian_pairs(model, multipliers)
-        .map(|(e, v, h)| {
-            let (dq, dz) = (step.dq[e], step.dz[v]);
-            let l = model.stress.plan.length[e];
-            0.5 * (l * h.abs() * dq * dq + 2.0 * h * dq * dz + h.abs() / l * dz * dz)
-        })
-        .sum()
 }

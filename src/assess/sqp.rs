@@ -3,7 +3,8 @@
 //! damped by a proximal weight ρ (Levenberg–Marquardt): a step is accepted only when φ falls
 //! by at least a tenth of what its model predicts, else once retried with a second-order
 //! correction (the constraints are bilinear, so their second-order term is known exactly)
-//! and then ρ grows. ν grows while the linearised residuals cannot be met at its price.
+//! and then ρ grows. ν grows while the linearised residuals cannot be met at its price and
+//! otherwise follows the step's multipliers (ten times the largest).
 
 use super::model::{other_end, Model, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
@@ -24,6 +25,8 @@ pub(super) struct Run {
 const ACCEPT: f64 = 0.1;
 const RHO_START: f64 = 1e-2;
 const RHO_MIN: f64 = 1e-8;
+/// Only steps at most this damped say the objective has settled.
+const RHO_SETTLED: f64 = 1e-3;
 /// Beyond this ρ no step of the model lowers φ: the search is stationary.
 const RHO_MAX: f64 = 1e8;
 /// ν at most this factor above its start.
@@ -96,8 +99,6 @@ struct Search<'m, 'a> {
     /// The best certified-feasible state (lowest objective) and the least infeasible one.
     best_feasible: Option<(f64, State)>,
     least_infeasible: (f64, State),
-    /// The last accepted step's multipliers of the residual rows.
-    multipliers: Option<Vec<f64>>,
     /// Objective values after the accepted steps.
     history: Vec<f64>,
     /// Once the objective has settled: ν stays high until the residuals meet the target.
@@ -130,7 +131,6 @@ impl<'m, 'a> Search<'m, 'a> {
             feasible_below: FEASIBILITY_MARGIN * settings.tolerance,
             certified_below: 0.5 * settings.tolerance,
             best_feasible: None,
-            multipliers: None,
             history: Vec::new(),
             polishing: false,
         }
@@ -145,7 +145,6 @@ impl<'m, 'a> Search<'m, 'a> {
             rho_z: 1e8,
             nu: 1e6,
             correction: None,
-            multipliers: None,
         };
         if let Some(step) = solve_step(self.model, layout, &self.state, &input) {
             self.state = self.apply(&step);
@@ -200,7 +199,6 @@ impl<'m, 'a> Search<'m, 'a> {
                     rho_z: self.rho,
                     nu: self.nu,
                     correction: Some(&correction),
-                    multipliers: self.multipliers.as_deref(),
                 };
                 let second = solve_step(self.model, layout, &self.state, &input)?;
                 let trial = self.apply(&second);
@@ -212,10 +210,11 @@ impl<'m, 'a> Search<'m, 'a> {
         let before = self.model.objective_value(&self.state);
         self.state = next;
         self.update_penalty(&multipliers, step.slack);
-        self.multipliers = Some(multipliers);
         self.residual = max_abs(&self.model.residuals(&self.state));
         self.record();
-        self.rho = (self.rho / 3.0).max(RHO_MIN);
+        // Steps the model predicts well need less damping.
+        let ratio = (phi - self.merit(&self.state)) / predicted;
+        self.rho = (self.rho / if ratio > 0.75 { 10.0 } else { 2.0 }).max(RHO_MIN);
         let after = self.model.objective_value(&self.state);
         if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
             eprintln!(
@@ -224,7 +223,8 @@ impl<'m, 'a> Search<'m, 'a> {
             );
         }
         self.history.push(after);
-        match (self.settled(), self.residual <= self.feasible_below) {
+        let settled = self.rho <= RHO_SETTLED && self.settled();
+        match (settled, self.residual <= self.feasible_below) {
             (true, true) => Outcome::Converged,
             // The objective has settled short of equilibrium: polish with a dear penalty.
             (true, false) => {
@@ -282,7 +282,6 @@ impl<'m, 'a> Search<'m, 'a> {
                 rho_z: self.rho,
                 nu: self.nu,
                 correction: None,
-                multipliers: self.multipliers.as_deref(),
             };
             let step = solve_step(self.model, layout, &self.state, &input)?;
             let l1: f64 = self
@@ -303,7 +302,6 @@ impl<'m, 'a> Search<'m, 'a> {
             rho_z: self.rho,
             nu: self.nu,
             correction: None,
-            multipliers: self.multipliers.as_deref(),
         };
         solve_step(self.model, layout, &self.state, &input)
     }
