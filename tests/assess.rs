@@ -323,3 +323,25 @@ fn cancelling_returns_a_state_with_its_termination() {
     assert_eq!(calls, 3);
     assert_eq!(result.positions.len(), problem.mesh.positions.len());
 }
+
+/// A hemisphere far too thin: no surface fits, and the answer says how much thicker and
+/// where the thinnest certified surface leaves the envelope.
+#[test]
+fn a_vault_too_thin_says_how_much_thicker() {
+    let (p, t) = generate::polar_disk(6);
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt(),
+        |_, outer| outer,
+    )
+    .unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.005)).unwrap();
+    let settings = AssessSettings::default().with_max_iterations(60);
+    let result = run(mesh.clone(), &envelope, settings);
+    assert!(!result.feasible);
+    let (scale, at) = result.needed_scale.expect("a least thickness");
+    assert!(scale > 1.0, "scale {scale}");
+    let v = at.expect("where the thinnest surface leaves the envelope") as usize;
+    assert!(!mesh.anchored[v] || mesh.on_boundary[v]);
+}

@@ -228,6 +228,10 @@ pub struct AssessResult {
     pub worst_bound: (f64, Option<u32>),
     /// The largest residual's vertex (None when there is no non-anchored vertex).
     pub worst_residual_vertex: Option<u32>,
+    /// When an analysis other than the least thickness found no certified surface: the
+    /// least thickness scale at which one was found (above 1: the envelope is too thin), and
+    /// the vertex where that surface leaves the given envelope the most. None otherwise.
+    pub needed_scale: Option<(f64, Option<u32>)>,
     pub seconds: f64,
 }
 
@@ -247,5 +251,39 @@ pub fn assess(
     settings.validate()?;
     let model = model::Model::new(problem, envelope, settings)?;
     let run = sqp::solve(&model, settings, progress)?;
-    Ok(model.certify(run, settings))
+    let mut result = model.certify(run, settings);
+    let cancelled = result.termination == Termination::Cancelled;
+    if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {
+        result.needed_scale = needed_scale(problem, envelope, settings)?;
+    }
+    Ok(result)
+}
+
+/// The least thickness scale with a certified surface, and where that surface leaves the
+/// envelope at scale 1 the most.
+fn needed_scale(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+) -> Result<Option<(f64, Option<u32>)>> {
+    let thinnest = AssessSettings {
+        objective: Objective::MinThickness,
+        ..settings.clone()
+    };
+    let model = model::Model::new(problem, envelope, &thinnest)?;
+    let run = sqp::solve(&model, &thinnest, None)?;
+    let found = model.certify(run, &thinnest);
+    if !found.feasible {
+        return Ok(None);
+    }
+    let outside = (0..found.positions.len())
+        .filter(|&v| problem.mesh.referenced[v])
+        .map(|v| {
+            let z = found.positions[v][2];
+            ((envelope.lower[v] - z).max(z - envelope.upper[v]), v as u32)
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .filter(|(excess, _)| *excess > 0.0)
+        .map(|(_, v)| v);
+    Ok(Some((found.thickness_scale, outside)))
 }

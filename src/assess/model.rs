@@ -317,6 +317,7 @@ impl<'a> Model<'a> {
             load_factor: lambda,
             worst_bound,
             worst_residual_vertex,
+            needed_scale: None,
             seconds: run.seconds,
         }
     }
