@@ -125,7 +125,9 @@ class VOUSSOIR_OT_form_find(bpy.types.Operator):
         name="Tolerance", description="Stop when eps_inf is below", min=1e-12, default=1e-6,
         precision=8,
     )  # fmt: skip
-    max_iterations: IntProperty(name="Max iterations", min=1, default=100)  # type: ignore[valid-type]
+    max_iterations: IntProperty(  # type: ignore[valid-type]
+        name="Max iterations", min=1, default=100
+    )
     group: StringProperty(  # type: ignore[valid-type]
         name="Supports group", description="Vertex group of the supports", default="anchored"
     )

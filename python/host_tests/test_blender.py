@@ -1,5 +1,6 @@
 """The Blender add-on (examples/blender/voussoir_formfind.py) in Blender as a Python module
-(`bpy` from PyPI, installed by `.ci/hosts blender`): every shared model is built as a mesh
+(`bpy` from PyPI, installed by `.ci/hosts blender`, with the wheel in Blender's user
+scripts/modules folder as docs/python.md installs it): every shared model is built as a mesh
 object with its supports as the vertex group "anchored", the operator "Form-find selected
 mesh" runs headless, and the new object's vertices must equal the Python API's positions
 rounded to float32, bit for bit (Blender keeps coordinates in single precision, so the
@@ -10,28 +11,46 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 
 import numpy as np
 import pytest
 
-import voussoir
-from conftest import MODEL_NAMES, REPO, host_import, read_obj
+from conftest import MODEL_NAMES, REPO, host_missing, read_obj
+
+try:
+    import bpy
+
+    # What Blender does at start: put the user's scripts/modules folder on sys.path.
+    bpy.utils.refresh_script_paths()
+    import voussoir
+except ImportError as e:
+    bpy = voussoir = None
+    MISSING = f"cannot import bpy and voussoir: {e}"
 
 ADDON = REPO / "examples" / "blender" / "voussoir_formfind.py"
 
 
+def test_the_wheel_is_in_blenders_user_modules():
+    if bpy is None:
+        host_missing("blender", MISSING)
+    modules = bpy.utils.user_resource("SCRIPTS", path="modules")
+    assert os.path.commonpath([voussoir.__file__, modules]) == modules, voussoir.__file__
+
+
 @pytest.fixture(scope="module")
 def addon():
-    bpy = host_import("blender", "bpy")
+    if bpy is None:
+        host_missing("blender", MISSING)
     spec = importlib.util.spec_from_file_location("voussoir_formfind", ADDON)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     module.register()
-    yield bpy, module
+    yield module
     module.unregister()
 
 
-def vault_object(bpy, models, name, group=True):
+def vault_object(models, name, group=True):
     """An empty scene with the model as the active, selected mesh object."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     vertices, faces = read_obj(models / f"{name}.obj")
@@ -59,19 +78,17 @@ def float32_points(points):
 
 
 def test_operator_defaults_are_the_library_defaults(addon):
-    bpy, module = addon
+    module = addon
     operator = module.VOUSSOIR_OT_form_find
     defaults = voussoir.defaults()
-    props = {p: operator.__annotations__[p].keywords["default"] for p in
-             ("method", "fairness", "max_height_change", "tolerance", "max_iterations")}  # fmt: skip
-    for key, value in props.items():
-        assert defaults[key] == value, key
+    names = ("method", "fairness", "max_height_change", "tolerance", "max_iterations")
+    for key in names:
+        assert defaults[key] == operator.__annotations__[key].keywords["default"], key
 
 
 @pytest.mark.parametrize("name", MODEL_NAMES)
 def test_operator_equals_the_python_api(name, addon, models):
-    bpy, module = addon
-    source = vault_object(bpy, models, name)
+    source = vault_object(models, name)
     assert bpy.ops.object.voussoir_form_find() == {"FINISHED"}
     found = bpy.context.active_object
     assert found.name == f"{name}_selfsupporting" and found is not source
@@ -86,8 +103,8 @@ def test_operator_equals_the_python_api(name, addon, models):
 
 
 def test_operator_settings_and_lowest_vertices(addon, models):
-    bpy, module = addon
-    vault_object(bpy, models, "dome_with_doors", group=False)
+    module = addon
+    vault_object(models, "dome_with_doors", group=False)
     bpy.context.active_object.location = (10.0, -4.0, 2.0)  # world coordinates are solved
     bpy.context.view_layer.update()
     result = bpy.ops.object.voussoir_form_find(fairness=0.1, max_iterations=60, method="paper")
@@ -106,8 +123,7 @@ def test_operator_settings_and_lowest_vertices(addon, models):
 
 
 def test_operator_reports_bad_input(addon, models):
-    bpy, module = addon
-    obj = vault_object(bpy, models, "neumunster", group=False)
+    obj = vault_object(models, "neumunster", group=False)
     obj.vertex_groups.new(name="anchored")  # an empty supports group
     with pytest.raises(RuntimeError, match="Voussoir: .*anchored"):
         bpy.ops.object.voussoir_form_find()

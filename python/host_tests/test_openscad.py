@@ -21,7 +21,9 @@ from conftest import REPO, host_program, read_obj
 MODELS = ("neumunster", "four_holes", "three_pillar")
 FORMATS = ("stl", "3mf", "off")
 SECTION = REPO / "examples" / "openscad" / "vault_section.scad"
-RENDER = 'difference() {{ import("{path}", convexity = 10); translate([1e6, 1e6, 1e6]) cube(1); }}\n'
+RENDER = (
+    'difference() {{ import("{path}", convexity = 10); translate([1e6, 1e6, 1e6]) cube(1); }}\n'
+)
 
 
 def read_stl(path):
