@@ -10,6 +10,9 @@ compressive stress of a shape as it stands, `form_find` the nearest self-support
 Both take the library's settings as keyword arguments (see `Settings`; `defaults()` lists
 every default) and release the GIL while they solve. Bad input raises `VoussoirError`, a
 `ValueError`, with the library's one-line message naming the argument at fault.
+
+Interchange, imported on their own: `voussoir.rhino` (.3dm meshes; the `rhino` extra) and
+`voussoir.compas` (compas meshes, the `compas` extra; FormDiagram JSON, no extra needed).
 """
 
 from __future__ import annotations
