@@ -276,7 +276,7 @@ fn bad_envelopes_and_settings_are_named() {
             "load_pattern",
         ),
         (
-            AssessSettings::default().with_unit_weight(0.0),
+            AssessSettings::default().with_unit_weight(-1.0),
             "unit_weight",
         ),
         (
@@ -344,4 +344,32 @@ fn a_vault_too_thin_says_how_much_thicker() {
     assert!(scale > 1.0, "scale {scale}");
     let v = at.expect("where the thinnest surface leaves the envelope") as usize;
     assert!(!mesh.anchored[v] || mesh.on_boundary[v]);
+}
+
+/// Bounds and loads given per vertex (compas_tno's zlb, zub and pz): the fan's closed form.
+#[test]
+fn bounds_and_loads_given_per_vertex() {
+    let (n, r, rise) = (10, 1.5, 0.8);
+    let mesh = fan(n, r, rise);
+    let lower: Vec<f64> = mesh.positions.iter().map(|p| p[2] - 0.1).collect();
+    let upper: Vec<f64> = mesh.positions.iter().map(|p| p[2] + 0.2).collect();
+    let envelope =
+        Envelope::from_bounds(&mesh, lower.clone(), upper, &Thickness::Uniform(1.0)).unwrap();
+    let mut loads = vec![0.0; n + 1];
+    loads[0] = 3.0;
+    let problem = Problem::new(mesh.clone()).with_extra_loads(loads).unwrap();
+    let settings = AssessSettings::default()
+        .with_objective(Objective::MinThrust)
+        .with_unit_weight(0.0);
+    let result = assess(&problem, &envelope, &settings, None).unwrap();
+    check_certificate(&mesh, &envelope, &result, 1e-6);
+    assert_eq!(result.loads[0], 3.0);
+    let expected = 3.0 * r / (rise + 0.2 + 0.1);
+    assert!((result.thrust_horizontal - expected).abs() <= 1e-4 * expected);
+    let mut swapped = lower.clone();
+    swapped[4] += 1.0;
+    let text = message(
+        Envelope::from_bounds(&mesh, swapped, lower, &Thickness::Uniform(1.0)).unwrap_err(),
+    );
+    assert!(text.contains("vertex 4"), "{text}");
 }

@@ -112,6 +112,51 @@ impl Envelope {
         })
     }
 
+    /// Bounds given per vertex (as compas_tno's `zlb`, `zub`), with the thickness whose
+    /// weight loads the vault (uniform or per face, as in [`Envelope::from_thickness`]).
+    ///
+    /// Errors name the argument with the wrong length, the vertex with a bound that is not
+    /// finite or with lower above upper, and the face with a bad thickness.
+    pub fn from_bounds(
+        mesh: &Mesh,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        thickness: &Thickness,
+    ) -> Result<Envelope> {
+        let n = mesh.positions.len();
+        for (name, values) in [("lower", &lower), ("upper", &upper)] {
+            if values.len() != n {
+                return Err(Error::InvalidArgument {
+                    name,
+                    reason: format!(
+                        "has {} entries, expected one per vertex ({n})",
+                        values.len()
+                    ),
+                });
+            }
+        }
+        for v in (0..n).filter(|&v| mesh.referenced[v]) {
+            if !(lower[v].is_finite() && upper[v].is_finite() && lower[v] <= upper[v]) {
+                return Err(Error::InvalidArgument {
+                    name: "lower",
+                    reason: format!(
+                        "vertex {v} has bounds [{}, {}]: they must be finite with lower <= upper",
+                        lower[v], upper[v]
+                    ),
+                });
+            }
+        }
+        let middle = (lower.iter().zip(&upper))
+            .map(|(l, u)| 0.5 * (l + u))
+            .collect();
+        Ok(Envelope {
+            middle,
+            lower,
+            upper,
+            face_thickness: face_values(mesh, thickness)?,
+        })
+    }
+
     /// Positions of the middle surface over the mesh's plan.
     pub fn middle_positions(&self, mesh: &Mesh) -> Vec<[f64; 3]> {
         (mesh.positions.iter().zip(&self.middle))

@@ -87,7 +87,7 @@ pub struct AssessSettings {
     /// support anywhere within the envelope. Default false.
     pub fixed_supports: bool,
     /// Weight per unit volume of the masonry: a face weighs area × thickness × unit weight.
-    /// Default 1.
+    /// 0: no self-weight, the problem's extra loads alone (loads given per vertex). Default 1.
     pub unit_weight: f64,
     /// How a face's weight is shared among its corners (on the middle surface). Default
     /// barycentric.
@@ -122,10 +122,10 @@ impl AssessSettings {
     /// Checks every setting; errors name it.
     pub fn validate(&self) -> Result<()> {
         let bad = |name: &'static str, reason: String| Err(Error::InvalidArgument { name, reason });
-        if !(self.unit_weight.is_finite() && self.unit_weight > 0.0) {
+        if !(self.unit_weight.is_finite() && self.unit_weight >= 0.0) {
             return bad(
                 "unit_weight",
-                format!("{} is not a finite number > 0", self.unit_weight),
+                format!("{} is not a finite number >= 0", self.unit_weight),
             );
         }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
