@@ -41,7 +41,7 @@ impl Envelope {
         let (mut lower, mut upper, mut middle) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
             let nz = normals[v][2];
-            if !(nz > MIN_NORMAL_Z) {
+            if nz.is_nan() || nz <= MIN_NORMAL_Z {
                 return Err(Error::InvalidArgument {
                     name: "thickness",
                     reason: format!(

@@ -296,9 +296,9 @@ fn horizontal_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Row
     let u = &model.stress.plan.u;
     for &v in &model.stress.balance {
         let v = v as usize;
-        for d in 0..2 {
+        for (d, &external) in model.stress.external[v].iter().enumerate() {
             let row = rows.next();
-            let mut imbalance = model.stress.external[v][d];
+            let mut imbalance = external;
             for &e in &model.incident[v] {
                 let e = e as usize;
                 let Some(qc) = layout.q_col[e] else { continue };
@@ -378,8 +378,8 @@ fn thrust_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) 
     for &(e, a, j) in &model.support_edges {
         let (a, j) = (a as usize, j as usize);
         let col = layout.q_col[e].expect("support edges carry force");
-        for d in 0..2 {
-            rows.a.push(first_row[a] + 1 + d, col, -(u[a][d] - u[j][d]));
+        for (d, (ua, uj)) in u[a].iter().zip(&u[j]).enumerate() {
+            rows.a.push(first_row[a] + 1 + d, col, -(ua - uj));
         }
     }
 }
