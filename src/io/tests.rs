@@ -131,6 +131,16 @@ fn malformed_lines_report_their_line_number() {
         ),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2.5 3\n", 4, "`2.5`"),
         (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n",
+            4,
+            "face lists vertex 2 twice",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3 -3\n",
+            5,
+            "face lists vertex 2 twice",
+        ),
+        (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n",
             4,
             "relative vertex index -4",
