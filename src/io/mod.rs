@@ -34,6 +34,7 @@ use std::path::Path;
 
 use crate::{Mesh, Result};
 
+pub use atomic::output_target;
 pub use format::{read_mesh, read_mesh_with_diagonals, write_mesh, write_mesh_as, MeshFormat};
 pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
 pub use off::parse_off;

@@ -152,9 +152,9 @@ fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, Strin
 }
 
 /// Writes vertices and faces (1-based) as OBJ. Coordinates are written with Rust's shortest
-/// round-trip formatting, so [`read_obj`] gives back the same bits. The file is written to a
-/// temporary file in the same folder and renamed over `path`, so a failure never leaves a
-/// half-written file. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
+/// round-trip formatting, so [`read_obj`] gives back the same bits. The file is written as
+/// [`super::write_mesh_as`] writes it: all or nothing, through symbolic links, never over a
+/// device, FIFO or folder. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
 pub fn write_obj(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Result<()> {
     super::atomic::check_face_indices(positions.len(), faces)?;
     super::atomic::write_atomically(path, |out| {
