@@ -281,6 +281,25 @@ fn choice<T: Copy>(flag: &str, text: &str, choices: &[(&str, T)]) -> Result<T, S
         })
 }
 
+/// Records `flag` in `given`, refusing a second use of it (or of the other spelling of the
+/// same setting: `--weld` and `--no-weld`), which would otherwise keep the last value unseen.
+fn once(given: &mut Vec<String>, flag: &str) -> Result<(), String> {
+    let key = |f: &str| match f {
+        "--no-weld" => "--weld".to_string(),
+        other => other.to_string(),
+    };
+    match given.iter().find(|g| key(g) == key(flag)) {
+        Some(first) if first == flag => Err(format!("{flag} is given twice; give it once")),
+        Some(first) => Err(format!(
+            "{first} and {flag} are both given; give one of them"
+        )),
+        None => {
+            given.push(flag.to_string());
+            Ok(())
+        }
+    }
+}
+
 /// Parses `args` (without the program name).
 pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parsed, String> {
     use lexopt::Arg::{Long, Short, Value};
@@ -305,6 +324,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         settings: FormFindSettings::default(),
     };
     let s = &mut o.settings;
+    let mut given: Vec<String> = Vec::new();
     while let Some(arg) = parser.next().map_err(|e| e.to_string())? {
         // Owned copies: `arg` borrows the parser, which `value()` needs.
         let (flag, positional) = match arg {
@@ -317,6 +337,9 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             v.into_string()
                 .map_err(|v| format!("{flag}: `{}` is not valid text", v.to_string_lossy()))
         };
+        if positional.is_none() {
+            once(&mut given, &flag)?;
+        }
         if let Some(path) = positional {
             if o.mesh.is_some() {
                 return Err(format!(

@@ -58,6 +58,15 @@ fn failed(message: impl ToString) -> Failure {
     }
 }
 
+/// A library error in words for an option's message: an invalid argument's reason alone
+/// (its `invalid argument `name`` prefix names a library parameter, not the option).
+fn reason(e: &voussoir::Error) -> String {
+    match e {
+        voussoir::Error::InvalidArgument { reason, .. } => reason.clone(),
+        other => other.to_string(),
+    }
+}
+
 /// Errors of the solver are about the input (mesh, supports, settings) unless numerical.
 fn solver_failure(e: voussoir::Error) -> Failure {
     match e {
@@ -162,7 +171,14 @@ fn formfind() -> Result<ExitCode, Failure> {
         Some(path) => model::from_files(path, &o).map_err(bad_input)?,
     };
     let paths = Paths::of(&o, &model.name);
-    output::check(&paths.targets(o.stress_only)).map_err(bad_input)?;
+    let mut inputs: Vec<(&str, &Path)> = Vec::new();
+    if let Some(mesh) = &o.mesh {
+        inputs.push(("MESH", mesh));
+    }
+    if let Some(supports) = &o.supports {
+        inputs.push(("--supports", supports));
+    }
+    output::check(&paths.targets(o.stress_only), &inputs).map_err(bad_input)?;
     let Paths {
         out,
         report: report_path,
@@ -176,7 +192,7 @@ fn formfind() -> Result<ExitCode, Failure> {
     let solid = match o.thickness() {
         Some(thickness) => {
             let solid = voussoir::thicken(&outcome.model.mesh, &outcome.positions, &thickness)
-                .map_err(|e| bad_input(format!("--solid: {e}")))?;
+                .map_err(|e| bad_input(format!("--solid: {}", reason(&e))))?;
             report["solid"] = report::solid(&solid, &outcome, &o);
             Some(solid)
         }
@@ -280,26 +296,31 @@ fn phrase(name: &Value) -> String {
     }
 }
 
+/// `n` and the noun, singular for 1: "1 hole", "2 holes".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 fn print_summary(outcome: &run::Outcome, report: &Value) {
     let m = &outcome.model;
     let mesh = &m.mesh;
     say!(
-        "{} ({}): {} vertices, {} faces, {} edges, {} holes, {} anchored",
+        "{} ({}): {}, {}, {}, {}, {} anchored",
         m.name,
         m.source,
-        mesh.n_vertices(),
-        mesh.n_faces(),
-        mesh.n_edges(),
-        mesh.holes().count(),
+        count(mesh.n_vertices(), "vertex", "vertices"),
+        count(mesh.n_faces(), "face", "faces"),
+        count(mesh.n_edges(), "edge", "edges"),
+        count(mesh.holes().count(), "hole", "holes"),
         mesh.anchored.iter().filter(|a| **a).count()
     );
     if let Some(w) = m.weld.as_ref().filter(|w| w.merged > 0) {
         say!(
-            "welded: {} of {} input vertices merged (closer than {:.3e}), {} faces collapsed",
+            "welded: {} of {} input vertices merged (closer than {:.3e}), {} collapsed",
             w.merged,
             w.input_vertices,
             w.tolerance,
-            w.collapsed_faces.len()
+            count(w.collapsed_faces.len(), "face", "faces")
         );
     }
     if !m.repairs.is_empty() {
@@ -309,8 +330,9 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             .filter(|r| matches!(r, voussoir::PlanRepair::Flip { .. }))
             .count();
         say!(
-            "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",
-            m.repairs.len() - flips
+            "plan repaired: {}, {} (listed in the report; --strict rejects instead)",
+            count(flips, "edge flip", "edge flips"),
+            count(m.repairs.len() - flips, "vertex nudge", "vertex nudges")
         );
     }
     let s = &outcome.stress;
@@ -347,7 +369,13 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
     }
     let tied = s.tau.iter().filter(|t| **t > 0.0).count();
     if tied > 0 {
-        say!("{tied} free boundary vertices need a tie or buttress (τ > 0; see the report)");
+        say!(
+            "{} a tie or buttress (τ > 0; see the report)",
+            match tied {
+                1 => "1 free boundary vertex needs".to_string(),
+                n => format!("{n} free boundary vertices need"),
+            }
+        );
     }
     say!(
         "time: stress {:.2} s, shape {:.2} s, total {:.2} s",

@@ -115,6 +115,10 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
         Err(e) if !o.y_up && is_plan_error(&e) && read(true).is_ok() => Err(format!(
             "{e} (seen with y up, as most modellers export, the plan is valid: try --up y)"
         )),
+        Err(voussoir::Error::InvalidArgument {
+            name: "weld tolerance",
+            reason,
+        }) => Err(format!("--weld: {reason} (or --no-weld)")),
         other => other.map_err(|e| e.to_string()),
     }
 }

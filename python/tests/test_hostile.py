@@ -97,7 +97,7 @@ def test_stacked_plan_overlaps():
 
 def test_coordinates_too_large_for_double_areas():
     raises(
-        "argument `vertices`: invalid argument `positions`: vertex 1 has the coordinate 1e200: "
+        "argument `vertices`: vertex 1 has the coordinate 1e200: "
         "beyond ±1e150, areas and loads cannot be represented in double precision (express the "
         "model in larger units)",
         voussoir.Mesh,
@@ -173,7 +173,9 @@ def test_zero_density_is_nothing_to_balance():
     for solve in (voussoir.analyse, voussoir.form_find):
         with pytest.raises(voussoir.VoussoirError) as caught:
             solve(zero)
-        assert str(caught.value).startswith("argument `loads`: invalid argument `loads`: ")
+        message = str(caught.value)
+        assert message.startswith("argument `loads`: "), message
+        assert "invalid argument" not in message, message
     voussoir.analyse(mesh())  # the same input with weight solves
 
 
@@ -216,7 +218,7 @@ def test_mesh_files(tmp_path, monkeypatch):
         anchored=A,
     )
     raises(
-        "argument `path`: invalid argument `path`: good.xyz: unknown extension `.xyz`; "
+        "argument `path`: good.xyz: unknown extension `.xyz`; "
         "the mesh formats are .obj, .off, .stl and .ply (and .3mf, written only)",
         read,
         "good.xyz",

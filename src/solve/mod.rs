@@ -333,11 +333,11 @@ fn infeasibility_hint(mesh: &crate::mesh::Mesh, s: &StressSettings) -> String {
         parts.push(if free_edges {
             "q_min (a straight free edge cannot carry q_min > 0 without τ; nor can every edge \
              of a ring of quads all split along the same diagonal, as in a latitude-longitude \
-             dome, unless the diagonals are marked: Problem::with_polygon_diagonals)"
+             dome, unless the quads are read as polygons, whose diagonals q_min does not bind)"
         } else {
             "q_min (not every edge of a ring of quads all split along the same diagonal, as in \
-             a latitude-longitude dome, can carry q_min > 0 unless the diagonals are marked: \
-             Problem::with_polygon_diagonals)"
+             a latitude-longitude dome, can carry q_min > 0 unless the quads are read as \
+             polygons, whose diagonals q_min does not bind)"
         });
     }
     if s.q_max.is_some() {
