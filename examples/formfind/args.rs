@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use voussoir::io::{ReadOptions, Supports, UpAxis};
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
     TauMode,
@@ -177,8 +178,8 @@ pub struct Options {
     pub weld: Option<f64>,
     /// `--strict`: no plan repair.
     pub strict: bool,
-    /// `--up y`: MESH is Y-up (heights along its second axis).
-    pub y_up: bool,
+    /// `--up`: the axis that points up in MESH.
+    pub up: UpAxis,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -203,6 +204,29 @@ pub enum SolidThickness {
 }
 
 impl Options {
+    /// How the library reads MESH: supports, welding, plan repair and up axis.
+    pub fn read_options(&self) -> ReadOptions {
+        let supports = if let Some(path) = &self.supports {
+            Supports::File(path.clone())
+        } else if let Some((tolerance, absolute)) = self.anchor_lowest {
+            Supports::Lowest {
+                tolerance,
+                absolute,
+            }
+        } else {
+            Supports::Boundary
+        };
+        let repair = if self.strict {
+            0.0
+        } else {
+            voussoir::DEFAULT_REPAIR_TOLERANCE
+        };
+        ReadOptions::new(supports)
+            .with_weld_tolerance(self.weld)
+            .with_repair_tolerance(repair)
+            .with_up(self.up)
+    }
+
     /// The thickness of the solid, if one is asked for.
     pub fn thickness(&self) -> Option<voussoir::Thickness> {
         match self.solid.as_ref()?.0 {
@@ -292,7 +316,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         anchor_lowest: None,
         weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
         strict: false,
-        y_up: false,
+        up: UpAxis::Z,
         out: None,
         report: None,
         pictures: None,
@@ -341,7 +365,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             }
             "--no-weld" => o.weld = None,
             "--strict" => o.strict = true,
-            "--up" => o.y_up = choice(&flag, &value()?, &[("z", false), ("y", true)])?,
+            "--up" => o.up = choice(&flag, &value()?, &[("z", UpAxis::Z), ("y", UpAxis::Y)])?,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
@@ -476,7 +500,7 @@ fn check(o: &Options) -> Result<(), String> {
             )
         }
     }
-    if o.y_up && o.mesh.is_none() {
+    if o.up != UpAxis::Z && o.mesh.is_none() {
         return Err("--up y needs a MESH (the embedded vault is Z-up)".into());
     }
     if let Some(out) = &o.out {
