@@ -29,6 +29,7 @@ mod smooth;
 mod solid;
 mod solve;
 mod stress;
+mod validate;
 
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;

@@ -122,8 +122,6 @@ def settings_of(a: argparse.Namespace) -> Dict[str, Any]:
 
 def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
     """The mesh of the command line, read by the library's one read path."""
-    if a.weld < 0:
-        raise Failure(f"--weld: must be >= 0, got {a.weld}")
     lowest: Optional[Tuple[float, str]] = None
     if a.anchor_lowest is not None:
         lowest = _bound("--anchor-lowest", a.anchor_lowest)
