@@ -78,7 +78,8 @@ fn models() {
             &dir.join(format!("{name}.obj")),
             &dir.join(format!("{name}.json")),
         )
-        .unwrap();
+        .unwrap()
+        .mesh;
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in &mesh.positions {
             for d in 0..2 {

@@ -30,6 +30,7 @@ mod smooth;
 mod solid;
 mod solve;
 mod stress;
+mod validate;
 
 pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
 pub use error::{Error, Result};

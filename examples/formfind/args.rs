@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use voussoir::io::{ReadOptions, Supports, UpAxis};
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
     TauMode,
@@ -177,8 +178,8 @@ pub struct Options {
     pub weld: Option<f64>,
     /// `--strict`: no plan repair.
     pub strict: bool,
-    /// `--up y`: MESH is Y-up (heights along its second axis).
-    pub y_up: bool,
+    /// `--up`: the axis that points up in MESH.
+    pub up: UpAxis,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -203,6 +204,29 @@ pub enum SolidThickness {
 }
 
 impl Options {
+    /// How the library reads MESH: supports, welding, plan repair and up axis.
+    pub fn read_options(&self) -> ReadOptions {
+        let supports = if let Some(path) = &self.supports {
+            Supports::File(path.clone())
+        } else if let Some((tolerance, absolute)) = self.anchor_lowest {
+            Supports::Lowest {
+                tolerance,
+                absolute,
+            }
+        } else {
+            Supports::Boundary
+        };
+        let repair = if self.strict {
+            0.0
+        } else {
+            voussoir::DEFAULT_REPAIR_TOLERANCE
+        };
+        ReadOptions::new(supports)
+            .with_weld_tolerance(self.weld)
+            .with_repair_tolerance(repair)
+            .with_up(self.up)
+    }
+
     /// The thickness of the solid, if one is asked for.
     pub fn thickness(&self) -> Option<voussoir::Thickness> {
         match self.solid.as_ref()?.0 {
@@ -311,7 +335,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         anchor_lowest: None,
         weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
         strict: false,
-        y_up: false,
+        up: UpAxis::Z,
         out: None,
         report: None,
         pictures: None,
@@ -355,16 +379,10 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--supports" => o.supports = Some(value()?.into()),
             "--anchor-boundary" => o.anchor_boundary = true,
             "--anchor-lowest" => o.anchor_lowest = Some(tolerance(&flag, &value()?)?),
-            "--weld" => {
-                let t = number(&flag, &value()?)?;
-                if t < 0.0 {
-                    return Err(format!("{flag}: must be >= 0, got {t}"));
-                }
-                o.weld = Some(t);
-            }
+            "--weld" => o.weld = Some(number(&flag, &value()?)?),
             "--no-weld" => o.weld = None,
             "--strict" => o.strict = true,
-            "--up" => o.y_up = choice(&flag, &value()?, &[("z", false), ("y", true)])?,
+            "--up" => o.up = choice(&flag, &value()?, &[("z", UpAxis::Z), ("y", UpAxis::Y)])?,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
@@ -383,35 +401,16 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--ascii" => o.ascii = true,
             "--stress-only" => o.stress_only = true,
             "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
-            "--fairness" => {
-                let g = number(&flag, &value()?)?;
-                if g < 0.0 {
-                    return Err(format!("{flag}: must be >= 0, got {g}"));
-                }
-                s.fairness = g;
-            }
-            "--max-height-change" => {
-                let h = number(&flag, &value()?)?;
-                if h <= 0.0 {
-                    return Err(format!("{flag}: must be > 0, got {h}"));
-                }
-                s.max_height_change = h;
-            }
+            "--fairness" => s.fairness = number(&flag, &value()?)?,
+            "--max-height-change" => s.max_height_change = number(&flag, &value()?)?,
             "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
             "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
-            "--tol" => {
-                let t = number(&flag, &value()?)?;
-                if t <= 0.0 {
-                    return Err(format!("{flag}: must be > 0, got {t}"));
-                }
-                s.tolerance = t;
-            }
+            "--tol" => s.tolerance = number(&flag, &value()?)?,
             "--max-iter" => {
                 let text = value()?;
-                s.max_iterations = match text.parse::<usize>() {
-                    Ok(n) if n >= 1 => n,
-                    _ => return Err(format!("{flag}: expected an integer >= 1, got `{text}`")),
-                };
+                s.max_iterations = text
+                    .parse::<usize>()
+                    .map_err(|_| format!("{flag}: expected an integer >= 1, got `{text}`"))?;
             }
             "--qmin" => s.stress.q_min = bound(&flag, &value()?)?,
             "--qmin-scope" => s.stress.q_min_scope = choice(&flag, &value()?, &SCOPES)?,
@@ -425,13 +424,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
             "--holes" => s.stress.holes = choice(&flag, &value()?, &HOLES)?,
             "--dual-smoothing" => s.stress.dual_length_smoothing = number(&flag, &value()?)?,
-            "--smoothing-decay" => {
-                let d = number(&flag, &value()?)?;
-                if !(0.0..1.0).contains(&d) {
-                    return Err(format!("{flag}: must be in [0, 1), got {d}"));
-                }
-                s.smoothing_decay = d;
-            }
+            "--smoothing-decay" => s.smoothing_decay = number(&flag, &value()?)?,
             "--odt" => {
                 let text = value()?;
                 o.odt = match text.parse::<usize>() {
@@ -499,7 +492,7 @@ fn check(o: &Options) -> Result<(), String> {
             )
         }
     }
-    if o.y_up && o.mesh.is_none() {
+    if o.up != UpAxis::Z && o.mesh.is_none() {
         return Err("--up y needs a MESH (the embedded vault is Z-up)".into());
     }
     if let Some(out) = &o.out {
@@ -513,10 +506,33 @@ fn check(o: &Options) -> Result<(), String> {
         }
     }
     check_solid(o)?;
-    o.settings.stress.validate().map_err(|e| {
-        e.to_string()
-            .replace("`q_min`", "--qmin")
-            .replace("`q_max`", "--qmax")
-            .replace("`dual_length_smoothing`", "--dual-smoothing")
-    })
+    if o.mesh.is_some() {
+        o.read_options().validate().map_err(flag_error)?;
+    }
+    o.settings.validate().map_err(flag_error)
+}
+
+/// The options that set each field the library's `validate` names.
+const FLAGS: [(&str, &str); 10] = [
+    ("tolerance", "--tol"),
+    ("max_iterations", "--max-iter"),
+    ("fairness", "--fairness"),
+    ("max_height_change", "--max-height-change"),
+    ("smoothing_decay", "--smoothing-decay"),
+    ("q_min", "--qmin"),
+    ("q_max", "--qmax"),
+    ("dual_length_smoothing", "--dual-smoothing"),
+    ("weld_tolerance", "--weld"),
+    ("anchor_lowest", "--anchor-lowest"),
+];
+
+/// A settings error of the library, named by the option that set the field.
+fn flag_error(e: voussoir::Error) -> String {
+    match e {
+        voussoir::Error::InvalidArgument { name, reason } => {
+            let flag = FLAGS.iter().find(|(field, _)| *field == name);
+            format!("{}: {reason}", flag.map_or(name, |f| f.1))
+        }
+        e => e.to_string(),
+    }
 }

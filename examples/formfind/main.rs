@@ -205,11 +205,7 @@ fn formfind() -> Result<ExitCode, Failure> {
     let mesh = &outcome.model.mesh;
     // Written meshes keep the input's axes.
     let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
-        if o.y_up {
-            positions.iter().map(|&p| model::to_y_up(p)).collect()
-        } else {
-            positions.to_vec()
-        }
+        positions.iter().map(|&p| o.up.to_file(p)).collect()
     };
     let positions = axes_of_input(&outcome.positions);
     staging

@@ -94,7 +94,7 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
         "supports": outcome.model.supports,
         "weld": weld(outcome),
         "strict": o.strict,
-        "up": if o.y_up { "y" } else { "z" },
+        "up": if o.up == voussoir::io::UpAxis::Y { "y" } else { "z" },
         "polygon_diagonals": outcome.model.diagonals.len(),
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),
