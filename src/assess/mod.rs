@@ -250,13 +250,36 @@ pub fn assess(
 ) -> Result<AssessResult> {
     settings.validate()?;
     let model = model::Model::new(problem, envelope, settings)?;
-    let run = sqp::solve(&model, settings, progress)?;
+    let (from, fit_iterations) = feasible_start(problem, envelope, settings)?;
+    let mut run = sqp::solve(&model, settings, progress, from)?;
+    run.iterations += fit_iterations;
     let mut result = model.certify(run, settings);
     let cancelled = result.termination == Termination::Cancelled;
     if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {
         result.needed_scale = needed_scale(problem, envelope, settings)?;
     }
     Ok(result)
+}
+
+/// For every analysis but `fit`: the `fit` search's answer, a surface inside the envelope
+/// (when one is found), to start from, so that the objective is pursued from equilibrium
+/// rather than traded against it; and the steps it took.
+fn feasible_start(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+) -> Result<(Option<model::State>, usize)> {
+    if settings.objective == Objective::Fit {
+        return Ok((None, 0));
+    }
+    let fit = AssessSettings {
+        objective: Objective::Fit,
+        load_pattern: None,
+        ..settings.clone()
+    };
+    let model = model::Model::new(problem, envelope, &fit)?;
+    let run = sqp::solve(&model, &fit, None, None)?;
+    Ok((Some(run.state), run.iterations))
 }
 
 /// The least thickness scale with a certified surface, and where that surface leaves the
@@ -271,7 +294,8 @@ fn needed_scale(
         ..settings.clone()
     };
     let model = model::Model::new(problem, envelope, &thinnest)?;
-    let run = sqp::solve(&model, &thinnest, None)?;
+    let (from, _) = feasible_start(problem, envelope, &thinnest)?;
+    let run = sqp::solve(&model, &thinnest, None, from)?;
     let found = model.certify(run, &thinnest);
     if !found.feasible {
         return Ok(None);

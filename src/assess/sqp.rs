@@ -36,15 +36,21 @@ const POLISH_STEPS: usize = 30;
 /// The search holds the residuals to this fraction of the tolerance.
 const FEASIBILITY_MARGIN: f64 = 0.1;
 
+/// Runs the search from `from` (a state of a search on the same mesh and supports, its
+/// scalar reset), or from the middle surface with its best stress.
 pub(super) fn solve(
     model: &Model,
     settings: &AssessSettings,
     mut progress: Option<&mut Progress>,
+    from: Option<State>,
 ) -> Result<Run> {
     let start = Instant::now();
     let layout = Layout::new(model);
     let mut search = Search::new(model, settings);
-    search.start_with_stress(&layout);
+    match from {
+        Some(state) => search.restart_from(state),
+        None => search.start_with_stress(&layout),
+    }
     let mut termination = Termination::MaxIterations;
     let mut iterations = 0;
     while iterations < settings.max_iterations {
@@ -151,6 +157,16 @@ impl<'m, 'a> Search<'m, 'a> {
             self.residual = max_abs(&self.model.residuals(&self.state));
             self.record();
         }
+    }
+
+    fn restart_from(&mut self, state: State) {
+        self.state = State {
+            t: self.state.t,
+            ..state
+        };
+        self.residual = max_abs(&self.model.residuals(&self.state));
+        self.least_infeasible = (self.residual, self.state.clone());
+        self.record();
     }
 
     /// Brings the last state into equilibrium at a dear penalty, at most `POLISH_STEPS`
