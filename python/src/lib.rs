@@ -15,6 +15,10 @@ use pyo3::prelude::*;
 
 #[pymodule]
 fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // numpy's C API is looked up on first use, by importing numpy from Rust. Done there (in
+    // the first `analyse`, say), a Ctrl-C pending from the solve interrupts that import and
+    // rust-numpy panics (a PanicException, not a KeyboardInterrupt): look it up now.
+    let _ = numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add("VoussoirError", m.py().get_type::<errors::VoussoirError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<mesh::Mesh>()?;

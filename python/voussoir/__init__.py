@@ -253,9 +253,13 @@ class Mesh:
         _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
 
     def __repr__(self) -> str:
+        def count(n: int, one: str, many: str) -> str:
+            return f"{n} {one if n == 1 else many}"
+
         return (
-            f"Mesh({len(self.vertices)} vertices, {len(self.faces)} faces, "
-            f"{len(self.anchored)} anchored, {self.n_holes} holes)"
+            f"Mesh({count(len(self.vertices), 'vertex', 'vertices')}, "
+            f"{count(len(self.faces), 'face', 'faces')}, {len(self.anchored)} anchored, "
+            f"{count(self.n_holes, 'hole', 'holes')})"
         )
 
 

@@ -12,6 +12,7 @@ import argparse
 import json
 import math
 import os
+import stat
 import sys
 import tempfile
 from pathlib import Path
@@ -160,9 +161,37 @@ def report(mesh: voussoir.Mesh, result: voussoir.StressResult, settings: Dict[st
     return fields
 
 
+def _file_kind(mode: int) -> str:
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "a special file"
+
+
+def _output_target(option: str, path: Path, inputs: Sequence[Tuple[str, Path]]) -> Path:
+    """The file an output replaces (through symbolic links, as the library writes), checked:
+    a regular file or none yet, and none of `inputs` (option, path)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        mode = None
+    if mode is not None and not stat.S_ISREG(mode):
+        raise Failure(f"{option}: {path}: is {_file_kind(mode)}, not a regular file: outputs "
+                      "replace regular files only")
+    target = Path(os.path.realpath(path))
+    for name, given in inputs:
+        if mode is not None and os.path.exists(given) and os.path.samefile(target, given):
+            raise Failure(f"{option} {path} names the input file of {name}: writing it would "
+                          "destroy the input; give the output another path")
+    return target
+
+
 def _write_all(files: Sequence[Tuple[Path, Any]]) -> None:
     """Writes every (path, writer) beside its target under a temporary name, then renames
-    them all: on any failure no target is touched."""
+    them all: on any failure no target is touched. Targets are the files symbolic links name
+    (see `_output_target`)."""
     staged: List[Tuple[Path, str]] = []
     try:
         for target, write in files:
@@ -189,6 +218,11 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise Failure(f"--out: {out}: unknown mesh format (use .obj, .off, .stl or .ply)")
     if a.density <= 0:
         raise Failure(f"--density: must be > 0, got {a.density}")
+    inputs = [("MESH", a.mesh)] + ([("--supports", Path(a.supports))] if a.supports else [])
+    out_target = _output_target("--out", out, inputs)
+    report_target = _output_target("--report", report_path, inputs)
+    if out_target == report_target:
+        raise Failure(f"--out and --report name the same file {out}; give each its own path")
     try:
         mesh = read_model(a, a.density)
         if a.stress_only:
@@ -211,7 +245,8 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         Path(path).write_text(text)
 
     try:
-        _write_all([(out, lambda p: mesh.write(p, result.positions)), (report_path, write_report)])
+        _write_all([(out_target, lambda p: mesh.write(p, result.positions)),
+                    (report_target, write_report)])
     except (OSError, voussoir.VoussoirError) as e:
         raise Failure(str(e), 1) from None
     print(f"{name}: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, {len(mesh.anchored)} anchored")
