@@ -94,6 +94,8 @@ pub struct WeldSummary {
     pub relative_tolerance: f64,
     pub tolerance: f64,
     pub collapsed_faces: Vec<usize>,
+    /// The welded vertex of each input vertex.
+    pub welded_id: Vec<u32>,
 }
 
 /// Reads `mesh_path` (any format), turns it Z-up for `--up y`, welds it unless `--no-weld` (STL
@@ -160,6 +162,7 @@ fn build(
                 relative_tolerance: t,
                 tolerance: w.tolerance,
                 collapsed_faces: w.collapsed_faces.clone(),
+                welded_id: w.welded_id.clone(),
             };
             (w.positions.clone(), w.faces.clone(), Some((w, summary)))
         }
