@@ -91,9 +91,11 @@ fn section(text: &str) -> Result<Section, String> {
     let axis = match axis.trim() {
         "x" => 0,
         "y" => 1,
-        _ => return Err(format!(
+        _ => {
+            return Err(format!(
             "--section: expected x, y, x=VALUE or y=VALUE (the vertical plane drawn), got `{text}`"
-        )),
+        ))
+        }
     };
     let at = match at {
         None => None,

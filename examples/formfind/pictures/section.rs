@@ -66,8 +66,12 @@ pub fn check(mesh: &Mesh, section: Section) -> Result<(), String> {
 }
 
 /// The segment the plane `p[axis] = at` cuts from each face it crosses, in face order.
+/// Crossings closer than 1e-9 of the plan's extent are one (the plane through a vertex
+/// crosses its two edges there).
 fn cut(mesh: &Mesh, axis: usize, at: f64) -> Vec<[Station; 2]> {
     let along = 1 - axis;
+    let (lo, hi) = plan_box(mesh, &mesh.positions);
+    let tolerance = 1e-9 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let mut segments = Vec::new();
     for f in &mesh.faces {
         let v = f.map(|v| v as usize);
@@ -84,7 +88,7 @@ fn cut(mesh: &Mesh, axis: usize, at: f64) -> Vec<[Station; 2]> {
             };
             let (a, b) = (v[i], v[j]);
             let s = (1.0 - t) * mesh.positions[a][along] + t * mesh.positions[b][along];
-            if points.iter().all(|p| p.s != s) {
+            if points.iter().all(|p| (p.s - s).abs() > tolerance) {
                 points.push(Station { s, a, b, t });
             }
         }
@@ -228,9 +232,12 @@ pub fn section(a: &Assessed, section: Section) -> Document {
     let view = &views[0];
     let along = ["y", "x"][section.axis];
     let verdict = if r.feasible {
-        "a thrust surface fits"
+        "a thrust surface fits".to_string()
     } else {
-        "no thrust surface found inside the envelope"
+        format!(
+            "no thrust surface found inside the envelope (ε∞ = {:.2e})",
+            r.eps_inf
+        )
     };
     let mut doc = page(
         WIDTH,
