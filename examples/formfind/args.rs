@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::assess::args::AssessOptions;
 use voussoir::io::{ReadOptions, Supports, UpAxis};
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
@@ -99,7 +100,12 @@ are replaced only when every output is written; two outputs may not share a path
                          and the form-found shape side by side, seen from
                          azimuth −60° and 30° above the horizon, shaded, the
                          faces coloured by height change; about 70 bytes per
-                         face and view (14 MB for 100k faces)
+                         face and view (14 MB for 100k faces). With --assess:
+                         plan_forces, section.svg (a vertical section: intrados,
+                         extrados, the thrust surface and the supports) and
+                         shape_3d.svg (the middle surface; the thrust surface,
+                         coloured by where it lies between intrados and
+                         extrados, under the translucent extrados)
   --solid T OUT          also a printable solid: the result thickened by T (half above,
                          half below, along vertex normals), closed by walls along every
                          boundary; OUT is .stl, .3mf (read as millimetres), .off, .obj or
@@ -111,6 +117,30 @@ are replaced only when every output is written; two outputs may not share a path
   --ascii                write STL and PLY outputs as ASCII text, not binary
   Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
   and NAME-supports.json, to try other options on.
+
+Assessment (instead of form finding; MESH is the masonry's middle surface):
+  --assess A             fit | min-thickness | min-thrust | max-thrust | max-load: find a
+                         compression-only thrust surface in equilibrium with the masonry's
+                         self-weight between intrados and extrados, over MESH's plan (by
+                         Heyman's safe theorem the vault then stands): fit, the one nearest
+                         the middle surface; min-thickness, the least uniform scale s of the
+                         thickness that still holds one (safety factor 1/s); min-thrust and
+                         max-thrust, the least and greatest horizontal thrust at the
+                         supports; max-load, the largest factor on --load-pattern. OUT is
+                         the thrust surface; the report's \"assessment\" holds the figures
+  --thickness T          the masonry's thickness along MESH's normals, half above, half below
+                         (read vertically as T / (2 n_z)); or `density`: --density / W
+  --intrados A           instead of --thickness: the intrados and the extrados as meshes
+  --extrados B           (.obj, .off, .stl, .ply), sampled on the vertical through each vertex
+  --unit-weight W        weight per unit volume: self-weight = area x thickness x W      [1]
+  --fixed-supports       keep the supports at MESH's heights (by default the thrust meets
+                         each support anywhere within the envelope)
+  --load-pattern L.json  max-load: a downward load per vertex of MESH (ids before welding;
+                         loads of merged vertices add): {{\"loads\": [..]}}, [..] or
+                         {{\"loads\": {{\"ID\": load, ..}}}}
+  --section S            the section picture's vertical plane: y (through the plan's centre,
+                         along x), x, y=VALUE or x=VALUE                                  [y]
+  --tol, --max-iter, --qmin and --load apply too [1e-6, 200, 0abs, barycentric]
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
@@ -143,9 +173,10 @@ Solver:
   --load R               barycentric | voronoi | plan: face weight sharing [{load}]
   -h, --help             this text
 
-Exit status: 0 converged (or --stress-only solved), 3 finished without converging
-(outputs written, the report says why), 2 bad input, options or output paths (nothing
-written), 1 other failure (nothing written).
+Exit status: 0 converged (or --stress-only solved; with --assess: a certified thrust
+surface found and the analysis converged), 3 finished without converging or (--assess) with
+no thrust surface inside the envelope (outputs written, the report says why), 2 bad input,
+options or output paths (nothing written), 1 other failure (nothing written).
 ",
         method = name_of(&METHODS, d.method),
         fairness = d.fairness,
@@ -192,6 +223,10 @@ pub struct Options {
     pub odt: Option<usize>,
     pub density: f64,
     pub settings: FormFindSettings,
+    /// `--assess` and its options.
+    pub assess: AssessOptions,
+    /// Every option given, in order (to tell a default from a value given).
+    pub given: Vec<String>,
 }
 
 /// The thickness of `--solid`.
@@ -346,6 +381,8 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         odt: None,
         density: 1.0,
         settings: FormFindSettings::default(),
+        assess: AssessOptions::default(),
+        given: Vec::new(),
     };
     let s = &mut o.settings;
     let mut given: Vec<String> = Vec::new();
@@ -374,6 +411,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             o.mesh = Some(path.into());
             continue;
         }
+        o.given.push(flag.clone());
         match flag.as_str() {
             "-h" | "--help" => return Ok(Parsed::Help),
             "--supports" => o.supports = Some(value()?.into()),
@@ -441,7 +479,11 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 o.density = d;
             }
             "--load" => s.stress.load_rule = choice(&flag, &value()?, &LOADS)?,
-            _ => return Err(format!("unknown option `{flag}`; try --help")),
+            _ => {
+                if !crate::assess::args::flag(&flag, &mut value, &mut o.assess)? {
+                    return Err(format!("unknown option `{flag}`; try --help"));
+                }
+            }
         }
     }
     check(&o)?;
@@ -506,6 +548,7 @@ fn check(o: &Options) -> Result<(), String> {
         }
     }
     check_solid(o)?;
+    crate::assess::args::check(o, &o.given)?;
     if o.mesh.is_some() {
         o.read_options().validate().map_err(flag_error)?;
     }

@@ -18,6 +18,8 @@ pub struct Model {
     pub supports: String,
     pub mesh: Mesh,
     pub faces: Vec<[u32; 3]>,
+    /// The mesh vertex of each file vertex (identity when not welded).
+    pub welded_ids: Vec<u32>,
     /// The welding of a mesh file (`None` for the embedded default and `--no-weld`).
     pub weld: Option<WeldSummary>,
     /// Plan repairs made before validation (none with `--strict`).
@@ -75,12 +77,14 @@ pub fn embedded_default() -> Model {
     let mesh = generate::lift(&points, &triangles, height, pillar)
         .expect("the embedded vault is a valid mesh");
     let faces = mesh.faces.clone();
+    let welded_ids = (0..mesh.n_vertices() as u32).collect();
     Model {
         name: "vault".into(),
         source: "embedded default: sail vault on four pillars, free arches, two oculi".into(),
         supports: "corner pillars".into(),
         mesh,
         faces,
+        welded_ids,
         weld: None,
         repairs: Vec::new(),
         diagonals: Vec::new(),
@@ -134,6 +138,7 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
         supports,
         faces: mesh.input_faces(),
         mesh,
+        welded_ids: model.welded_ids,
         weld: model.weld,
         repairs: model.repairs,
         diagonals: model.diagonals,
