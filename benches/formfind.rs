@@ -140,12 +140,11 @@ fn models() {
         "three_pillar",
         "vault_pq",
     ] {
-        let mesh = voussoir::io::load_model(
+        let problem = voussoir::io::load_model(
             &dir.join(format!("{name}.obj")),
             &dir.join(format!("{name}.json")),
         )
         .expect("model");
-        let problem = Problem::new(mesh);
         for method in [FormMethod::Nearest, FormMethod::Paper] {
             let s = FormFindSettings::default().with_method(method);
             let t = Instant::now();

@@ -98,12 +98,11 @@ fn variable_load_dome(n: usize) -> Problem {
 }
 
 fn shared_model(dir: &Path, name: &str) -> Option<Problem> {
-    let mesh = voussoir::io::load_model(
+    voussoir::io::load_model(
         &dir.join(format!("{name}.obj")),
         &dir.join(format!("{name}.json")),
     )
-    .ok()?;
-    Some(Problem::new(mesh))
+    .ok()
 }
 
 /// Runs of a stress step timed for its median when one run takes less than a second: at least

@@ -1103,7 +1103,7 @@ void vsr_settings_destroy(struct VsrSettings *settings);
 VsrStatus vsr_settings_set_tolerance(struct VsrSettings *settings, double tolerance);
 
 /**
- * Sets the maximum number of form-finding iterations (stress steps), >= 1. Default 50.
+ * Sets the maximum number of form-finding iterations (stress steps), >= 1. Default 100.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

@@ -16,6 +16,7 @@
 //! ```
 #![deny(unsafe_code)]
 
+mod assess;
 pub mod capi;
 mod error;
 pub mod generate;
@@ -29,7 +30,9 @@ mod smooth;
 mod solid;
 mod solve;
 mod stress;
+mod validate;
 
+pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;

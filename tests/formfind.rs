@@ -172,7 +172,7 @@ fn bad_input_gets_one_line_and_no_output() {
     rejects(
         &sq,
         &["sq.obj", "--supports", "s.json", "--tol", "-1"],
-        "--tol: must be > 0",
+        "--tol: -1 must be > 0",
     );
     rejects(
         &sq,

@@ -22,7 +22,9 @@ const MODELS: [(&str, usize, usize, usize); 9] = [
 fn load(dir: &std::path::Path, name: &str) -> Mesh {
     let obj = dir.join(format!("{name}.obj"));
     let json = dir.join(format!("{name}.json"));
-    io::load_model(&obj, &json).unwrap_or_else(|e| panic!("{name}: {e}"))
+    io::load_model(&obj, &json)
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+        .mesh
 }
 
 #[test]

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use crate::assess::args::AssessOptions;
+use voussoir::io::{ReadOptions, Supports, UpAxis};
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
     TauMode,
@@ -98,7 +100,12 @@ are replaced only when every output is written; two outputs may not share a path
                          and the form-found shape side by side, seen from
                          azimuth −60° and 30° above the horizon, shaded, the
                          faces coloured by height change; about 70 bytes per
-                         face and view (14 MB for 100k faces)
+                         face and view (14 MB for 100k faces). With --assess:
+                         plan_forces, section.svg (a vertical section: intrados,
+                         extrados, the thrust surface and the supports) and
+                         shape_3d.svg (the middle surface; the thrust surface,
+                         coloured by where it lies between intrados and
+                         extrados, under the translucent extrados)
   --solid T OUT          also a printable solid: the result thickened by T (half above,
                          half below, along vertex normals), closed by walls along every
                          boundary; OUT is .stl, .3mf (read as millimetres), .off, .obj or
@@ -110,6 +117,30 @@ are replaced only when every output is written; two outputs may not share a path
   --ascii                write STL and PLY outputs as ASCII text, not binary
   Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
   and NAME-supports.json, to try other options on.
+
+Assessment (instead of form finding; MESH is the masonry's middle surface):
+  --assess A             fit | min-thickness | min-thrust | max-thrust | max-load: find a
+                         compression-only thrust surface in equilibrium with the masonry's
+                         self-weight between intrados and extrados, over MESH's plan (by
+                         Heyman's safe theorem the vault then stands): fit, the one nearest
+                         the middle surface; min-thickness, the least uniform scale s of the
+                         thickness that still holds one (safety factor 1/s); min-thrust and
+                         max-thrust, the least and greatest horizontal thrust at the
+                         supports; max-load, the largest factor on --load-pattern. OUT is
+                         the thrust surface; the report's \"assessment\" holds the figures
+  --thickness T          the masonry's thickness along MESH's normals, half above, half below
+                         (read vertically as T / (2 n_z)); or `density`: --density / W
+  --intrados A           instead of --thickness: the intrados and the extrados as meshes
+  --extrados B           (.obj, .off, .stl, .ply), sampled on the vertical through each vertex
+  --unit-weight W        weight per unit volume: self-weight = area x thickness x W      [1]
+  --fixed-supports       keep the supports at MESH's heights (by default the thrust meets
+                         each support anywhere within the envelope)
+  --load-pattern L.json  max-load: a downward load per vertex of MESH (ids before welding;
+                         loads of merged vertices add): {{\"loads\": [..]}}, [..] or
+                         {{\"loads\": {{\"ID\": load, ..}}}}
+  --section S            the section picture's vertical plane: y (through the plan's centre,
+                         along x), x, y=VALUE or x=VALUE                                  [y]
+  --tol, --max-iter, --qmin and --load apply too [1e-6, 200, 0abs, barycentric]
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
@@ -142,9 +173,10 @@ Solver:
   --load R               barycentric | voronoi | plan: face weight sharing [{load}]
   -h, --help             this text
 
-Exit status: 0 converged (or --stress-only solved), 3 finished without converging
-(outputs written, the report says why), 2 bad input, options or output paths (nothing
-written), 1 other failure (nothing written).
+Exit status: 0 converged (or --stress-only solved; with --assess: a certified thrust
+surface found and the analysis converged), 3 finished without converging or (--assess) with
+no thrust surface inside the envelope (outputs written, the report says why), 2 bad input,
+options or output paths (nothing written), 1 other failure (nothing written).
 ",
         method = name_of(&METHODS, d.method),
         fairness = d.fairness,
@@ -177,8 +209,8 @@ pub struct Options {
     pub weld: Option<f64>,
     /// `--strict`: no plan repair.
     pub strict: bool,
-    /// `--up y`: MESH is Y-up (heights along its second axis).
-    pub y_up: bool,
+    /// `--up`: the axis that points up in MESH.
+    pub up: UpAxis,
     pub out: Option<PathBuf>,
     pub report: Option<PathBuf>,
     pub pictures: Option<PathBuf>,
@@ -191,6 +223,10 @@ pub struct Options {
     pub odt: Option<usize>,
     pub density: f64,
     pub settings: FormFindSettings,
+    /// `--assess` and its options.
+    pub assess: AssessOptions,
+    /// Every option given, in order (to tell a default from a value given).
+    pub given: Vec<String>,
 }
 
 /// The thickness of `--solid`.
@@ -203,6 +239,29 @@ pub enum SolidThickness {
 }
 
 impl Options {
+    /// How the library reads MESH: supports, welding, plan repair and up axis.
+    pub fn read_options(&self) -> ReadOptions {
+        let supports = if let Some(path) = &self.supports {
+            Supports::File(path.clone())
+        } else if let Some((tolerance, absolute)) = self.anchor_lowest {
+            Supports::Lowest {
+                tolerance,
+                absolute,
+            }
+        } else {
+            Supports::Boundary
+        };
+        let repair = if self.strict {
+            0.0
+        } else {
+            voussoir::DEFAULT_REPAIR_TOLERANCE
+        };
+        ReadOptions::new(supports)
+            .with_weld_tolerance(self.weld)
+            .with_repair_tolerance(repair)
+            .with_up(self.up)
+    }
+
     /// The thickness of the solid, if one is asked for.
     pub fn thickness(&self) -> Option<voussoir::Thickness> {
         match self.solid.as_ref()?.0 {
@@ -311,7 +370,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         anchor_lowest: None,
         weld: Some(voussoir::io::DEFAULT_WELD_TOLERANCE),
         strict: false,
-        y_up: false,
+        up: UpAxis::Z,
         out: None,
         report: None,
         pictures: None,
@@ -322,6 +381,8 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         odt: None,
         density: 1.0,
         settings: FormFindSettings::default(),
+        assess: AssessOptions::default(),
+        given: Vec::new(),
     };
     let s = &mut o.settings;
     let mut given: Vec<String> = Vec::new();
@@ -350,21 +411,16 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             o.mesh = Some(path.into());
             continue;
         }
+        o.given.push(flag.clone());
         match flag.as_str() {
             "-h" | "--help" => return Ok(Parsed::Help),
             "--supports" => o.supports = Some(value()?.into()),
             "--anchor-boundary" => o.anchor_boundary = true,
             "--anchor-lowest" => o.anchor_lowest = Some(tolerance(&flag, &value()?)?),
-            "--weld" => {
-                let t = number(&flag, &value()?)?;
-                if t < 0.0 {
-                    return Err(format!("{flag}: must be >= 0, got {t}"));
-                }
-                o.weld = Some(t);
-            }
+            "--weld" => o.weld = Some(number(&flag, &value()?)?),
             "--no-weld" => o.weld = None,
             "--strict" => o.strict = true,
-            "--up" => o.y_up = choice(&flag, &value()?, &[("z", false), ("y", true)])?,
+            "--up" => o.up = choice(&flag, &value()?, &[("z", UpAxis::Z), ("y", UpAxis::Y)])?,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
@@ -383,35 +439,16 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--ascii" => o.ascii = true,
             "--stress-only" => o.stress_only = true,
             "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
-            "--fairness" => {
-                let g = number(&flag, &value()?)?;
-                if g < 0.0 {
-                    return Err(format!("{flag}: must be >= 0, got {g}"));
-                }
-                s.fairness = g;
-            }
-            "--max-height-change" => {
-                let h = number(&flag, &value()?)?;
-                if h <= 0.0 {
-                    return Err(format!("{flag}: must be > 0, got {h}"));
-                }
-                s.max_height_change = h;
-            }
+            "--fairness" => s.fairness = number(&flag, &value()?)?,
+            "--max-height-change" => s.max_height_change = number(&flag, &value()?)?,
             "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
             "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
-            "--tol" => {
-                let t = number(&flag, &value()?)?;
-                if t <= 0.0 {
-                    return Err(format!("{flag}: must be > 0, got {t}"));
-                }
-                s.tolerance = t;
-            }
+            "--tol" => s.tolerance = number(&flag, &value()?)?,
             "--max-iter" => {
                 let text = value()?;
-                s.max_iterations = match text.parse::<usize>() {
-                    Ok(n) if n >= 1 => n,
-                    _ => return Err(format!("{flag}: expected an integer >= 1, got `{text}`")),
-                };
+                s.max_iterations = text
+                    .parse::<usize>()
+                    .map_err(|_| format!("{flag}: expected an integer >= 1, got `{text}`"))?;
             }
             "--qmin" => s.stress.q_min = bound(&flag, &value()?)?,
             "--qmin-scope" => s.stress.q_min_scope = choice(&flag, &value()?, &SCOPES)?,
@@ -425,13 +462,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
             "--holes" => s.stress.holes = choice(&flag, &value()?, &HOLES)?,
             "--dual-smoothing" => s.stress.dual_length_smoothing = number(&flag, &value()?)?,
-            "--smoothing-decay" => {
-                let d = number(&flag, &value()?)?;
-                if !(0.0..1.0).contains(&d) {
-                    return Err(format!("{flag}: must be in [0, 1), got {d}"));
-                }
-                s.smoothing_decay = d;
-            }
+            "--smoothing-decay" => s.smoothing_decay = number(&flag, &value()?)?,
             "--odt" => {
                 let text = value()?;
                 o.odt = match text.parse::<usize>() {
@@ -448,7 +479,11 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 o.density = d;
             }
             "--load" => s.stress.load_rule = choice(&flag, &value()?, &LOADS)?,
-            _ => return Err(format!("unknown option `{flag}`; try --help")),
+            _ => {
+                if !crate::assess::args::flag(&flag, &mut value, &mut o.assess)? {
+                    return Err(format!("unknown option `{flag}`; try --help"));
+                }
+            }
         }
     }
     check(&o)?;
@@ -499,7 +534,7 @@ fn check(o: &Options) -> Result<(), String> {
             )
         }
     }
-    if o.y_up && o.mesh.is_none() {
+    if o.up != UpAxis::Z && o.mesh.is_none() {
         return Err("--up y needs a MESH (the embedded vault is Z-up)".into());
     }
     if let Some(out) = &o.out {
@@ -513,10 +548,34 @@ fn check(o: &Options) -> Result<(), String> {
         }
     }
     check_solid(o)?;
-    o.settings.stress.validate().map_err(|e| {
-        e.to_string()
-            .replace("`q_min`", "--qmin")
-            .replace("`q_max`", "--qmax")
-            .replace("`dual_length_smoothing`", "--dual-smoothing")
-    })
+    crate::assess::args::check(o, &o.given)?;
+    if o.mesh.is_some() {
+        o.read_options().validate().map_err(flag_error)?;
+    }
+    o.settings.validate().map_err(flag_error)
+}
+
+/// The options that set each field the library's `validate` names.
+const FLAGS: [(&str, &str); 10] = [
+    ("tolerance", "--tol"),
+    ("max_iterations", "--max-iter"),
+    ("fairness", "--fairness"),
+    ("max_height_change", "--max-height-change"),
+    ("smoothing_decay", "--smoothing-decay"),
+    ("q_min", "--qmin"),
+    ("q_max", "--qmax"),
+    ("dual_length_smoothing", "--dual-smoothing"),
+    ("weld_tolerance", "--weld"),
+    ("anchor_lowest", "--anchor-lowest"),
+];
+
+/// A settings error of the library, named by the option that set the field.
+fn flag_error(e: voussoir::Error) -> String {
+    match e {
+        voussoir::Error::InvalidArgument { name, reason } => {
+            let flag = FLAGS.iter().find(|(field, _)| *field == name);
+            format!("{}: {reason}", flag.map_or(name, |f| f.1))
+        }
+        e => e.to_string(),
+    }
 }

@@ -11,7 +11,16 @@
 //! on stderr, a non-zero exit status and no output files, and existing files are replaced only
 //! when every output is written.
 
+/// `println!` that ignores a closed stdout (as in `formfind | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod args;
+mod assess;
 mod draw;
 mod model;
 mod output;
@@ -31,14 +40,6 @@ const NOT_CONVERGED: u8 = 3;
 /// Folder of the default output paths.
 const OUT_DIR: &str = "formfind-out";
 
-/// `println!` that ignores a closed stdout (as in `formfind | head`) instead of panicking.
-macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
-}
-
 struct Failure {
     code: u8,
     message: String,
@@ -55,15 +56,6 @@ fn failed(message: impl ToString) -> Failure {
     Failure {
         code: 1,
         message: message.to_string(),
-    }
-}
-
-/// A library error in words for an option's message: an invalid argument's reason alone
-/// (its `invalid argument `name`` prefix names a library parameter, not the option).
-fn reason(e: &voussoir::Error) -> String {
-    match e {
-        voussoir::Error::InvalidArgument { reason, .. } => reason.clone(),
-        other => other.to_string(),
     }
 }
 
@@ -118,9 +110,10 @@ struct Paths {
 }
 
 impl Paths {
-    fn of(o: &args::Options, name: &str) -> Paths {
+    /// The paths of a run on the model `name`; OUT defaults to `NAME-SUFFIX.obj`.
+    fn of(o: &args::Options, name: &str, suffix: &str) -> Paths {
         let dir = PathBuf::from(OUT_DIR);
-        let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{name}-formfound.obj")));
+        let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{name}-{suffix}.obj")));
         let input_copy = o.mesh.is_none().then(|| {
             let base = out.parent().unwrap_or(Path::new(""));
             (
@@ -137,8 +130,8 @@ impl Paths {
         }
     }
 
-    /// Every file a run writes, with the option that names it.
-    fn targets(&self, stress_only: bool) -> Vec<output::Target> {
+    /// Every file a run writes, with the option that names it; `pictures` are file names.
+    fn targets(&self, pictures: &[&str]) -> Vec<output::Target> {
         let target = |option: &str, path: &Path| output::Target {
             option: option.into(),
             path: path.to_path_buf(),
@@ -147,7 +140,7 @@ impl Paths {
         if let Some(solid) = &self.solid {
             targets.push(target("--solid", solid));
         }
-        for file in pictures::names(stress_only) {
+        for file in pictures {
             targets.push(target("--pictures", &self.pictures.join(file)));
         }
         if let Some((obj, json)) = &self.input_copy {
@@ -170,22 +163,15 @@ fn formfind() -> Result<ExitCode, Failure> {
         None => model::embedded_default(),
         Some(path) => model::from_files(path, &o).map_err(bad_input)?,
     };
-    let paths = Paths::of(&o, &model.name);
-    let mut inputs: Vec<(&str, &Path)> = Vec::new();
-    if let Some(mesh) = &o.mesh {
-        inputs.push(("MESH", mesh));
+    if o.assess.objective.is_some() {
+        return assess::main(&o, model);
     }
-    if let Some(supports) = &o.supports {
-        inputs.push(("--supports", supports));
-    }
-    output::check(&paths.targets(o.stress_only), &inputs).map_err(bad_input)?;
-    let Paths {
-        out,
-        report: report_path,
-        pictures: pictures_dir,
-        solid: solid_path,
-        input_copy,
-    } = paths;
+    let paths = Paths::of(&o, &model.name, "formfound");
+    output::check(
+        &paths.targets(&pictures::names(o.stress_only)),
+        &input_paths(&o),
+    )
+    .map_err(bad_input)?;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
     let mut report = report::build(&o, &outcome);
@@ -199,23 +185,75 @@ fn formfind() -> Result<ExitCode, Failure> {
         None => None,
     };
     let pictures = pictures::all(&outcome);
+    let outputs = Outputs {
+        positions: &outcome.positions,
+        solid: solid.as_ref(),
+        report: &report,
+        pictures: &pictures,
+    };
+    write_outputs(&o, &paths, &outcome.model, &outputs)?;
 
+    print_summary(&outcome, &report);
+    say!("wrote:");
+    say!(
+        "  {:<40} {}",
+        paths.out.display(),
+        "form-found mesh (same faces)"
+    );
+    if let (Some(solid), Some(path)) = (&solid, &paths.solid) {
+        say!(
+            "  {:<40} printable solid: {} faces, volume {:.6e}",
+            path.display(),
+            solid.faces.len(),
+            solid.volume()
+        );
+    }
+    print_written(&paths, &pictures, "--tau zero");
+    if outcome.succeeded() {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        let why = match outcome.termination {
+            Some(_) => format!("not converged ({})", phrase(&report["termination"])),
+            None => format!("stress analysis {}", phrase(&report["stress_status"])),
+        };
+        eprintln!("formfind: {why}: the outputs hold the best state reached");
+        Ok(ExitCode::from(NOT_CONVERGED))
+    }
+}
+
+/// What a run writes besides the embedded input's copy.
+struct Outputs<'a> {
+    /// OUT's positions (Z-up).
+    positions: &'a [[f64; 3]],
+    solid: Option<&'a voussoir::Solid>,
+    report: &'a Value,
+    pictures: &'a [(&'static str, String)],
+}
+
+/// Writes every output (all or nothing): OUT and the solid in the input's axes, the report,
+/// the pictures and, for the embedded input, its copy and supports.
+fn write_outputs(
+    o: &args::Options,
+    paths: &Paths,
+    model: &model::Model,
+    outputs: &Outputs,
+) -> Result<(), Failure> {
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
-    let mesh = &outcome.model.mesh;
+    let mesh = &model.mesh;
     // Written meshes keep the input's axes.
     let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
-        if o.y_up {
-            positions.iter().map(|&p| model::to_y_up(p)).collect()
-        } else {
-            positions.to_vec()
-        }
+        positions.iter().map(|&p| o.up.to_file(p)).collect()
     };
-    let positions = axes_of_input(&outcome.positions);
     staging
-        .write_mesh(&out, &positions, &outcome.model.faces, o.ascii)
+        .write_mesh(
+            &paths.out,
+            &axes_of_input(outputs.positions),
+            &model.faces,
+            o.ascii,
+        )
         .map_err(failed)?;
-    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
+    if let (Some(solid), Some(path)) = (outputs.solid, &paths.solid) {
         staging
             .write_mesh(
                 path,
@@ -226,44 +264,37 @@ fn formfind() -> Result<ExitCode, Failure> {
             .map_err(failed)?;
     }
     staging
-        .write(&report_path, report_text(&report).as_bytes())
+        .write(&paths.report, report_text(outputs.report).as_bytes())
         .map_err(failed)?;
-    for (file, svg) in &pictures {
+    for (file, svg) in outputs.pictures {
         staging
-            .write(&pictures_dir.join(file), svg.as_bytes())
+            .write(&paths.pictures.join(file), svg.as_bytes())
             .map_err(failed)?;
     }
-    if let Some((obj, json)) = &input_copy {
+    if let Some((obj, json)) = &paths.input_copy {
         let anchored: Vec<usize> = (0..mesh.n_vertices())
             .filter(|&v| mesh.anchored[v])
             .collect();
         let supports = serde_json::json!({ "anchored": anchored }).to_string() + "\n";
         staging
-            .write_obj(obj, &mesh.positions, &outcome.model.faces)
+            .write_obj(obj, &mesh.positions, &model.faces)
             .map_err(failed)?;
         staging.write(json, supports.as_bytes()).map_err(failed)?;
     }
-    staging.commit().map_err(failed)?;
+    staging.commit().map_err(failed)
+}
 
-    print_summary(&outcome, &report);
-    say!("wrote:");
-    say!("  {:<40} {}", out.display(), "form-found mesh (same faces)");
-    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
-        say!(
-            "  {:<40} printable solid: {} faces, volume {:.6e}",
-            path.display(),
-            solid.faces.len(),
-            solid.volume()
-        );
-    }
-    say!("  {:<40} {}", report_path.display(), "report (JSON)");
+/// The lines of the summary after OUT's: the report, the pictures, the embedded input.
+/// `options` are those the hint suggests to try on the embedded input.
+fn print_written(paths: &Paths, pictures: &[(&str, String)], options: &str) {
+    say!("  {:<40} {}", paths.report.display(), "report (JSON)");
     let names: Vec<&str> = pictures.iter().map(|(n, _)| *n).collect();
     say!(
         "  {:<40} {}",
-        format!("{}/", pictures_dir.display()),
+        format!("{}/", paths.pictures.display()),
         names.join(" ")
     );
-    if let Some((obj, json)) = &input_copy {
+    if let Some((obj, json)) = &paths.input_copy {
         say!(
             "  {:<40} {}",
             obj.display(),
@@ -271,20 +302,19 @@ fn formfind() -> Result<ExitCode, Failure> {
         );
         say!("  {:<40}", json.display());
         say!(
-            "try your own options on it, e.g.:\n  cargo run --release --example formfind -- {} --supports {} --tau zero",
+            "try your own options on it, e.g.:\n  cargo run --release --example formfind -- {} --supports {} {options}",
             obj.display(),
             json.display()
         );
     }
-    if outcome.succeeded() {
-        Ok(ExitCode::SUCCESS)
-    } else {
-        let why = match outcome.termination {
-            Some(_) => format!("not converged ({})", phrase(&report["termination"])),
-            None => format!("stress analysis {}", phrase(&report["stress_status"])),
-        };
-        eprintln!("formfind: {why}: the outputs hold the best state reached");
-        Ok(ExitCode::from(NOT_CONVERGED))
+}
+
+/// A library error in words for an option's message: an invalid argument's reason alone
+/// (its `invalid argument `name`` prefix names a library parameter, not the option).
+fn reason(e: &voussoir::Error) -> String {
+    match e {
+        voussoir::Error::InvalidArgument { reason, .. } => reason.clone(),
+        other => other.to_string(),
     }
 }
 
@@ -301,8 +331,20 @@ fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
-fn print_summary(outcome: &run::Outcome, report: &Value) {
-    let m = &outcome.model;
+/// The input files an output may not overwrite, with the option that names each.
+pub fn input_paths(o: &args::Options) -> Vec<(&'static str, &Path)> {
+    let mut inputs: Vec<(&'static str, &Path)> = Vec::new();
+    if let Some(mesh) = &o.mesh {
+        inputs.push(("MESH", mesh));
+    }
+    if let Some(supports) = &o.supports {
+        inputs.push(("--supports", supports));
+    }
+    inputs
+}
+
+/// The lines about the input: sizes, welding, plan repairs.
+fn print_model(m: &model::Model) {
     let mesh = &m.mesh;
     say!(
         "{} ({}): {}, {}, {}, {}, {} anchored",
@@ -335,6 +377,10 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             count(m.repairs.len() - flips, "vertex nudge", "vertex nudges")
         );
     }
+}
+
+fn print_summary(outcome: &run::Outcome, report: &Value) {
+    print_model(&outcome.model);
     let s = &outcome.stress;
     match &outcome.termination {
         None => say!(

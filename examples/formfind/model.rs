@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use voussoir::generate::{self, Domain};
-use voussoir::{io, Mesh};
-use voussoir::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
+use voussoir::io::{self, Supports, UpAxis, WeldSummary};
+use voussoir::{Mesh, PlanRepair};
 
 use crate::args::Options;
 
@@ -18,6 +18,8 @@ pub struct Model {
     pub supports: String,
     pub mesh: Mesh,
     pub faces: Vec<[u32; 3]>,
+    /// The mesh vertex of each file vertex (identity when not welded).
+    pub welded_ids: Vec<u32>,
     /// The welding of a mesh file (`None` for the embedded default and `--no-weld`).
     pub weld: Option<WeldSummary>,
     /// Plan repairs made before validation (none with `--strict`).
@@ -75,62 +77,72 @@ pub fn embedded_default() -> Model {
     let mesh = generate::lift(&points, &triangles, height, pillar)
         .expect("the embedded vault is a valid mesh");
     let faces = mesh.faces.clone();
+    let welded_ids = (0..mesh.n_vertices() as u32).collect();
     Model {
         name: "vault".into(),
         source: "embedded default: sail vault on four pillars, free arches, two oculi".into(),
         supports: "corner pillars".into(),
         mesh,
         faces,
+        welded_ids,
         weld: None,
         repairs: Vec::new(),
         diagonals: Vec::new(),
     }
 }
 
-/// How the input's vertices were welded, for the report.
-pub struct WeldSummary {
-    pub input_vertices: usize,
-    pub merged: usize,
-    pub relative_tolerance: f64,
-    pub tolerance: f64,
-    pub collapsed_faces: Vec<usize>,
-}
-
-/// Reads `mesh_path` (any format), turns it Z-up for `--up y`, welds it unless `--no-weld` (STL
-/// always, at the default tolerance if need be), and anchors the vertices of `--supports`
-/// (input ids, mapped onto welded ones), of `--anchor-lowest` or every boundary vertex. A mesh
-/// whose plan is invalid but would be valid seen Y-up gets a hint to `--up y` in its error.
+/// Reads `mesh_path` with the library's read path (`io::read_model`) and the options of the
+/// command line. A mesh whose plan is invalid but would be valid seen Y-up gets a hint to
+/// `--up y` in its error.
 pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
-    let ((positions, faces), diagonals) =
-        io::read_mesh_with_diagonals(mesh_path).map_err(|e| e.to_string())?;
-    let read = |y_up: bool| {
-        let positions = if y_up {
-            positions.iter().map(|&p| from_y_up(p)).collect()
-        } else {
-            positions.clone()
-        };
-        build(mesh_path, o, positions, faces.clone(), &diagonals)
-    };
-    match read(o.y_up) {
-        Err(e) if !o.y_up && is_plan_error(&e) && read(true).is_ok() => Err(format!(
-            "{e} (seen with y up, as most modellers export, the plan is valid: try --up y)"
-        )),
+    let options = o.read_options();
+    let read = io::read_model(mesh_path, &options);
+    let model = match read {
+        Err(e) if options.up == UpAxis::Z && is_plan_error(&e) => {
+            let y_up = options.clone().with_up(UpAxis::Y);
+            return Err(match io::read_model(mesh_path, &y_up) {
+                Ok(_) => format!(
+                    "{e} (seen with y up, as most modellers export, the plan is valid: try --up y)"
+                ),
+                Err(_) => e.to_string(),
+            });
+        }
         Err(voussoir::Error::InvalidArgument {
             name: "weld tolerance",
             reason,
-        }) => Err(format!("--weld: {reason} (or --no-weld)")),
-        other => other.map_err(|e| e.to_string()),
-    }
-}
-
-/// A position of a Y-up file in the Z-up frame: a quarter turn about the x axis.
-pub fn from_y_up(p: [f64; 3]) -> [f64; 3] {
-    [p[0], -p[2], p[1]]
-}
-
-/// A Z-up position back in a Y-up file's axes (the inverse of [`from_y_up`]).
-pub fn to_y_up(p: [f64; 3]) -> [f64; 3] {
-    [p[0], p[2], -p[1]]
+        }) => return Err(format!("--weld: {reason} (or --no-weld)")),
+        other => other.map_err(|e| e.to_string())?,
+    };
+    let supports = match &options.supports {
+        Supports::File(path) => path.display().to_string(),
+        Supports::Lowest {
+            tolerance,
+            absolute,
+        } => {
+            let unit = if *absolute {
+                ""
+            } else {
+                " x the bounding box diagonal"
+            };
+            format!("every vertex within {tolerance}{unit} of the lowest height (--anchor-lowest)")
+        }
+        _ => "every boundary vertex (--anchor-boundary)".into(),
+    };
+    let name = mesh_path
+        .file_stem()
+        .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+    let mesh = model.problem.mesh;
+    Ok(Model {
+        name,
+        source: mesh_path.display().to_string(),
+        supports,
+        faces: mesh.input_faces(),
+        mesh,
+        welded_ids: model.welded_ids,
+        weld: model.weld,
+        repairs: model.repairs,
+        diagonals: model.diagonals,
+    })
 }
 
 /// Whether `e` says the plan (the projection along z) is not a valid one.
@@ -142,130 +154,4 @@ fn is_plan_error(e: &voussoir::Error) -> bool {
             | voussoir::Error::OverlappingPlan { .. }
             | voussoir::Error::OverlappingFaces { .. }
     )
-}
-
-/// The model of `positions` and `faces` (already Z-up): welding, supports, plan repair and
-/// validation.
-fn build(
-    mesh_path: &Path,
-    o: &Options,
-    positions: Vec<[f64; 3]>,
-    faces: Vec<[u32; 3]>,
-    diagonals: &[[u32; 2]],
-) -> voussoir::Result<Model> {
-    let is_stl = io::MeshFormat::from_path(mesh_path)?.is_single_precision();
-    let tolerance = o.weld.or(is_stl.then_some(io::DEFAULT_WELD_TOLERANCE));
-    let (positions, faces, welded) = match tolerance {
-        Some(t) => {
-            let w = io::weld(&positions, &faces, t)?;
-            let summary = WeldSummary {
-                input_vertices: positions.len(),
-                merged: w.merged,
-                relative_tolerance: t,
-                tolerance: w.tolerance,
-                collapsed_faces: w.collapsed_faces.clone(),
-            };
-            (w.positions.clone(), w.faces.clone(), Some((w, summary)))
-        }
-        None => (positions, faces, None),
-    };
-    let (anchored, supports_label) = if let Some(path) = &o.supports {
-        let ids = io::read_supports(path)?;
-        let ids = match &welded {
-            Some((w, _)) => w.map_ids(&ids)?,
-            None => ids,
-        };
-        (ids, path.display().to_string())
-    } else if let Some((tol, absolute)) = o.anchor_lowest {
-        let ids = lowest(&positions, &faces, tol, absolute);
-        let unit = if absolute {
-            ""
-        } else {
-            " x the bounding box diagonal"
-        };
-        let label =
-            format!("every vertex within {tol}{unit} of the lowest height (--anchor-lowest)");
-        (ids, label)
-    } else {
-        (
-            boundary_vertices(&faces),
-            "every boundary vertex (--anchor-boundary)".into(),
-        )
-    };
-    let (mut positions, mut faces) = (positions, faces);
-    let repairs = if o.strict {
-        Vec::new()
-    } else {
-        repair_plan(
-            &mut positions,
-            &mut faces,
-            &anchored,
-            DEFAULT_REPAIR_TOLERANCE,
-        )?
-    };
-    let mesh = Mesh::new(positions, faces.clone(), &anchored)?;
-    let welded_id = |v: u32| match &welded {
-        Some((w, _)) => w.welded_id[v as usize],
-        None => v,
-    };
-    // Welding or a plan repair's flip may have removed a diagonal: only the edges left count.
-    let diagonals = mesh.interior_edges_among(diagonals.iter().map(|d| d.map(welded_id)));
-    let name = mesh_path
-        .file_stem()
-        .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
-    Ok(Model {
-        name,
-        source: mesh_path.display().to_string(),
-        supports: supports_label,
-        mesh,
-        faces,
-        weld: welded.map(|(_, s)| s),
-        repairs,
-        diagonals,
-    })
-}
-
-/// The vertices on an edge of a single face, in id order.
-fn boundary_vertices(faces: &[[u32; 3]]) -> Vec<u32> {
-    let mut uses: std::collections::HashMap<(u32, u32), usize> = Default::default();
-    for f in faces {
-        for k in 0..3 {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    let mut boundary: Vec<u32> = uses
-        .iter()
-        .filter(|(_, &n)| n == 1)
-        .flat_map(|(&(a, b), _)| [a, b])
-        .collect();
-    boundary.sort_unstable();
-    boundary.dedup();
-    boundary
-}
-
-/// The vertices of some face within `tol` of the lowest such vertex's height; `tol` is
-/// relative to the bounding box diagonal of those vertices unless `absolute`.
-fn lowest(positions: &[[f64; 3]], faces: &[[u32; 3]], tol: f64, absolute: bool) -> Vec<u32> {
-    let mut referenced = vec![false; positions.len()];
-    for &v in faces.iter().flatten() {
-        referenced[v as usize] = true;
-    }
-    let used = || {
-        (0..positions.len())
-            .filter(|&v| referenced[v])
-            .map(|v| positions[v])
-    };
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in used() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
-    let reach = if absolute { tol } else { tol * diagonal };
-    (0..positions.len() as u32)
-        .filter(|&v| referenced[v as usize] && positions[v as usize][2] <= lo[2] + reach)
-        .collect()
 }

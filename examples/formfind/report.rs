@@ -53,8 +53,8 @@ fn bound(b: QBound, unit: f64) -> Value {
 
 /// How the input was welded: the output mesh and every vertex id in this report are welded
 /// ids, numbered in the order of their first input vertex.
-fn weld(outcome: &Outcome) -> Value {
-    match &outcome.model.weld {
+pub fn weld(model: &crate::model::Model) -> Value {
+    match &model.weld {
         None => Value::Null,
         Some(w) => json!({
             "input_vertices": w.input_vertices,
@@ -69,7 +69,7 @@ fn weld(outcome: &Outcome) -> Value {
 
 /// One plan repair as JSON: a flip (faces, removed and added edge) or a nudge (vertex, face,
 /// plan position before and after).
-fn repair(r: &PlanRepair) -> Value {
+pub fn repair(r: &PlanRepair) -> Value {
     match r {
         PlanRepair::Flip {
             faces,
@@ -92,9 +92,9 @@ fn settings(o: &Options, outcome: &Outcome) -> Value {
     json!({
         "mesh": outcome.model.source,
         "supports": outcome.model.supports,
-        "weld": weld(outcome),
+        "weld": weld(&outcome.model),
         "strict": o.strict,
-        "up": if o.y_up { "y" } else { "z" },
+        "up": if o.up == voussoir::io::UpAxis::Y { "y" } else { "z" },
         "polygon_diagonals": outcome.model.diagonals.len(),
         "stress_only": o.stress_only,
         "solver": name_of(&SOLVERS, st.formulation),

@@ -17,11 +17,6 @@ pub fn invalid(name: &str, reason: impl std::fmt::Display) -> PyErr {
     VoussoirError::new_err(format!("argument `{name}`: {reason}"))
 }
 
-/// A non-finite number where a finite one is needed (the C API's `VSR_STATUS_NON_FINITE`).
-pub fn not_finite(name: &str, value: f64) -> PyErr {
-    invalid(name, format_args!("{value} is not finite"))
-}
-
 /// A library error, prefixed with the argument at fault as the C API's `from_error` does:
 /// `arg` is the argument the call was about; mesh errors name the array they come from.
 pub fn from_error(arg: &str, e: Error) -> PyErr {

@@ -28,6 +28,5 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::analyse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
     m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
-    m.add_function(wrap_pyfunction!(solve::read_welded, m)?)?;
     Ok(())
 }

@@ -4,8 +4,8 @@ use crate::errors::{from_error, invalid, VoussoirError};
 use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use voussoir::io::{read_mesh_with_diagonals, read_supports, weld};
-use voussoir::{repair_plan, PlanRepair};
+use voussoir::io::{read_model, ReadOptions, Supports, UpAxis};
+use voussoir::PlanRepair;
 use voussoir::{Mesh as RustMesh, Problem};
 
 /// A validated triangle mesh with its supports and loads (native half of `voussoir.Mesh`).
@@ -15,6 +15,8 @@ pub struct Mesh {
     /// The mesh vertex of each vertex of the file it was read from.
     welded_ids: Option<Vec<u32>>,
     repairs: Vec<PlanRepair>,
+    /// The up axis of the file it was read from (z for a mesh built from arrays).
+    pub up: UpAxis,
 }
 
 /// Rows of `width` numbers from an array of shape (n, width) (or (n,) when `width` is 1).
@@ -80,6 +82,7 @@ impl Mesh {
             problem,
             welded_ids: None,
             repairs: Vec::new(),
+            up: UpAxis::Z,
         }
     }
 
@@ -89,12 +92,7 @@ impl Mesh {
 
     /// Faces in the orientation they were given (the library stores them counter-clockwise).
     pub fn input_faces(&self) -> Vec<[u32; 3]> {
-        let m = self.mesh();
-        if m.reversed {
-            m.faces.iter().map(|&[a, b, c]| [a, c, b]).collect()
-        } else {
-            m.faces.clone()
-        }
+        self.mesh().input_faces()
     }
 }
 
@@ -110,12 +108,16 @@ fn loads(
     let Some(array) = array else {
         return Ok(problem);
     };
-    let values = rows(name, &array, width)?;
     let m = &problem.mesh;
     let (expected, what) = if per_face {
         (m.n_faces(), "face")
     } else {
         (m.n_vertices(), "vertex")
+    };
+    // A single number stands for every row (`face_density=2.0`).
+    let values = match array.shape() {
+        [] if width == 1 => vec![array.as_array().iter().copied().next().unwrap_or(0.0); expected],
+        _ => rows(name, &array, width)?,
     };
     let n = values.len() / width;
     if n != expected {
@@ -164,15 +166,41 @@ fn with_loads(
     })
 }
 
-fn tolerance(name: &str, value: f64) -> PyResult<f64> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(invalid(
-            name,
-            format_args!("{value} is not a finite number >= 0"),
-        ))
+/// The one way of choosing supports among `Mesh.from_file`'s keywords.
+fn supports_of(
+    file: Option<PathBuf>,
+    ids: Option<Vec<u32>>,
+    boundary: bool,
+    lowest: Option<f64>,
+) -> PyResult<Supports> {
+    let ids = ids.filter(|ids| !ids.is_empty());
+    if file.is_some() && ids.is_some() {
+        return Err(invalid(
+            "anchored",
+            "give either `supports` or `anchored`, not both",
+        ));
     }
+    let given = [file.is_some(), ids.is_some(), boundary, lowest.is_some()];
+    if given.iter().filter(|g| **g).count() > 1 {
+        return Err(invalid(
+            if boundary {
+                "anchor_boundary"
+            } else {
+                "anchor_lowest"
+            },
+            "give one of `supports`, `anchored`, `anchor_boundary` and `anchor_lowest`",
+        ));
+    }
+    Ok(match (file, ids, lowest) {
+        (Some(file), _, _) => Supports::File(file),
+        (_, Some(ids), _) => Supports::Ids(ids),
+        (_, _, Some(tolerance)) => Supports::Lowest {
+            tolerance,
+            absolute: false,
+        },
+        _ if boundary => Supports::Boundary,
+        _ => Supports::Ids(Vec::new()),
+    })
 }
 
 #[pymethods]
@@ -203,56 +231,66 @@ impl Mesh {
         Ok(Mesh::new(problem))
     }
 
-    /// Reads a mesh file (as `vsr_mesh_read`): weld, map support ids, mend the plan, validate.
+    /// Reads a mesh file with `voussoir::io::read_model` (as `vsr_mesh_read` does): weld,
+    /// choose the supports, mend the plan, validate, mark the polygon diagonals.
     #[staticmethod]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (path, supports, anchored, weld_tolerance, repair_tolerance, face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None))]
+    #[pyo3(signature = (path, supports, anchored, weld_tolerance, repair_tolerance, anchor_boundary=false, anchor_lowest=None, anchor_lowest_absolute=false, up="z", face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None))]
     fn read(
         path: PathBuf,
         supports: Option<PathBuf>,
         anchored: Option<PyReadonlyArrayDyn<'_, i64>>,
-        weld_tolerance: f64,
+        weld_tolerance: Option<f64>,
         repair_tolerance: f64,
+        anchor_boundary: bool,
+        anchor_lowest: Option<f64>,
+        anchor_lowest_absolute: bool,
+        up: &str,
         face_density: Array<'_>,
         extra_loads: Array<'_>,
         horizontal_forces: Array<'_>,
         prescribed_tau: Array<'_>,
     ) -> PyResult<Mesh> {
         let given = match &anchored {
-            Some(a) => ids("anchored", rows("anchored", a, 1)?)?,
-            None => Vec::new(),
+            Some(a) => Some(ids("anchored", rows("anchored", a, 1)?)?),
+            None => None,
         };
-        if supports.is_some() && !given.is_empty() {
-            return Err(invalid(
-                "anchored",
-                "give either `supports` or `anchored`, not both",
-            ));
-        }
-        let weld_tolerance = tolerance("weld_tolerance", weld_tolerance)?;
-        let repair_tolerance = tolerance("repair_tolerance", repair_tolerance)?;
-        let ((positions, faces), diagonals) =
-            read_mesh_with_diagonals(&path).map_err(|e| from_error("path", e))?;
-        let ids = match &supports {
-            Some(p) => read_supports(p).map_err(|e| from_error("supports", e))?,
-            None => given,
+        let supports = supports_of(supports, given, anchor_boundary, anchor_lowest)?;
+        let supports = match supports {
+            Supports::Lowest { tolerance, .. } => Supports::Lowest {
+                tolerance,
+                absolute: anchor_lowest_absolute,
+            },
+            other => other,
         };
-        let welded = weld(&positions, &faces, weld_tolerance).map_err(|e| from_error("path", e))?;
-        let anchored = welded
-            .map_ids(&ids)
-            .map_err(|e| from_error("anchored", e))?;
-        let (mut positions, mut faces) = (welded.positions, welded.faces);
-        let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
-            .map_err(|e| from_error("path", e))?;
-        let mesh = RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
-        // q_min does not bind the file's polygon diagonals, as in `vsr_mesh_read`.
-        let diagonals = mesh.interior_edges_among(
-            (diagonals.iter()).map(|d| d.map(|v| welded.welded_id[v as usize])),
-        );
-        let problem = Problem::new(mesh)
-            .with_polygon_diagonals(&diagonals)
-            .map_err(|e| from_error("path", e))?;
+        let up = match up {
+            "z" => UpAxis::Z,
+            "y" => UpAxis::Y,
+            other => {
+                return Err(invalid(
+                    "up",
+                    format_args!("'{other}' is not one of 'z', 'y'"),
+                ))
+            }
+        };
+        let options = ReadOptions::new(supports)
+            .with_weld_tolerance(weld_tolerance)
+            .with_repair_tolerance(repair_tolerance)
+            .with_up(up);
+        let model = read_model(&path, &options).map_err(|e| match e {
+            voussoir::Error::InvalidArgument { name, reason }
+                if matches!(
+                    name,
+                    "weld_tolerance" | "repair_tolerance" | "anchor_lowest"
+                ) =>
+            {
+                invalid(name, reason)
+            }
+            e if options.blames_supports_file(&e) => from_error("supports", e),
+            e => from_error("path", e),
+        })?;
         let problem = with_loads(
-            problem,
+            model.problem,
             face_density,
             extra_loads,
             horizontal_forces,
@@ -260,8 +298,9 @@ impl Mesh {
         )?;
         Ok(Mesh {
             problem,
-            welded_ids: Some(welded.welded_id),
-            repairs,
+            welded_ids: Some(model.welded_ids),
+            repairs: model.repairs,
+            up: model.up,
         })
     }
 

@@ -1,7 +1,8 @@
-//! Keyword settings → `FormFindSettings`, validated one by one as the C API's setters do (same
-//! checks, same messages, the argument named by its keyword), starting from the Rust defaults.
+//! Keyword settings → `FormFindSettings`, starting from the Rust defaults: each value is
+//! converted here, then the whole is checked by the library's `FormFindSettings::validate`
+//! (the checks of the C API's setters, same messages), the setting named by its keyword.
 
-use crate::errors::{invalid, not_finite};
+use crate::errors::invalid;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use voussoir::{
@@ -76,33 +77,77 @@ fn number(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
         .map_err(|_| invalid(name, "is not a number"))
 }
 
-fn finite(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let v = number(name, value)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(not_finite(name, v))
-    }
+/// Where a scalar setting lives in `FormFindSettings`.
+enum Slot {
+    Number(fn(&mut FormFindSettings) -> &mut f64),
+    Count(fn(&mut FormFindSettings) -> &mut usize),
+    Flag(fn(&mut FormFindSettings) -> &mut bool),
 }
 
-/// The C API's `at_least`: finite and >= `min` (> `min` when `strict`).
-fn at_least(name: &str, value: &Bound<'_, PyAny>, min: f64, strict: bool) -> PyResult<f64> {
-    let v = finite(name, value)?;
-    if v < min || (strict && v == min) {
-        let op = if strict { ">" } else { ">=" };
-        return Err(invalid(name, format_args!("{v} must be {op} {min}")));
-    }
-    Ok(v)
-}
+/// The scalar settings by keyword, read by [`from_kwargs`] and [`defaults`]: adding a scalar
+/// setting to the Rust settings adds one row here (its range is checked by
+/// `FormFindSettings::validate`).
+const SCALARS: &[(&str, Slot)] = &[
+    ("fairness", Slot::Number(|f| &mut f.fairness)),
+    (
+        "max_height_change",
+        Slot::Number(|f| &mut f.max_height_change),
+    ),
+    ("tolerance", Slot::Number(|f| &mut f.tolerance)),
+    ("max_iterations", Slot::Count(|f| &mut f.max_iterations)),
+    ("stall_window", Slot::Count(|f| &mut f.stall_window)),
+    ("odt_iterations", Slot::Count(|f| &mut f.odt_iterations)),
+    (
+        "odt_free_boundary",
+        Slot::Flag(|f| &mut f.odt_free_boundary),
+    ),
+    ("proximal_weight", Slot::Number(|f| &mut f.proximal_weight)),
+    ("smoothing_decay", Slot::Number(|f| &mut f.smoothing_decay)),
+    ("schedule_mu0", Slot::Number(|f| &mut f.schedule.mu0)),
+    ("schedule_beta", Slot::Number(|f| &mut f.schedule.beta)),
+    ("schedule_mu_min", Slot::Number(|f| &mut f.schedule.mu_min)),
+    ("schedule_eta", Slot::Number(|f| &mut f.schedule.eta)),
+    ("schedule_pull", Slot::Number(|f| &mut f.schedule.pull)),
+    (
+        "regularisation",
+        Slot::Number(|f| &mut f.stress.regularisation),
+    ),
+    (
+        "dual_length_smoothing",
+        Slot::Number(|f| &mut f.stress.dual_length_smoothing),
+    ),
+];
 
-fn count(name: &str, value: &Bound<'_, PyAny>, min: usize) -> PyResult<usize> {
-    let v: i64 = value
-        .extract()
-        .map_err(|_| invalid(name, "is not an integer"))?;
-    if v < min as i64 {
-        return Err(invalid(name, format_args!("must be >= {min}")));
+impl Slot {
+    /// Stores `v`, converted (not range-checked: `FormFindSettings::validate` does that).
+    fn set(&self, f: &mut FormFindSettings, name: &str, v: &Bound<'_, PyAny>) -> PyResult<()> {
+        match self {
+            Slot::Number(at) => *at(f) = number(name, v)?,
+            Slot::Count(at) => {
+                let n: i64 = v
+                    .extract()
+                    .map_err(|_| invalid(name, "is not an integer"))?;
+                *at(f) = usize::try_from(n)
+                    .map_err(|_| invalid(name, format_args!("{n} is negative")))?;
+            }
+            Slot::Flag(at) => {
+                *at(f) = v
+                    .extract::<bool>()
+                    .map_err(|_| invalid(name, "is not True or False"))?
+            }
+        }
+        Ok(())
     }
-    usize::try_from(v).map_err(|_| invalid(name, "is too large"))
+
+    /// The setting's value in `f`.
+    fn get<'py>(&self, py: Python<'py>, f: &FormFindSettings) -> PyResult<Bound<'py, PyAny>> {
+        let mut f = f.clone();
+        Ok(match self {
+            Slot::Number(at) => (*at(&mut f)).into_pyobject(py)?.into_any(),
+            Slot::Count(at) => (*at(&mut f)).into_pyobject(py)?.into_any(),
+            Slot::Flag(at) => (*at(&mut f)).into_pyobject(py)?.to_owned().into_any(),
+        })
+    }
 }
 
 fn bound(value: f64, relative: bool) -> QBound {
@@ -113,7 +158,17 @@ fn bound(value: f64, relative: bool) -> QBound {
     }
 }
 
-/// Settings from keyword arguments (only those given), on top of the Rust defaults.
+/// The keyword of a setting the library names by its field (`schedule.mu0`, `solver`).
+fn keyword(field: &str) -> String {
+    match field {
+        "solver" => "qp_solver".into(),
+        f if f.starts_with("dual_length_bounds") => "dual_length_bounds".into(),
+        f => f.replace('.', "_"),
+    }
+}
+
+/// Settings from keyword arguments (only those given), on top of the Rust defaults, checked
+/// by the library's `FormFindSettings::validate`.
 pub fn from_kwargs(kwargs: &Bound<'_, PyDict>) -> PyResult<FormFindSettings> {
     let mut f = FormFindSettings::default();
     let get = |key: &str| kwargs.get_item(key);
@@ -134,14 +189,14 @@ pub fn from_kwargs(kwargs: &Bound<'_, PyDict>) -> PyResult<FormFindSettings> {
             f.stress.q_min = bound(v, q_min_relative);
         }
     }
-    f.stress.validate().map_err(|e| match e {
-        voussoir::Error::InvalidArgument { name, reason } => invalid(name, reason),
+    f.validate().map_err(|e| match e {
+        voussoir::Error::InvalidArgument { name, reason } => invalid(&keyword(name), reason),
         e => invalid("settings", e),
     })?;
     Ok(f)
 }
 
-/// Applies one setting, checked as its C setter checks it.
+/// Stores one setting, converted from its Python value.
 fn apply(
     f: &mut FormFindSettings,
     key: &str,
@@ -149,45 +204,18 @@ fn apply(
     q_min_relative: bool,
     q_max_relative: bool,
 ) -> PyResult<()> {
+    if let Some((_, slot)) = SCALARS.iter().find(|(k, _)| *k == key) {
+        return slot.set(f, key, v);
+    }
     let s = &mut f.stress;
     match key {
         "method" => f.method = choice(key, v, &METHODS)?,
-        "fairness" => f.fairness = at_least(key, v, 0.0, false)?,
-        "max_height_change" => f.max_height_change = at_least(key, v, 0.0, true)?,
-        "tolerance" => f.tolerance = at_least(key, v, 0.0, true)?,
-        "max_iterations" => f.max_iterations = count(key, v, 1)?,
-        "stall_window" => f.stall_window = count(key, v, 1)?,
-        "odt_iterations" => f.odt_iterations = count(key, v, 0)?,
-        "odt_free_boundary" => {
-            f.odt_free_boundary = v
-                .extract::<bool>()
-                .map_err(|_| invalid(key, "is not True or False"))?
-        }
-        "proximal_weight" => f.proximal_weight = at_least(key, v, 0.0, false)?,
-        "smoothing_decay" => {
-            let d = at_least(key, v, 0.0, false)?;
-            if d >= 1.0 {
-                return Err(invalid(key, format_args!("{d} must be < 1")));
-            }
-            f.smoothing_decay = d;
-        }
-        "schedule_mu0" => f.schedule.mu0 = at_least(key, v, 0.0, false)?,
-        "schedule_beta" => {
-            let b = at_least(key, v, 0.0, false)?;
-            if b > 1.0 {
-                return Err(invalid(key, format_args!("{b} must be <= 1")));
-            }
-            f.schedule.beta = b;
-        }
-        "schedule_mu_min" => f.schedule.mu_min = at_least(key, v, 0.0, false)?,
-        "schedule_eta" => f.schedule.eta = at_least(key, v, 0.0, true)?,
-        "schedule_pull" => f.schedule.pull = at_least(key, v, 0.0, false)?,
-        "q_min" => s.q_min = bound(at_least(key, v, 0.0, false)?, q_min_relative),
+        "q_min" => s.q_min = bound(number(key, v)?, q_min_relative),
         "q_max" => {
             s.q_max = if v.is_none() || number(key, v)? == f64::INFINITY {
                 None
             } else {
-                Some(bound(at_least(key, v, 0.0, true)?, q_max_relative))
+                Some(bound(number(key, v)?, q_max_relative))
             }
         }
         "q_min_kind" | "q_max_kind" => {}
@@ -197,15 +225,13 @@ fn apply(
         "load_rule" => s.load_rule = choice(key, v, &LOAD_RULES)?,
         "formulation" => s.formulation = choice(key, v, &FORMULATIONS)?,
         "qp_solver" => s.solver = choice(key, v, &QP_SOLVERS)?,
-        "regularisation" => s.regularisation = at_least(key, v, 0.0, false)?,
-        "dual_length_smoothing" => s.dual_length_smoothing = at_least(key, v, 0.0, false)?,
         "dual_length_bounds" => s.dual_length_bounds = dual_bounds(v)?,
         _ => return Err(invalid(key, "is not a setting (see voussoir.defaults())")),
     }
     Ok(())
 }
 
-/// `None` or `(lo, hi)`, checked as `vsr_settings_set_dual_length_bounds` checks them.
+/// `None` or `(lo, hi)`; `(0, inf)` is no bounds, as in `vsr_settings_set_dual_length_bounds`.
 fn dual_bounds(v: &Bound<'_, PyAny>) -> PyResult<Option<(f64, f64)>> {
     if v.is_none() {
         return Ok(None);
@@ -213,15 +239,9 @@ fn dual_bounds(v: &Bound<'_, PyAny>) -> PyResult<Option<(f64, f64)>> {
     let (lo, hi): (Bound<'_, PyAny>, Bound<'_, PyAny>) = v
         .extract()
         .map_err(|_| invalid("dual_length_bounds", "is not None or a pair (lo, hi)"))?;
-    let lo = at_least("dual_length_bounds", &lo, 0.0, false)?;
+    let lo = number("dual_length_bounds", &lo)?;
     let hi = number("dual_length_bounds", &hi)?;
-    if hi.is_nan() || hi <= lo {
-        return Err(invalid(
-            "dual_length_bounds",
-            format_args!("{hi} must be > lo ({lo})"),
-        ));
-    }
-    Ok((lo > 0.0 || hi.is_finite()).then_some((lo, hi)))
+    Ok((lo != 0.0 || hi != f64::INFINITY).then_some((lo, hi)))
 }
 
 /// Every setting with its default, from `FormFindSettings::default()`.
@@ -233,20 +253,9 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let (q_min, q_min_kind) = split(Some(s.q_min));
     let (q_max, q_max_kind) = split(s.q_max);
     d.set_item("method", name_of(&METHODS, f.method))?;
-    d.set_item("fairness", f.fairness)?;
-    d.set_item("max_height_change", f.max_height_change)?;
-    d.set_item("tolerance", f.tolerance)?;
-    d.set_item("max_iterations", f.max_iterations)?;
-    d.set_item("stall_window", f.stall_window)?;
-    d.set_item("odt_iterations", f.odt_iterations)?;
-    d.set_item("odt_free_boundary", f.odt_free_boundary)?;
-    d.set_item("proximal_weight", f.proximal_weight)?;
-    d.set_item("smoothing_decay", f.smoothing_decay)?;
-    d.set_item("schedule_mu0", f.schedule.mu0)?;
-    d.set_item("schedule_beta", f.schedule.beta)?;
-    d.set_item("schedule_mu_min", f.schedule.mu_min)?;
-    d.set_item("schedule_eta", f.schedule.eta)?;
-    d.set_item("schedule_pull", f.schedule.pull)?;
+    for (key, slot) in SCALARS {
+        d.set_item(key, slot.get(py, &f)?)?;
+    }
     d.set_item("q_min", q_min)?;
     d.set_item("q_min_kind", q_min_kind)?;
     d.set_item("q_max", q_max)?;
@@ -257,8 +266,6 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("load_rule", name_of(&LOAD_RULES, s.load_rule))?;
     d.set_item("formulation", name_of(&FORMULATIONS, s.formulation))?;
     d.set_item("qp_solver", name_of(&QP_SOLVERS, s.solver))?;
-    d.set_item("regularisation", s.regularisation)?;
-    d.set_item("dual_length_smoothing", s.dual_length_smoothing)?;
     d.set_item("dual_length_bounds", s.dual_length_bounds)?;
     Ok(d)
 }

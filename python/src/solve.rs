@@ -5,7 +5,7 @@ use crate::errors::{from_error, invalid};
 use crate::mesh::Mesh;
 use crate::results;
 use crate::settings;
-use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -90,7 +90,7 @@ pub fn form_find<'py>(
 }
 
 /// Writes `positions` with the mesh's faces (as given) to `path`, in the format of its
-/// extension, all or nothing.
+/// extension and the axes of the file the mesh was read from, all or nothing.
 #[pyfunction]
 pub fn write_mesh(
     mesh: &Bound<'_, Mesh>,
@@ -109,31 +109,9 @@ pub fn write_mesh(
         ));
     }
     let flat: Vec<f64> = positions.as_array().iter().copied().collect();
-    let rows: Vec<[f64; 3]> = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    // Written in the axes of the file the mesh was read from.
+    let rows: Vec<[f64; 3]> = (flat.chunks_exact(3))
+        .map(|c| m.up.to_file([c[0], c[1], c[2]]))
+        .collect();
     voussoir::io::write_mesh(&path, &rows, &m.input_faces()).map_err(|e| from_error("path", e))
-}
-
-/// Welded (n, 3) float64 vertices, (m, 3) uint32 faces and, per file vertex, its welded id.
-type WeldedArrays<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<u32>>,
-    Bound<'py, PyArray1<u32>>,
-);
-
-/// The vertices and faces of a mesh file, welded as `Mesh.from_file` welds them (no other
-/// check): what the command line's `--anchor-boundary` and `--anchor-lowest` look at.
-#[pyfunction]
-pub fn read_welded<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-    weld_tolerance: f64,
-) -> PyResult<WeldedArrays<'py>> {
-    let (positions, faces) = voussoir::io::read_mesh(&path).map_err(|e| from_error("path", e))?;
-    let w = voussoir::io::weld(&positions, &faces, weld_tolerance)
-        .map_err(|e| from_error("path", e))?;
-    Ok((
-        results::matrix(py, &w.positions),
-        results::matrix(py, &w.faces),
-        PyArray1::from_vec(py, w.welded_id),
-    ))
 }

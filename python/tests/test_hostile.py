@@ -137,6 +137,12 @@ SETTER_CASES = [
     ({"dual_length_bounds": (2.0, 1.0)}, "argument `dual_length_bounds`: 1 must be > lo (2)"),
     ({"q_min": 2.0, "q_max": 1.0}, "argument `q_max`: must be >= q_min"),
     ({"frobnicate": 1}, "argument `frobnicate`: is not a setting (see voussoir.defaults())"),
+    # Checked by the library's FormFindSettings::validate, as the C setters are.
+    ({"max_height_change": math.inf}, "argument `max_height_change`: inf is not finite"),
+    ({"schedule_eta": 0.0}, "argument `schedule_eta`: 0 must be > 0"),
+    ({"stall_window": 0}, "argument `stall_window`: must be >= 1"),
+    ({"max_iterations": -1}, "argument `max_iterations`: -1 is negative"),
+    ({"dual_length_bounds": (-1.0, 2.0)}, "argument `dual_length_bounds`: -1 must be >= 0"),
 ]
 
 

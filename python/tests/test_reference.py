@@ -51,3 +51,43 @@ def test_form_finding_equals_the_rust_api(name, models, formfind, tmp_path):
         assert np.array_equal(getattr(result, key), np.array(report[key])), key
     for key in NUMBERS:
         assert getattr(result, key) == report[key], key
+
+
+FORMATS = ("obj", "off", "ply", "stl")
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_every_format_reads_as_the_rust_api_reads_it(name, models, formfind, tmp_path):
+    """`Mesh.from_file` and the formfind example read a file through the same library call
+    (`io::read_model`): the same mesh, supports and stress in every format, with supports
+    from a file, the boundary or the lowest vertices."""
+    obj, supports = models / f"{name}.obj", models / f"{name}.json"
+    source = voussoir.Mesh.from_file(obj, supports)
+    ways = [(["--supports", supports], {"supports": supports})]
+    if name == "free_vault":
+        ways += [
+            (["--anchor-boundary"], {"anchor_boundary": True}),
+            (["--anchor-lowest", "0.02"], {"anchor_lowest": 0.02}),
+        ]
+    for fmt in FORMATS:
+        path = tmp_path / f"{name}.{fmt}"
+        source.write(path)
+        for flags, keywords in ways:
+            rust = subprocess.run(
+                [formfind, path, *flags, "--stress-only", "--out", "out.obj", "--report", "r.json",
+                 "--pictures", "pics"],
+                cwd=tmp_path,
+                capture_output=True,
+                text=True,
+            )
+            assert rust.returncode in (0, 3), rust.stderr
+            report = json.loads((tmp_path / "r.json").read_text())
+            mesh = voussoir.Mesh.from_file(path, **keywords)
+            what = f"{name}.{fmt} {flags[0]}"
+            assert np.array_equal(mesh.vertices, read_obj_vertices(tmp_path / "out.obj")), what
+            assert np.array_equal(mesh.anchored, np.array(report["anchored"], dtype=np.uint32)), what
+            assert np.array_equal(mesh.edges, np.array(report["edges"], dtype=np.uint32)), what
+            if fmt == "obj" or len(mesh.vertices) < 400:
+                result = voussoir.analyse(mesh)
+                assert np.array_equal(result.force_densities, np.array(report["force_densities"])), what
+                assert np.array_equal(result.residuals, np.array(report["residuals"])), what

@@ -10,6 +10,9 @@ compressive stress of a shape as it stands, `form_find` the nearest self-support
 Both take the library's settings as keyword arguments (see `Settings`; `defaults()` lists
 every default) and release the GIL while they solve. Bad input raises `VoussoirError`, a
 `ValueError`, with the library's one-line message naming the argument at fault.
+
+Interchange, imported on their own: `voussoir.rhino` (.3dm meshes; the `rhino` extra) and
+`voussoir.compas` (compas meshes, the `compas` extra; FormDiagram JSON, no extra needed).
 """
 
 from __future__ import annotations
@@ -48,7 +51,9 @@ def _floats(name: str, value: Any) -> Optional[np.ndarray]:
     if value is None:
         return None
     try:
-        return np.ascontiguousarray(value, dtype=np.float64)
+        array = np.asarray(value, dtype=np.float64)
+        # A single number stays 0-d: it stands for every face or vertex.
+        return array if array.ndim == 0 else np.ascontiguousarray(array)
     except (TypeError, ValueError) as e:
         raise VoussoirError(f"argument `{name}`: is not an array of numbers ({e})") from None
 
@@ -86,6 +91,8 @@ class Mesh:
             free boundary vertices; default 0.
         prescribed_tau: (n,) inward normal push per free boundary vertex, used with
             ``tau="prescribed"``; finite and >= 0; default 0.
+        A single number given for `face_density`, `extra_loads` or `prescribed_tau` stands
+            for every face or vertex.
 
     Raises:
         VoussoirError: the mesh or a load is invalid; the message names the argument, and the
@@ -122,35 +129,60 @@ class Mesh:
         supports: Optional[PathLike] = None,
         *,
         anchored: Any = None,
+        anchor_boundary: bool = False,
+        anchor_lowest: Optional[float] = None,
+        anchor_lowest_absolute: bool = False,
+        weld: bool = True,
         weld_tolerance: Optional[float] = None,
         repair_tolerance: Optional[float] = None,
+        up: str = "z",
         face_density: Any = None,
         extra_loads: Any = None,
         horizontal_forces: Any = None,
         prescribed_tau: Any = None,
     ) -> "Mesh":
-        """Reads an OBJ, OFF, STL or PLY file (by its extension; polygons split into fans).
+        """Reads an OBJ, OFF, STL or PLY file (by its extension; polygons split into fans,
+        whose diagonals q_min does not bind), as the library's ``io::read_model`` does.
 
         Args:
             path: the mesh file.
             supports: a JSON file of anchored vertex ids (``{"anchored": [ids]}`` or
-                ``[ids]``), the file's own 0-based vertex ids; or None to give `anchored`.
+                ``[ids]``), the file's own 0-based vertex ids; or None to give `anchored`,
+                `anchor_boundary` or `anchor_lowest` instead (one of the four).
             anchored: anchored file vertex ids when `supports` is None.
+            anchor_boundary: anchor every boundary vertex.
+            anchor_lowest: anchor every vertex within this of the lowest height, relative to
+                the bounding-box diagonal (absolute with ``anchor_lowest_absolute=True``).
+            weld: False keeps the file's vertices as they are (STL files, whose triangles
+                never share vertices, are welded all the same).
             weld_tolerance: vertices closer than this x the bounding-box diagonal are merged
                 (0: only equal positions); default ``voussoir.WELD_TOLERANCE``.
             repair_tolerance: faces whose plan area is below this x the median plan area are
                 mended by plan edge flips or the smallest plan move of a vertex (0: none,
                 such faces are rejected); default ``voussoir.REPAIR_TOLERANCE``.
+            up: "z", or "y" for a Y-up file (as most modellers export): the mesh is turned
+                Z-up, and `write` turns positions back.
             face_density, extra_loads, horizontal_forces, prescribed_tau: as for `Mesh`,
-                per vertex of the mesh read (after welding).
+                per face or vertex of the mesh read (after welding); a single number stands
+                for every face or vertex.
         """
         mesh = cls.__new__(cls)
+        if not weld:
+            tolerance = None
+        elif weld_tolerance is None:
+            tolerance = _native.WELD_TOLERANCE
+        else:
+            tolerance = float(weld_tolerance)
         mesh._native = _native.Mesh.read(
             os.fspath(_required("path", path)),
             None if supports is None else os.fspath(supports),
             None if anchored is None else _ids("anchored", anchored),
-            _native.WELD_TOLERANCE if weld_tolerance is None else float(weld_tolerance),
+            tolerance,
             _native.REPAIR_TOLERANCE if repair_tolerance is None else float(repair_tolerance),
+            bool(anchor_boundary),
+            None if anchor_lowest is None else float(anchor_lowest),
+            bool(anchor_lowest_absolute),
+            up,
             _floats("face_density", face_density),
             _floats("extra_loads", extra_loads),
             _floats("horizontal_forces", horizontal_forces),
@@ -215,7 +247,8 @@ class Mesh:
 
     def write(self, path: PathLike, positions: Any = None) -> None:
         """Writes `positions` (default: the mesh's own) with the faces to `path`: .obj, .off,
-        .ply (every bit kept) or .stl (single precision), all or nothing."""
+        .ply (every bit kept) or .stl (single precision), all or nothing, in the axes of the
+        file the mesh was read from (Y-up for ``up="y"``)."""
         points = self.vertices if positions is None else _floats("positions", positions)
         _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
 

@@ -65,6 +65,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--weld", type=float, default=voussoir.WELD_TOLERANCE,
                    help=f"merge vertices closer than TOL x bounding-box diagonal [{voussoir.WELD_TOLERANCE:g}]")
     p.add_argument("--no-weld", action="store_true", help="keep the file's vertices as they are")
+    p.add_argument("--up", choices=["z", "y"], default="z",
+                   help="the axis that points up in MESH; y for Y-up files (outputs keep MESH's axes) [z]")
     p.add_argument("--strict", action="store_true", help="reject plan slivers instead of mending them")
     p.add_argument("--out", type=Path, help="form-found mesh [formfind-out/NAME-formfound.obj]")
     p.add_argument("--report", type=Path, help="everything computed, as JSON [formfind-out/report.json]")
@@ -119,49 +121,24 @@ def settings_of(a: argparse.Namespace) -> Dict[str, Any]:
     return s
 
 
-def _boundary_vertices(faces: np.ndarray) -> List[int]:
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    return sorted(set(unique[counts == 1].ravel().tolist()))
-
-
-def _lowest_vertices(vertices: np.ndarray, faces: np.ndarray, text: str) -> List[int]:
-    value, kind = _bound("--anchor-lowest", text)
-    if value < 0:
-        raise Failure(f"--anchor-lowest: expected a number >= 0 or NUMBERabs, got `{text}`")
-    used = np.unique(faces.ravel())
-    points = vertices[used]
-    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-    reach = value if kind == "absolute" else value * diagonal
-    low = points[:, 2].min()
-    return [int(v) for v in used if vertices[v, 2] <= low + reach]
-
-
 def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
-    weld = 0.0 if a.no_weld else a.weld
-    if weld < 0:
-        raise Failure(f"--weld: must be >= 0, got {weld}")
-    anchored: Optional[List[int]] = None
-    if not a.supports:
-        # Boundary and heights of the welded mesh, named by a file vertex of each.
-        vertices, faces, welded_id = _native.read_welded(os.fspath(a.mesh), weld)
-        faces = faces.astype(np.int64)
-        if a.anchor_boundary:
-            chosen = _boundary_vertices(faces)
-        else:
-            chosen = _lowest_vertices(vertices, faces, a.anchor_lowest)
-        _, first_file_vertex = np.unique(welded_id, return_index=True)
-        anchored = [int(first_file_vertex[v]) for v in chosen]
-    probe = voussoir.Mesh.from_file(
-        a.mesh, a.supports, anchored=anchored, weld_tolerance=weld,
-        repair_tolerance=0.0 if a.strict else None,
-    )
-    if density == 1.0:
-        return probe
+    """The mesh of the command line, read by the library's one read path."""
+    lowest: Optional[Tuple[float, str]] = None
+    if a.anchor_lowest is not None:
+        lowest = _bound("--anchor-lowest", a.anchor_lowest)
+        if lowest[0] < 0:
+            raise Failure(f"--anchor-lowest: expected a number >= 0 or NUMBERabs, got `{a.anchor_lowest}`")
     return voussoir.Mesh.from_file(
-        a.mesh, a.supports, anchored=anchored, weld_tolerance=weld,
+        a.mesh,
+        a.supports,
+        anchor_boundary=a.anchor_boundary,
+        anchor_lowest=None if lowest is None else lowest[0],
+        anchor_lowest_absolute=lowest is not None and lowest[1] == "absolute",
+        weld=not a.no_weld,
+        weld_tolerance=a.weld,
         repair_tolerance=0.0 if a.strict else None,
-        face_density=np.full(len(probe.faces), density),
+        up=a.up,
+        face_density=density,
     )
 
 

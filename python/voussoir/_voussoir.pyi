@@ -26,8 +26,12 @@ class Mesh:
         path: str,
         supports: Optional[str],
         anchored: Optional[np.ndarray],
-        weld_tolerance: float,
+        weld_tolerance: Optional[float],
         repair_tolerance: float,
+        anchor_boundary: bool = ...,
+        anchor_lowest: Optional[float] = ...,
+        anchor_lowest_absolute: bool = ...,
+        up: str = ...,
         face_density: Optional[np.ndarray] = ...,
         extra_loads: Optional[np.ndarray] = ...,
         horizontal_forces: Optional[np.ndarray] = ...,
@@ -64,4 +68,3 @@ def form_find(
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
 ) -> Dict[str, Any]: ...
 def write_mesh(mesh: Mesh, positions: np.ndarray, path: str) -> None: ...
-def read_welded(path: str, weld_tolerance: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...

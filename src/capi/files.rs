@@ -8,10 +8,8 @@ use super::boundary::{CResult, Failure};
 use super::mesh::VsrMesh;
 use super::result::VsrResult;
 use super::status::VsrStatus;
-use crate::io;
-use crate::mesh::repair::{repair_plan, PlanRepair};
-use crate::mesh::Mesh;
-use crate::problem::Problem;
+use crate::io::{self, ReadOptions, Supports};
+use crate::mesh::repair::PlanRepair;
 
 /// A path argument: non-NULL, NUL-terminated UTF-8.
 ///
@@ -85,8 +83,8 @@ pub unsafe extern "C" fn vsr_mesh_read(
         let n = checked_len::<u32>("anchored", "n_anchored", n_anchored, 1)?;
         // SAFETY: length checked; readability is the caller's contract.
         let ids = unsafe { input("anchored", anchored, n)? };
-        let supports_path = if supports_path.is_null() {
-            None
+        let supports = if supports_path.is_null() {
+            Supports::Ids(ids.to_vec())
         } else {
             if n_anchored > 0 {
                 return Err(Failure::invalid(
@@ -95,51 +93,26 @@ pub unsafe extern "C" fn vsr_mesh_read(
                 ));
             }
             // SAFETY: non-NULL; NUL-terminated by the caller's contract.
-            Some(unsafe { path_arg("supports_path", supports_path)? })
+            Supports::File(unsafe { path_arg("supports_path", supports_path)? })
         };
-        for (name, value) in [
-            ("weld_tolerance", weld_tolerance),
-            ("repair_tolerance", repair_tolerance),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(Failure::invalid(
-                    name,
-                    format!("{value} is not a finite number >= 0"),
-                ));
+        let options = ReadOptions::new(supports)
+            .with_weld_tolerance(Some(weld_tolerance))
+            .with_repair_tolerance(repair_tolerance);
+        let model = io::read_model(&path, &options).map_err(|e| match e {
+            crate::Error::InvalidArgument { name, reason }
+                if matches!(name, "weld_tolerance" | "repair_tolerance") =>
+            {
+                Failure::invalid(name, reason)
             }
-        }
-        let ((positions, faces), diagonals) =
-            io::read_mesh_with_diagonals(&path).map_err(|e| from_error("path", e))?;
-        let ids = match &supports_path {
-            Some(p) => io::read_supports(p).map_err(|e| from_error("supports_path", e))?,
-            None => ids.to_vec(),
-        };
-        let welded =
-            io::weld(&positions, &faces, weld_tolerance).map_err(|e| from_error("path", e))?;
-        let anchored = welded
-            .map_ids(&ids)
-            .map_err(|e| from_error("anchored", e))?;
-        let (mut positions, mut faces) = (welded.positions, welded.faces);
-        let repairs = repair_plan(&mut positions, &mut faces, &anchored, repair_tolerance)
-            .map_err(|e| from_error("path", e))?;
-        let mesh = Mesh::new(positions, faces, &anchored).map_err(|e| from_error("path", e))?;
-        // q_min does not bind the diagonals of the file's polygons (see
-        // `Problem::with_polygon_diagonals`); welding or a repair's flip may have removed some.
-        let diagonals = mesh.interior_edges_among(
-            (diagonals.iter()).map(|d| d.map(|v| welded.welded_id[v as usize])),
-        );
-        let problem = Problem::new(mesh)
-            .with_polygon_diagonals(&diagonals)
-            .map_err(|e| from_error("path", e))?;
-        let handle = Box::new(VsrMesh {
-            problem,
-            welded_ids: Some(welded.welded_id),
-            repairs,
-        });
+            e if options.blames_supports_file(&e) => from_error("supports_path", e),
+            e => from_error("path", e),
+        })?;
         if !n_merged.is_null() {
+            let merged = model.weld.as_ref().map_or(0, |w| w.merged);
             // SAFETY: non-NULL; writable by the caller's contract.
-            unsafe { n_merged.write(welded.merged) };
+            unsafe { n_merged.write(merged) };
         }
+        let handle = Box::new(VsrMesh::from_model(model));
         // SAFETY: `out` is non-NULL and writable by the caller's contract.
         unsafe { out.write(Box::into_raw(handle)) };
         Ok(())
@@ -201,13 +174,8 @@ pub unsafe extern "C" fn vsr_result_write(
     boundary!({
         // SAFETY: forwarded caller's contract.
         let (result, mesh, path) = unsafe { write_args(result, mesh, path)? };
-        let m = &mesh.problem.mesh;
         let positions = result.positions();
-        let faces: Vec<[u32; 3]> = if m.reversed {
-            m.faces.iter().map(|&[a, b, c]| [a, c, b]).collect()
-        } else {
-            m.faces.clone()
-        };
+        let faces = mesh.problem.mesh.input_faces();
         let format = io::MeshFormat::from_path(&path).map_err(|e| from_error("path", e))?;
         if format == io::MeshFormat::ThreeMf {
             return Err(Failure::invalid(

@@ -18,6 +18,17 @@ pub struct VsrMesh {
     pub(crate) repairs: Vec<crate::mesh::repair::PlanRepair>,
 }
 
+impl VsrMesh {
+    /// The handle of a mesh file read by [`crate::io::read_model`].
+    pub(crate) fn from_model(model: crate::io::Model) -> VsrMesh {
+        VsrMesh {
+            problem: model.problem,
+            welded_ids: Some(model.welded_ids),
+            repairs: model.repairs,
+        }
+    }
+}
+
 /// Largest vertex count (ids are `uint32_t`).
 const MAX_VERTICES: usize = u32::MAX as usize;
 /// Largest triangle count (edge and half-edge ids must fit in `uint32_t`).

@@ -1,13 +1,14 @@
 //! `VsrSettings`: the options of both solves, with one validating setter per option.
 //!
-//! Defaults are those of the Rust [`FormFindSettings::default`]; every setter validates its
-//! value (and, for bounds, the combination with the other bound) before it changes anything.
+//! Defaults are those of the Rust [`FormFindSettings::default`]; every setter converts its
+//! arguments (enums, +INFINITY for "no bound") and leaves the range checks to
+//! [`FormFindSettings::validate`], through `update`, before it changes anything.
 //!
 //! Every option of [`FormFindSettings`] and its [`crate::StressSettings`] has a setter here.
-//! When an option is added to the Rust settings, add its
-//! `vsr_settings_set_*` function, a row in the defaults table of `vsr_settings_create` and in
-//! the `documented_defaults` test below, then rewrite the header
-//! (`VSR_BLESS=1 cargo test --test capi_header`).
+//! When an option is added to the Rust settings, add its `vsr_settings_set_*` function (see
+//! ARCHITECTURE.md, "Adding a setting") and a row in the defaults table of
+//! `vsr_settings_create`, then rewrite the header (`VSR_BLESS=1 cargo test --test
+//! capi_header`).
 
 use super::boundary::{boundary, handle_mut, out_ptr, CResult, Failure};
 use super::status::{self, VsrStatus};
@@ -96,38 +97,38 @@ pub unsafe extern "C" fn vsr_settings_destroy(settings: *mut VsrSettings) {
     })
 }
 
-/// Applies `f` to a copy of the settings, validates the copy, and stores it on success.
-unsafe fn update(settings: *mut VsrSettings, f: impl FnOnce(&mut FormFindSettings)) -> CResult {
+/// Applies `f` to a copy of the settings, validates the copy with the library's
+/// [`FormFindSettings::validate`] (the one set of range checks), and stores it on success.
+/// `args` maps the settings' field names to the setter's argument names, which a failure
+/// names; a field outside it, or a relation between two settings (q_max below q_min), keeps
+/// the setting's own name.
+unsafe fn update(
+    settings: *mut VsrSettings,
+    args: &[(&str, &str)],
+    f: impl FnOnce(&mut FormFindSettings),
+) -> CResult {
     // SAFETY: caller's contract (valid handle, exclusive access).
     let s = unsafe { handle_mut("settings", settings)? };
     let mut form = s.form.clone();
     f(&mut form);
-    form.stress.validate().map_err(|e| match e {
-        crate::Error::InvalidArgument { name, reason } => Failure::invalid(name, reason),
-        e => Failure::invalid("settings", e),
+    form.validate().map_err(|e| {
+        let relation = crate::validate::is_relation(&e);
+        let status = if crate::validate::is_not_finite(&e) {
+            VsrStatus::NonFinite
+        } else {
+            VsrStatus::InvalidArgument
+        };
+        match e {
+            crate::Error::InvalidArgument { name, reason } => {
+                let field = |a: &&(&str, &str)| a.0 == name && !relation;
+                let arg = args.iter().find(field).map_or(name, |a| a.1);
+                Failure::new(status, format!("argument `{arg}`: {reason}"))
+            }
+            e => Failure::invalid("settings", e),
+        }
     })?;
     s.form = form;
     Ok(())
-}
-
-fn finite(name: &str, v: f64) -> CResult<f64> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Failure::new(
-            VsrStatus::NonFinite,
-            format!("argument `{name}`: {v} is not finite"),
-        ))
-    }
-}
-
-fn at_least(name: &str, v: f64, min: f64, strict: bool) -> CResult<f64> {
-    let v = finite(name, v)?;
-    if v < min || (strict && v == min) {
-        let op = if strict { ">" } else { ">=" };
-        return Err(Failure::invalid(name, format!("{v} must be {op} {min}")));
-    }
-    Ok(v)
 }
 
 /// Sets the convergence tolerance on ε∞ = max |r_i| / mean p_i (dimensionless): form
@@ -141,13 +142,12 @@ pub unsafe extern "C" fn vsr_settings_set_tolerance(
     tolerance: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("tolerance", tolerance, 0.0, true)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.tolerance = v) }
+        unsafe { update(settings, &[], |f| f.tolerance = tolerance) }
     })
 }
 
-/// Sets the maximum number of form-finding iterations (stress steps), >= 1. Default 50.
+/// Sets the maximum number of form-finding iterations (stress steps), >= 1. Default 100.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -157,11 +157,8 @@ pub unsafe extern "C" fn vsr_settings_set_max_iterations(
     max_iterations: usize,
 ) -> VsrStatus {
     boundary!({
-        if max_iterations == 0 {
-            return Err(Failure::invalid("max_iterations", "must be >= 1"));
-        }
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.max_iterations = max_iterations) }
+        unsafe { update(settings, &[], |f| f.max_iterations = max_iterations) }
     })
 }
 
@@ -176,11 +173,9 @@ pub unsafe extern "C" fn vsr_settings_set_stall_window(
     iterations: usize,
 ) -> VsrStatus {
     boundary!({
-        if iterations == 0 {
-            return Err(Failure::invalid("iterations", "must be >= 1"));
-        }
+        let args = [("stall_window", "iterations")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stall_window = iterations) }
+        unsafe { update(settings, &args, |f| f.stall_window = iterations) }
     })
 }
 
@@ -199,14 +194,13 @@ pub unsafe extern "C" fn vsr_settings_set_q_min(
 ) -> VsrStatus {
     boundary!({
         let relative = status::bound_kind("kind", kind)?;
-        let v = at_least("value", value, 0.0, false)?;
         let bound = if relative {
-            QBound::Relative(v)
+            QBound::Relative(value)
         } else {
-            QBound::Absolute(v)
+            QBound::Absolute(value)
         };
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.q_min = bound) }
+        unsafe { update(settings, &[("q_min", "value")], |f| f.stress.q_min = bound) }
     })
 }
 
@@ -224,7 +218,7 @@ pub unsafe extern "C" fn vsr_settings_set_q_min_scope(
     boundary!({
         let scope = status::edge_scope("scope", scope)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.q_min_scope = scope) }
+        unsafe { update(settings, &[], |f| f.stress.q_min_scope = scope) }
     })
 }
 
@@ -244,16 +238,13 @@ pub unsafe extern "C" fn vsr_settings_set_q_max(
         let relative = status::bound_kind("kind", kind)?;
         let bound = if value == f64::INFINITY {
             None
+        } else if relative {
+            Some(QBound::Relative(value))
         } else {
-            let v = at_least("value", value, 0.0, true)?;
-            Some(if relative {
-                QBound::Relative(v)
-            } else {
-                QBound::Absolute(v)
-            })
+            Some(QBound::Absolute(value))
         };
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.q_max = bound) }
+        unsafe { update(settings, &[("q_max", "value")], |f| f.stress.q_max = bound) }
     })
 }
 
@@ -270,7 +261,7 @@ pub unsafe extern "C" fn vsr_settings_set_tau_mode(
     boundary!({
         let mode = status::tau_mode("mode", mode)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.tau = mode) }
+        unsafe { update(settings, &[], |f| f.stress.tau = mode) }
     })
 }
 
@@ -287,7 +278,7 @@ pub unsafe extern "C" fn vsr_settings_set_hole_mode(
     boundary!({
         let mode = status::hole_mode("mode", mode)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.holes = mode) }
+        unsafe { update(settings, &[], |f| f.stress.holes = mode) }
     })
 }
 
@@ -303,7 +294,7 @@ pub unsafe extern "C" fn vsr_settings_set_method(
     boundary!({
         let method = status::method("method", method)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.method = method) }
+        unsafe { update(settings, &[], |f| f.method = method) }
     })
 }
 
@@ -320,9 +311,8 @@ pub unsafe extern "C" fn vsr_settings_set_fairness(
     gamma: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("gamma", gamma, 0.0, false)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.fairness = v) }
+        unsafe { update(settings, &[("fairness", "gamma")], |f| f.fairness = gamma) }
     })
 }
 
@@ -338,9 +328,9 @@ pub unsafe extern "C" fn vsr_settings_set_max_height_change(
     diagonals: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("diagonals", diagonals, 0.0, true)?;
+        let args = [("max_height_change", "diagonals")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.max_height_change = v) }
+        unsafe { update(settings, &args, |f| f.max_height_change = diagonals) }
     })
 }
 
@@ -357,7 +347,7 @@ pub unsafe extern "C" fn vsr_settings_set_load_rule(
     boundary!({
         let rule = status::load_rule("rule", rule)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.load_rule = rule) }
+        unsafe { update(settings, &[], |f| f.stress.load_rule = rule) }
     })
 }
 
@@ -374,7 +364,7 @@ pub unsafe extern "C" fn vsr_settings_set_formulation(
     boundary!({
         let formulation = status::formulation("formulation", formulation)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.formulation = formulation) }
+        unsafe { update(settings, &[], |f| f.stress.formulation = formulation) }
     })
 }
 
@@ -392,7 +382,7 @@ pub unsafe extern "C" fn vsr_settings_set_qp_solver(
     boundary!({
         let solver = status::qp_solver("solver", solver)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.solver = solver) }
+        unsafe { update(settings, &[], |f| f.stress.solver = solver) }
     })
 }
 
@@ -408,9 +398,9 @@ pub unsafe extern "C" fn vsr_settings_set_regularisation(
     epsilon: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("epsilon", epsilon, 0.0, false)?;
+        let args = [("regularisation", "epsilon")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.regularisation = v) }
+        unsafe { update(settings, &args, |f| f.stress.regularisation = epsilon) }
     })
 }
 
@@ -428,13 +418,14 @@ pub unsafe extern "C" fn vsr_settings_set_dual_length_bounds(
     hi: f64,
 ) -> VsrStatus {
     boundary!({
-        let lo = at_least("lo", lo, 0.0, false)?;
-        if hi.is_nan() || hi <= lo {
-            return Err(Failure::invalid("hi", format!("{hi} must be > lo ({lo})")));
-        }
-        let bounds = (lo > 0.0 || hi.is_finite()).then_some((lo, hi));
+        // Unbounded on both sides: no bounds (any other pair is checked as given).
+        let bounds = (lo != 0.0 || hi != f64::INFINITY).then_some((lo, hi));
+        let args = [
+            ("dual_length_bounds.lo", "lo"),
+            ("dual_length_bounds.hi", "hi"),
+        ];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.stress.dual_length_bounds = bounds) }
+        unsafe { update(settings, &args, |f| f.stress.dual_length_bounds = bounds) }
     })
 }
 
@@ -454,14 +445,13 @@ pub unsafe extern "C" fn vsr_settings_set_dual_length_smoothing(
     decay: f64,
 ) -> VsrStatus {
     boundary!({
-        let mu = at_least("mu", mu, 0.0, false)?;
-        let decay = at_least("decay", decay, 0.0, false)?;
-        if decay >= 1.0 {
-            return Err(Failure::invalid("decay", format!("{decay} must be < 1")));
-        }
+        let args = [
+            ("dual_length_smoothing", "mu"),
+            ("smoothing_decay", "decay"),
+        ];
         // SAFETY: forwarded caller's contract.
         unsafe {
-            update(settings, |f| {
+            update(settings, &args, |f| {
                 f.stress.dual_length_smoothing = mu;
                 f.smoothing_decay = decay;
             })
@@ -480,9 +470,9 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_mu0(
     mu0: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("mu0", mu0, 0.0, false)?;
+        let args = [("schedule.mu0", "mu0")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.schedule.mu0 = v) }
+        unsafe { update(settings, &args, |f| f.schedule.mu0 = mu0) }
     })
 }
 
@@ -497,12 +487,9 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_beta(
     beta: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("beta", beta, 0.0, false)?;
-        if v > 1.0 {
-            return Err(Failure::invalid("beta", format!("{v} must be <= 1")));
-        }
+        let args = [("schedule.beta", "beta")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.schedule.beta = v) }
+        unsafe { update(settings, &args, |f| f.schedule.beta = beta) }
     })
 }
 
@@ -516,9 +503,9 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_mu_min(
     mu_min: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("mu_min", mu_min, 0.0, false)?;
+        let args = [("schedule.mu_min", "mu_min")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.schedule.mu_min = v) }
+        unsafe { update(settings, &args, |f| f.schedule.mu_min = mu_min) }
     })
 }
 
@@ -533,9 +520,9 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_eta(
     eta: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("eta", eta, 0.0, true)?;
+        let args = [("schedule.eta", "eta")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.schedule.eta = v) }
+        unsafe { update(settings, &args, |f| f.schedule.eta = eta) }
     })
 }
 
@@ -550,9 +537,9 @@ pub unsafe extern "C" fn vsr_settings_set_schedule_pull(
     pull: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("pull", pull, 0.0, false)?;
+        let args = [("schedule.pull", "pull")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.schedule.pull = v) }
+        unsafe { update(settings, &args, |f| f.schedule.pull = pull) }
     })
 }
 
@@ -569,9 +556,9 @@ pub unsafe extern "C" fn vsr_settings_set_proximal_weight(
     weight: f64,
 ) -> VsrStatus {
     boundary!({
-        let v = at_least("weight", weight, 0.0, false)?;
+        let args = [("proximal_weight", "weight")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.proximal_weight = v) }
+        unsafe { update(settings, &args, |f| f.proximal_weight = weight) }
     })
 }
 
@@ -589,7 +576,7 @@ pub unsafe extern "C" fn vsr_settings_set_odt_iterations(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.odt_iterations = iterations) }
+        unsafe { update(settings, &[], |f| f.odt_iterations = iterations) }
     })
 }
 
@@ -611,7 +598,7 @@ pub unsafe extern "C" fn vsr_settings_set_odt_free_boundary(
             v => return Err(Failure::invalid("enable", format!("{v} is not 0 or 1"))),
         };
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |f| f.odt_free_boundary = on) }
+        unsafe { update(settings, &[], |f| f.odt_free_boundary = on) }
     })
 }
 

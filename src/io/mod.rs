@@ -1,13 +1,13 @@
 //! Mesh files (OBJ, OFF, STL, PLY, chosen by extension through [`read_mesh`] and
-//! [`write_mesh`]; 3MF for closed solids, written only), welding of duplicated vertices ([`weld`]), and a JSON sidecar listing the
-//! anchored (support) vertices.
+//! [`write_mesh`]; 3MF for closed solids, written only), welding of duplicated vertices
+//! ([`weld`]), a JSON sidecar listing the anchored (support) vertices, and [`read_model`],
+//! which makes a [`crate::Problem`] of a file: the read path of every layer.
 //!
 //! ```no_run
-//! use std::path::Path;
-//! let mesh = voussoir::io::load_model(
-//!     Path::new("models/hex.obj"),
-//!     Path::new("models/hex.json"),
-//! )?;
+//! use voussoir::io::{read_model, ReadOptions, Supports};
+//! let options = ReadOptions::new(Supports::Boundary).with_weld_tolerance(Some(1e-6));
+//! let model = read_model("models/hex.stl".as_ref(), &options)?;
+//! let mesh = &model.problem.mesh;
 //! println!("{} vertices, {} holes", mesh.n_vertices(), mesh.holes().count());
 //! # Ok::<(), voussoir::Error>(())
 //! ```
@@ -16,6 +16,7 @@ mod atomic;
 mod format;
 #[cfg(test)]
 mod format_tests;
+mod model;
 mod obj;
 mod off;
 mod ply;
@@ -32,10 +33,11 @@ mod weld_tests;
 
 use std::path::Path;
 
-use crate::{Mesh, Result};
+use crate::{Problem, Result};
 
 pub use atomic::output_target;
 pub use format::{read_mesh, read_mesh_with_diagonals, write_mesh, write_mesh_as, MeshFormat};
+pub use model::{read_model, Model, ReadOptions, Supports, UpAxis, WeldSummary};
 pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
 pub use off::parse_off;
 pub use ply::parse_ply;
@@ -44,7 +46,7 @@ pub use supports::{parse_supports, read_supports};
 pub use weld::{weld, Welded, DEFAULT_WELD_TOLERANCE};
 
 /// Vertex positions (x, y plan; z height) and triangles (0-based vertex ids), as read from a
-/// file, before validation by [`Mesh::new`].
+/// file, before validation by [`crate::Mesh::new`].
 pub type RawMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
 /// A [`RawMesh`] and the diagonals that split its polygons (vertex pairs).
@@ -100,11 +102,11 @@ fn excerpt(text: &str) -> String {
     out
 }
 
-/// Reads an OBJ mesh and its JSON supports file, and validates them with [`Mesh::new`].
-pub fn load_model(obj: &Path, supports: &Path) -> Result<Mesh> {
-    let (positions, faces) = read_obj(obj)?;
-    let anchored = read_supports(supports)?;
-    Mesh::new(positions, faces, &anchored)
+/// [`read_model`] of a mesh file (any format) with its JSON supports file and the default
+/// options: the problem alone.
+pub fn load_model(mesh: &Path, supports: &Path) -> Result<Problem> {
+    let options = ReadOptions::new(Supports::File(supports.to_path_buf()));
+    read_model(mesh, &options).map(|m| m.problem)
 }
 
 /// A crate's error message on one line (some span several, with tabs).

@@ -367,7 +367,7 @@ fn load_model_from_files() {
     let json = dir.0.join("m.json");
     fs::write(&obj, format!("{SQUARE}v 9 9 9\nf 1 2 3 4\n")).unwrap();
     fs::write(&json, "{\"anchored\": [0, 1]}").unwrap();
-    let mesh = load_model(&obj, &json).unwrap();
+    let mesh = load_model(&obj, &json).unwrap().mesh;
     assert_eq!(
         (mesh.n_vertices(), mesh.n_edges(), mesh.n_faces()),
         (5, 5, 2)

@@ -16,6 +16,16 @@ impl Mesh {
             .collect()
     }
 
+    /// The faces in the orientation they were given ([`Mesh::faces`] are counter-clockwise in
+    /// plan, all reversed when the input was clockwise): the faces to write back.
+    pub fn input_faces(&self) -> Vec<[u32; 3]> {
+        if self.reversed {
+            self.faces.iter().map(|&[a, b, c]| [a, c, b]).collect()
+        } else {
+            self.faces.clone()
+        }
+    }
+
     /// L₀, the length unit of relative force-density bounds ([`crate::QBound::Relative`]):
     /// half the plan bounding-box diagonal of the referenced vertices at `positions`.
     pub fn plan_scale(&self, positions: &[[f64; 3]]) -> f64 {

@@ -42,6 +42,19 @@ impl Default for Schedule {
     }
 }
 
+impl Schedule {
+    /// Checks every parameter, naming the first bad one (`schedule.mu0`, ...): μ₀, μ_min and
+    /// ν finite and >= 0, β in [0, 1], η finite and > 0.
+    pub fn validate(&self) -> Result<()> {
+        use crate::validate::{above, at_least, within};
+        at_least("schedule.mu0", self.mu0, 0.0)?;
+        within("schedule.beta", self.beta, 0.0, 1.0, false)?;
+        at_least("schedule.mu_min", self.mu_min, 0.0)?;
+        above("schedule.eta", self.eta, 0.0)?;
+        at_least("schedule.pull", self.pull, 0.0)
+    }
+}
+
 crate::setters::with_setters!(Schedule {
     with_mu0: mu0: f64,
     with_beta: beta: f64,

@@ -5,7 +5,7 @@
 mod nearest;
 mod paper;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::problem::Problem;
 use crate::shape::Schedule;
 use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus};
@@ -191,34 +191,32 @@ pub fn form_find(
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
 ) -> Result<FormFindResult> {
-    validate(settings)?;
+    settings.validate()?;
     match settings.method {
         FormMethod::Nearest => nearest::nearest(problem, settings, progress),
         FormMethod::Paper => paper::paper(problem, settings, progress),
     }
 }
 
-fn validate(settings: &FormFindSettings) -> Result<()> {
-    settings.stress.validate()?;
-    let bad = |name, reason: &str| {
-        Err(Error::InvalidArgument {
-            name,
-            reason: reason.into(),
-        })
-    };
-    if !(settings.tolerance > 0.0 && settings.tolerance.is_finite()) {
-        return bad("tolerance", "must be finite and > 0");
+impl FormFindSettings {
+    /// Checks every setting, naming the first bad one ([`crate::Error::InvalidArgument`] with the
+    /// field's name): the stress settings ([`StressSettings::validate`]) and the schedule
+    /// ([`Schedule::validate`]); tolerance and max_height_change finite and > 0; fairness and
+    /// proximal_weight finite and >= 0; smoothing_decay in [0, 1); max_iterations and
+    /// stall_window >= 1. [`form_find`] calls it, and so does every layer (C, Python, command
+    /// line) before it keeps a setting.
+    pub fn validate(&self) -> Result<()> {
+        use crate::validate::{above, at_least, count, within};
+        self.stress.validate()?;
+        above("tolerance", self.tolerance, 0.0)?;
+        count("max_iterations", self.max_iterations, 1)?;
+        count("stall_window", self.stall_window, 1)?;
+        at_least("fairness", self.fairness, 0.0)?;
+        above("max_height_change", self.max_height_change, 0.0)?;
+        at_least("proximal_weight", self.proximal_weight, 0.0)?;
+        within("smoothing_decay", self.smoothing_decay, 0.0, 1.0, true)?;
+        self.schedule.validate()
     }
-    if !(0.0..1.0).contains(&settings.smoothing_decay) {
-        return bad("smoothing_decay", "must be in [0, 1)");
-    }
-    if !(settings.fairness >= 0.0 && settings.fairness.is_finite()) {
-        return bad("fairness", "must be finite and >= 0");
-    }
-    if settings.max_height_change.is_nan() || settings.max_height_change <= 0.0 {
-        return bad("max_height_change", "must be > 0");
-    }
-    Ok(())
 }
 
 /// What a loop hands to [`finish`].

@@ -135,39 +135,34 @@ impl Default for StressSettings {
 }
 
 impl StressSettings {
-    /// Rejects NaN, negative or inconsistent values, naming the field.
+    /// Checks every field, naming the first bad one ([`Error::InvalidArgument`] with the
+    /// field's name; `dual_length_bounds.lo` and `.hi` for the bounds): q_min finite and at
+    /// least 0; q_max finite and positive, and at least q_min when both have the same kind;
+    /// the dual length bounds with lo finite and at least 0, hi above lo (hi may be +∞); the
+    /// smoothing weight and the regularisation finite and at least 0. Every layer (C, Python,
+    /// command line) calls this.
     pub fn validate(&self) -> Result<()> {
-        let bad = |name, reason: &str| {
-            Err(Error::InvalidArgument {
-                name,
-                reason: reason.into(),
-            })
-        };
+        use crate::validate::{above, at_least};
         let q_min = self.q_min.value();
-        if !q_min.is_finite() || q_min < 0.0 {
-            return bad("q_min", "must be finite and >= 0");
-        }
+        at_least("q_min", q_min, 0.0)?;
         if let Some(q_max) = self.q_max {
             let v = q_max.value();
-            if v.is_nan() || v <= 0.0 {
-                return bad("q_max", "must be > 0 (or unset)");
-            }
+            above("q_max", v, 0.0)?;
             if std::mem::discriminant(&q_max) == std::mem::discriminant(&self.q_min) && v < q_min {
-                return bad("q_max", "must be >= q_min");
+                return Err(crate::validate::below_other("q_max", "q_min"));
             }
         }
         if let Some((lo, hi)) = self.dual_length_bounds {
-            if !(lo.is_finite() && lo >= 0.0 && hi > lo) {
-                return bad("dual_length_bounds", "must be finite with 0 <= lo < hi");
+            at_least("dual_length_bounds.lo", lo, 0.0)?;
+            if hi.is_nan() || hi <= lo {
+                return Err(Error::InvalidArgument {
+                    name: "dual_length_bounds.hi",
+                    reason: format!("{hi} must be > lo ({lo})"),
+                });
             }
         }
-        if !self.dual_length_smoothing.is_finite() || self.dual_length_smoothing < 0.0 {
-            return bad("dual_length_smoothing", "must be finite and >= 0");
-        }
-        if !self.regularisation.is_finite() || self.regularisation < 0.0 {
-            return bad("regularisation", "must be finite and >= 0");
-        }
-        Ok(())
+        at_least("dual_length_smoothing", self.dual_length_smoothing, 0.0)?;
+        at_least("regularisation", self.regularisation, 0.0)
     }
 }
 

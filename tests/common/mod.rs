@@ -46,7 +46,8 @@ pub fn load_model(name: &str) -> Option<Mesh> {
             &dir.join(format!("{name}.obj")),
             &dir.join(format!("{name}.json")),
         )
-        .unwrap_or_else(|e| panic!("{name}: {e}")),
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+        .mesh,
     )
 }
 

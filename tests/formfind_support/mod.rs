@@ -115,6 +115,7 @@ pub fn run(cwd: &Path, args: &[&str]) -> Output {
         .expect("formfind runs")
 }
 
+pub mod views;
 pub mod xml;
 
 #[path = "../common/models.rs"]
