@@ -236,6 +236,9 @@ fn ascii_stl_with_several_solids_and_a_nameless_one() {
     let text = format!("solid\n{facet}endsolid\nsolid two\n{facet}{facet}endsolid two\n");
     let (p, f) = parse_stl(text.as_bytes(), "x.stl").unwrap();
     assert_eq!((p.len(), f.len()), (9, 3));
+    // A solid without facets is no parse error: the mesh it makes is empty.
+    let (p, f) = parse_stl(b"solid x\nendsolid x\n", "x.stl").unwrap();
+    assert!(p.is_empty() && f.is_empty());
 }
 
 #[test]

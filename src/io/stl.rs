@@ -151,8 +151,8 @@ struct AsciiReader {
 impl AsciiReader {
     /// What the file must still hold, if it cannot end here.
     fn expected(&self) -> Option<String> {
+        // A file read at all began with `solid`: at `Solid`, every solid has ended.
         match self.expect {
-            Expect::Solid if self.triangles.is_empty() => Some("`solid`".into()),
             Expect::Solid => None,
             other => Some(self.describe(other)),
         }

@@ -329,6 +329,18 @@ fn malformed_supports_report_line_and_reason() {
         ("{\n \"anchored\": [1, 2\n", 3, "invalid JSON"),
         ("", 1, "invalid JSON"),
     ];
+    // A long bad value is quoted by an excerpt, not in full.
+    let long = format!("[\"{}\"]", "x".repeat(100_000));
+    match parse_supports(&long, "s.json") {
+        Err(Error::Parse { reason, .. }) => {
+            assert!(reason.len() < 200, "{} bytes", reason.len());
+            assert!(
+                reason.contains(&format!("\"{}…\"", "x".repeat(40))),
+                "{reason}"
+            );
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
     for &(text, line, needle) in cases {
         match parse_supports(text, "s.json") {
             Err(Error::Parse {
