@@ -168,7 +168,9 @@ Solver:
                          lengths at each face (a smoother force diagram)   [{smooth}]
   --smoothing-decay D    form finding fades MU as MU D^k, 0 <= D < 1;
                          nearer 1: smoother, further from the input        [{decay}]
-  --odt N                ODT smoothing of the plan before each of the first N stress steps [0]
+  --odt N                ODT sweeps of the plan: the nearest method runs all N
+                         on the input first; the paper method one before
+                         each of its first N stress steps                  [0]
   --density D            weight per unit area of every face                [1]
   --load R               barycentric | voronoi | plan: face weight sharing [{load}]
   -h, --help             this text

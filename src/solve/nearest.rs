@@ -231,10 +231,14 @@ impl<'a, 'p> Nearest<'a, 'p> {
             let prior = self.held.clone();
             let answer = self.stress_step(Some(&prior))?;
             self.held = answer;
-            if let Some(t) = self.after_stress_step() {
+            // Recorded before anything ends the loop, so that a run stopped here (budget,
+            // callback) answers the best state of its whole history.
+            let ended = self.after_stress_step();
+            let settled = self.record();
+            if let Some(t) = ended {
                 return Ok(t);
             }
-            if self.record() {
+            if settled {
                 return Ok(Termination::Converged);
             }
             stage_rounds += 1;

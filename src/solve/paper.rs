@@ -148,7 +148,6 @@ pub(super) fn paper_within(
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
         let certified_eps = certified.eps_inf;
-        lowest.offer(&positions, &certified);
         last = Some(certified);
         if certified_eps < settings.tolerance {
             history.push(certified_eps);
@@ -174,9 +173,9 @@ pub(super) fn paper_within(
     ))
 }
 
-/// The lowest-ε∞ state reached (heights with the forces certified there), the answer of a loop
-/// that ends without converging: later steps of a stalled loop may have moved further from
-/// balance.
+/// The lowest-ε∞ state of the stress steps (heights with the forces certified there, the
+/// states the history lists), the answer of a loop that ends without converging: later steps
+/// of a stalled loop may have moved further from balance.
 #[derive(Default)]
 struct Lowest {
     state: Option<(Vec<[f64; 3]>, StressResult)>,

@@ -406,8 +406,24 @@ pub fn analyse_cached(
     })
 }
 
-/// A stress step's data in frame units (z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄), the
-/// same for all its attempts, with the physical loads and scales.
+/// Heights over `l0`, relative to the mean height of the anchored vertices (of all referenced
+/// ones without any) where that lies far from them (`crate::geometry::far_base`): the QP sees
+/// only their differences, which keep their digits where a model lifted by 10⁷ would lose
+/// seven of them to z / L₀ rounded at that size. Elsewhere the heights are taken as they are,
+/// so that ordinary models are solved with the same arithmetic wherever they stand.
+fn relative_heights(mesh: &Mesh, positions: &[[f64; 3]], l0: f64) -> Vec<f64> {
+    let heights = |keep: &dyn Fn(usize) -> bool| {
+        (0..positions.len())
+            .filter(|&v| mesh.referenced[v] && keep(v))
+            .map(|v| positions[v][2])
+            .collect::<Vec<f64>>()
+    };
+    let supports = heights(&|v| mesh.anchored[v]);
+    let all = heights(&|_| true);
+    let base = crate::geometry::far_base(if supports.is_empty() { &all } else { &supports }, &all);
+    positions.iter().map(|p| (p[2] - base) / l0).collect()
+}
+
 struct FramedStep {
     frame: Frame,
     plan: Plan,
@@ -417,6 +433,7 @@ struct FramedStep {
     p_bar: f64,
     /// The natural force density scale p̄ / L₀.
     unit: f64,
+    /// Heights in frame units, relative to the supports' mean height (`relative_heights`).
     z: Vec<f64>,
     p: Vec<f64>,
     normal: Vec<[f64; 2]>,
@@ -443,7 +460,7 @@ impl FramedStep {
         let (load, free, p_bar) = loads_at(problem, positions, settings);
         check_mean_load(&load, &free)?;
         let unit = p_bar / l0;
-        let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
+        let z = relative_heights(mesh, positions, l0);
         let p: Vec<f64> = match load_offset {
             Some(offset) => (load.iter().zip(offset))
                 .map(|(x, o)| (x + o) / p_bar)
