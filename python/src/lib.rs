@@ -5,6 +5,7 @@
 //! `voussoir/_results.py` wraps in typed classes. Errors carry the C API's one-line messages,
 //! with the argument named as the Python signature names it.
 
+mod assess;
 mod errors;
 mod mesh;
 mod results;
@@ -27,6 +28,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(settings::defaults, m)?)?;
     m.add_function(wrap_pyfunction!(solve::analyse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
+    m.add_function(wrap_pyfunction!(assess::assess, m)?)?;
     m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
     Ok(())
 }

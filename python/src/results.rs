@@ -87,7 +87,7 @@ pub fn stress<'py>(
 }
 
 /// (name, the vertices it lists, the constraint, hint or failure it names).
-fn termination(t: &Termination) -> (&'static str, Vec<u32>, Option<String>) {
+pub fn termination(t: &Termination) -> (&'static str, Vec<u32>, Option<String>) {
     match t {
         Termination::Converged => ("converged", vec![], None),
         Termination::MaxIterations => ("max_iterations", vec![], None),
