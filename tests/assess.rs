@@ -145,6 +145,22 @@ fn a_self_supporting_middle_surface_is_its_own_nearest_thrust_surface() {
         .map(|(a, b)| (a[2] - b[2]).abs())
         .fold(0.0, f64::max);
     assert!(moved < 1e-4, "moved {moved}");
+    // Its least thickness over any family about it is 0.
+    let problem = Problem::new(truth.clone());
+    let envelope_at = |t: f64| Envelope::from_thickness(&truth, &Thickness::Uniform(t));
+    let family = min_thickness_of_family(
+        &problem,
+        envelope_at,
+        0.05,
+        1e-3,
+        &AssessSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        family.converged && family.thickness < 1e-7,
+        "{}",
+        family.thickness
+    );
 }
 
 /// A hemispherical dome: every analysis returns a certified thrust surface, the least

@@ -2,7 +2,7 @@
 //! settings → `AssessSettings` (checked as the C API's `vsr_assess_settings_set_*` check them,
 //! with the same messages), and `voussoir::assess` with the GIL released.
 
-use crate::errors::{from_error, invalid, not_finite};
+use crate::errors::{from_error, invalid};
 use crate::mesh::{shape_text, Mesh};
 use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -35,7 +35,7 @@ fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(not_finite(name, x))
+        Err(invalid(name, format_args!("{x} is not finite")))
     }
 }
 
@@ -310,5 +310,77 @@ fn fields<'py>(
         "face_thickness",
         PyArray1::from_slice(py, &env.face_thickness),
     )?;
+    Ok(d)
+}
+
+/// Per-vertex bounds from `envelope_at(t)`: a pair (lower, upper) of n floats each.
+fn family_member(
+    py: Python<'_>,
+    mesh: &voussoir::Mesh,
+    envelope_at: &Py<PyAny>,
+    t: f64,
+) -> PyResult<Envelope> {
+    let answer = envelope_at.call1(py, (t,))?;
+    let (lower, upper): (PyReadonlyArrayDyn<'_, f64>, PyReadonlyArrayDyn<'_, f64>) =
+        answer.bind(py).extract().map_err(|_| {
+            invalid(
+                "envelope_at",
+                format_args!(
+                    "envelope_at({t}) did not return a pair (lower, upper) of float arrays"
+                ),
+            )
+        })?;
+    let lower = floats("envelope_at", &lower, "lower bound")?;
+    let upper = floats("envelope_at", &upper, "upper bound")?;
+    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
+        .map_err(|e| from_error("envelope_at", e))
+}
+
+/// `min_thickness_of_family(mesh, envelope_at, thickness, scale_tolerance, settings)`: the
+/// least certified thickness of the family and its analysis' fields, with `thickness`,
+/// `rounds` and `family_converged` added.
+#[pyfunction]
+pub fn min_thickness_of_family<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    envelope_at: Bound<'py, PyAny>,
+    thickness: f64,
+    scale_tolerance: f64,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !envelope_at.is_callable() {
+        return Err(invalid("envelope_at", "is not callable"));
+    }
+    let s = settings_from(settings)?;
+    let m: &Mesh = mesh.get();
+    let mesh_ref = &m.problem.mesh;
+    let callback = envelope_at.unbind();
+    let callback = &callback;
+    let mut raised: Option<PyErr> = None;
+    let found = py.detach(|| {
+        let member = |t: f64| {
+            Python::attach(|py| {
+                py.check_signals()
+                    .and_then(|_| family_member(py, mesh_ref, callback, t))
+            })
+            .map_err(|e| {
+                raised = Some(e);
+                voussoir::Error::InvalidArgument {
+                    name: "envelope_at",
+                    reason: "raised an exception".into(),
+                }
+            })
+        };
+        voussoir::min_thickness_of_family(&m.problem, member, thickness, scale_tolerance, &s)
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    let found = found.map_err(|e| from_error("envelope_at", e))?;
+    let env = family_member(py, mesh_ref, callback, found.thickness)?;
+    let d = fields(py, mesh_ref, &env, &found.result)?;
+    d.set_item("thickness", found.thickness)?;
+    d.set_item("rounds", found.rounds)?;
+    d.set_item("family_converged", found.converged)?;
     Ok(d)
 }

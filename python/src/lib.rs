@@ -29,6 +29,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::analyse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
     m.add_function(wrap_pyfunction!(assess::assess, m)?)?;
+    m.add_function(wrap_pyfunction!(assess::min_thickness_of_family, m)?)?;
     m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
     Ok(())
 }

@@ -75,4 +75,11 @@ def assess(
     settings: Dict[str, Any],
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
 ) -> Dict[str, Any]: ...
+def min_thickness_of_family(
+    mesh: Mesh,
+    envelope_at: Callable[[float], Tuple[np.ndarray, np.ndarray]],
+    thickness: float,
+    scale_tolerance: float,
+    settings: Dict[str, Any],
+) -> Dict[str, Any]: ...
 def write_mesh(mesh: Mesh, positions: np.ndarray, path: str) -> None: ...

@@ -13,7 +13,9 @@ pub struct FamilyThickness {
     /// The least thickness found whose envelope holds a certified thrust surface.
     pub thickness: f64,
     /// The least-thickness analysis of `E(thickness)`: its surface lies inside the envelope
-    /// scaled by `thickness_scale` ≤ 1 about its middle, so inside `E(thickness)`.
+    /// scaled by `thickness_scale` ≤ 1 about its middle, so inside `E(thickness)`. (When
+    /// the middle surface stands, the analysis of the last round's `E(t_k)`, with
+    /// `thickness` = t_k × `thickness_scale`.)
     pub result: AssessResult,
     /// Least-thickness analyses run in all (one per thickness tried).
     pub rounds: usize,
@@ -22,6 +24,9 @@ pub struct FamilyThickness {
     /// thickness of a nested family.
     pub converged: bool,
 }
+
+/// Below this least scale the middle surface stands: the least thickness is 0 to within it.
+const STANDS: f64 = 1e-6;
 
 /// Rounds of [`min_thickness_of_family`] at most.
 const MAX_ROUNDS: usize = 12;
@@ -36,7 +41,10 @@ const MAX_ROUNDS: usize = 12;
 /// round with s_k ≤ 1 certifies t_k: its surface lies inside `E(t_k)`. The search ends
 /// when 1 − `scale_tolerance` ≤ s_k ≤ 1 (or after twelve rounds); for a nested family (bounds that move inward as t
 /// falls) that thickness is a local minimum over the family, because the round's analysis
-/// found no uniformly thinner copy of `E(t_k)` that holds a surface. Returns the least
+/// found no uniformly thinner copy of `E(t_k)` that holds a surface. A round whose least
+/// scale is below 1e-6 ends the search with t_k·s_k: the middle surface of `E(t_k)` holds a
+/// thrust surface to that precision (the least thickness is 0), and its analysis is
+/// certified inside `E(t_k)` scaled by s_k. Otherwise returns the least
 /// certified thickness; an error when no round certified one (the message gives the last
 /// round's end) or when `thickness` or `scale_tolerance` is not a finite number > 0.
 pub fn min_thickness_of_family(
@@ -71,6 +79,15 @@ pub fn min_thickness_of_family(
             return finish(best, rounds).ok_or_else(|| no_surface(t, &end));
         }
         let s = result.thickness_scale;
+        if s < STANDS {
+            // The middle surface of E(t) itself (nearly) holds a thrust surface.
+            return Ok(FamilyThickness {
+                thickness: t * s,
+                result,
+                rounds,
+                converged: true,
+            });
+        }
         let converged = s <= 1.0 && s >= 1.0 - scale_tolerance;
         if s <= 1.0 && best.as_ref().is_none_or(|b| t < b.thickness) {
             best = Some(FamilyThickness {
