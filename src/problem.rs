@@ -126,6 +126,22 @@ impl Problem {
         Ok(self)
     }
 
+    /// The mean of `loads` (one per vertex, as [`crate::StressResult::loads`]) over the
+    /// non-anchored vertices: p̄, the unit of ε∞ and of relative force-density bounds (with
+    /// L₀). 1 when there is no such vertex or the mean is not positive, as the solver takes it.
+    pub fn mean_load(&self, loads: &[f64]) -> f64 {
+        let free: Vec<f64> = (0..self.mesh.n_vertices())
+            .filter(|&v| self.mesh.is_non_anchored(v))
+            .filter_map(|v| loads.get(v).copied())
+            .collect();
+        let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
+        if mean > 0.0 {
+            mean
+        } else {
+            1.0
+        }
+    }
+
     /// Prescribed normal push per vertex (used at free boundary vertices): finite and >= 0.
     pub fn with_prescribed_tau(mut self, tau: Vec<f64>) -> Result<Problem> {
         check_len(

@@ -77,26 +77,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// The report with one top-level key per line: objects indented, arrays kept on one line.
-fn report_text(report: &Value) -> String {
-    let Value::Object(map) = report else {
-        return report.to_string();
-    };
-    let lines: Vec<String> = map
-        .iter()
-        .map(|(k, v)| {
-            let value = match v {
-                Value::Object(_) => serde_json::to_string_pretty(v)
-                    .expect("JSON values serialise")
-                    .replace('\n', "\n  "),
-                _ => v.to_string(),
-            };
-            format!("  {}: {value}", Value::from(k.as_str()))
-        })
-        .collect();
-    format!("{{\n{}\n}}\n", lines.join(",\n"))
-}
-
 /// Where a run writes.
 struct Paths {
     out: PathBuf,
@@ -172,10 +152,10 @@ fn formfind() -> Result<ExitCode, Failure> {
     } = paths;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
-    let mut report = report::build(&o, &outcome);
+    let mut report = serde_json::to_value(outcome.report(&o.settings)).map_err(failed)?;
     let solid = match o.thickness() {
         Some(thickness) => {
-            let solid = voussoir::thicken(&outcome.model.mesh, &outcome.positions, &thickness)
+            let solid = voussoir::thicken(outcome.model.mesh(), &outcome.positions, &thickness)
                 .map_err(|e| bad_input(format!("--solid: {e}")))?;
             report["solid"] = report::solid(&solid, &outcome, &o);
             Some(solid)
@@ -186,7 +166,7 @@ fn formfind() -> Result<ExitCode, Failure> {
 
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
-    let mesh = &outcome.model.mesh;
+    let mesh = outcome.model.mesh();
     // Written meshes keep the input's axes.
     let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
         positions.iter().map(|&p| o.up.to_file(p)).collect()
@@ -206,7 +186,10 @@ fn formfind() -> Result<ExitCode, Failure> {
             .map_err(failed)?;
     }
     staging
-        .write(&report_path, report_text(&report).as_bytes())
+        .write(
+            &report_path,
+            voussoir::report::json_text(&report).as_bytes(),
+        )
         .map_err(failed)?;
     for (file, svg) in &pictures {
         staging
@@ -278,18 +261,18 @@ fn phrase(name: &Value) -> String {
 
 fn print_summary(outcome: &run::Outcome, report: &Value) {
     let m = &outcome.model;
-    let mesh = &m.mesh;
+    let mesh = m.mesh();
     say!(
         "{} ({}): {} vertices, {} faces, {} edges, {} holes, {} anchored",
         m.name,
-        m.source,
+        m.read.source,
         mesh.n_vertices(),
         mesh.n_faces(),
         mesh.n_edges(),
         mesh.holes().count(),
         mesh.anchored.iter().filter(|a| **a).count()
     );
-    if let Some(w) = m.weld.as_ref().filter(|w| w.merged > 0) {
+    if let Some(w) = m.read.weld.as_ref().filter(|w| w.merged > 0) {
         say!(
             "welded: {} of {} input vertices merged (closer than {:.3e}), {} faces collapsed",
             w.merged,
@@ -298,15 +281,15 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             w.collapsed_faces.len()
         );
     }
-    if !m.repairs.is_empty() {
-        let flips = m
-            .repairs
+    let repairs = &m.read.repairs;
+    if !repairs.is_empty() {
+        let flips = repairs
             .iter()
             .filter(|r| matches!(r, voussoir::PlanRepair::Flip { .. }))
             .count();
         say!(
             "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",
-            m.repairs.len() - flips
+            repairs.len() - flips
         );
     }
     let s = &outcome.stress;
@@ -326,9 +309,12 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.tolerance,
                 outcome.before.eps_inf
             );
-            let detail = &report["termination_detail"];
             // A stall with no vertex to name has nothing to add to its own line.
-            if !detail.is_null() && *detail != serde_json::json!({ "vertices": [] }) {
+            let vertices = &report["termination_vertices"];
+            if vertices.as_array().is_some_and(|v| !v.is_empty()) {
+                say!("  vertices: {vertices}");
+            }
+            if let Some(detail) = report["termination_detail"].as_str() {
                 say!("  details: {detail}");
             }
             say!(

@@ -8,7 +8,7 @@ use svg::Document;
 use voussoir::Mesh;
 
 use crate::draw::{self, bbox, colour_bar, fmt, line, page, text, View};
-use crate::run::{mean_load, Outcome};
+use crate::run::Outcome;
 
 const WIDTH: f64 = 900.0;
 const TOP: f64 = 70.0;
@@ -143,7 +143,7 @@ fn anchor_key(x: f64, y: f64) -> Group {
 
 /// (a) Edges coloured and sized by force density; supports and free vertices that need τ.
 fn plan_forces(o: &Outcome) -> Document {
-    let (mesh, pos, s) = (&o.model.mesh, &o.positions, &o.stress);
+    let (mesh, pos, s) = (o.model.mesh(), &o.positions, &o.stress);
     let q = &s.force_densities;
     let q_max = q.iter().copied().fold(0.0, f64::max);
     let (q_top, ticks) = q_scale(q.iter().copied());
@@ -264,10 +264,10 @@ fn force_diagram(o: &Outcome) -> Document {
 
 /// (c) |r_i| / p̄ per vertex on a log scale, before and after.
 fn residuals(o: &Outcome) -> Document {
-    let mesh = &o.model.mesh;
+    let mesh = o.model.mesh();
     let tol = o.tolerance;
     let floor = (tol / 10.0).log10().floor();
-    let mut panels = vec![("input", &o.model.mesh.positions, &o.before)];
+    let mut panels = vec![("input", &o.model.mesh().positions, &o.before)];
     if o.termination.is_some() {
         panels.push(("form-found", &o.positions, &o.stress));
     }
@@ -275,7 +275,7 @@ fn residuals(o: &Outcome) -> Document {
     let rel: Vec<Vec<f64>> = panels
         .iter()
         .map(|(_, _, s)| {
-            let mean = mean_load(&o.model, &s.loads);
+            let mean = o.model.read.problem.mean_load(&s.loads);
             s.residuals.iter().map(|r| r.abs() / mean).collect()
         })
         .collect();
@@ -349,7 +349,7 @@ fn residuals(o: &Outcome) -> Document {
 
 /// (d) Height change per face (mean of its vertices), blue down, red up.
 fn height_change(o: &Outcome) -> Document {
-    let mesh = &o.model.mesh;
+    let mesh = o.model.mesh();
     let dz: Vec<f64> = (0..mesh.n_vertices())
         .map(|v| o.positions[v][2] - mesh.positions[v][2])
         .collect();

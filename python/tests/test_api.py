@@ -7,6 +7,7 @@ import dataclasses
 import json
 import subprocess
 import sys
+import typing
 
 import numpy as np
 import pytest
@@ -14,7 +15,8 @@ import pytest
 import voussoir
 from conftest import REPO, SQUARE_ANCHORED, SQUARE_FACES, SQUARE_POSITIONS
 
-from voussoir._settings import SETTING_NAMES
+from voussoir import _voussoir as _native
+from voussoir._settings import SETTING_NAMES, Settings
 
 
 def square(**loads) -> voussoir.Mesh:
@@ -31,6 +33,19 @@ def test_settings_list_every_default_and_nothing_else():
     d = voussoir.defaults()
     assert set(d) == set(SETTING_NAMES)
     assert d["method"] == "nearest" and d["q_max"] is None and d["dual_length_bounds"] is None
+
+
+def test_the_typed_choices_are_the_library_names():
+    """`Settings`' Literal types list the names the library parses and reports."""
+    hints = typing.get_type_hints(Settings)
+    for key, names in _native.choices().items():
+        if key == "up":
+            continue
+        assert list(typing.get_args(hints[key])) == names, key
+    for key, names in _native.choices().items():
+        for name in names:
+            if key != "up":
+                voussoir.analyse(square(), **{key: name})
 
 
 def test_a_default_given_explicitly_changes_nothing():

@@ -12,8 +12,10 @@ use crate::{Error, Result};
 /// Default tolerance of [`repair_plan`], relative to the median plan area of the faces.
 pub const DEFAULT_REPAIR_TOLERANCE: f64 = 1e-4;
 
-/// One change made by [`repair_plan`].
-#[derive(Clone, Debug, PartialEq)]
+/// One change made by [`repair_plan`]. Serialised (in reports) as `{"flip": {...}}` or
+/// `{"nudge": {...}}`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum PlanRepair {
     /// Faces `faces[0]` and `faces[1]` shared the edge `removed`; they now share `added`.

@@ -17,7 +17,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Mat, Side};
 
 /// Parameters of the paper's proximal schedule ([`crate::FormMethod::Paper`]): μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct Schedule {
     pub mu0: f64,

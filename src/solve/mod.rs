@@ -57,10 +57,12 @@ pub enum FormMethod {
     Paper,
 }
 
-/// Settings of the whole loop.
-#[derive(Debug, Clone, PartialEq)]
+/// Settings of the whole loop. Serialised (in reports) flat, with the names of Python's
+/// keyword settings.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct FormFindSettings {
+    #[serde(flatten)]
     pub stress: StressSettings,
     /// Default [`FormMethod::Nearest`].
     pub method: FormMethod,

@@ -31,7 +31,9 @@ pub enum TauMode {
 
 /// A force-density bound, either physical (force per length) or relative to the problem's
 /// natural scale p̄ / L₀ (mean load over non-anchored vertices / half the plan diagonal).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Serialised (in reports) as `{"absolute": v}` or `{"relative": v}`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum QBound {
     Absolute(f64),
@@ -82,8 +84,9 @@ pub enum QpSolver {
 
 /// Settings of one stress step. The defaults are those of form finding
 /// (`FormFindSettings::default().stress`) and of the C API's `vsr_settings_create`, so that
-/// `analyse` and `vsr_analyse` give the same answer.
-#[derive(Debug, Clone, PartialEq)]
+/// `analyse` and `vsr_analyse` give the same answer. Serialised (in reports) with the names
+/// of Python's keyword settings.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct StressSettings {
     /// Lower bound on force densities (default: 0.05 p̄/L₀, `QBound::Relative(0.05)`, on all
@@ -113,6 +116,7 @@ pub struct StressSettings {
     /// numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is repeated with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
+    #[serde(rename = "qp_solver")]
     pub solver: QpSolver,
 }
 
