@@ -57,5 +57,5 @@ pub mod internals {
     pub use crate::geometry::{Frame, Plan};
     pub use crate::stress::airy::AiryOperator;
     pub use crate::stress::holes::cut_holes;
-    pub use crate::stress::{analyse_at, analyse_cached, StressCache};
+    pub use crate::stress::{analyse_cached, StressCache};
 }
