@@ -28,6 +28,7 @@ use super::sparse::Csr;
 
 mod factorise;
 mod gmres;
+mod graph;
 mod kkt;
 mod newton;
 mod ordering;
