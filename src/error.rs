@@ -73,7 +73,8 @@ pub enum Error {
     },
 }
 
-fn ids(list: &[usize]) -> String {
+/// At most [`MAX_IDS_SHOWN`] ids, comma-separated, then how many there are in all.
+pub(crate) fn ids(list: &[usize]) -> String {
     let mut s: Vec<String> = list
         .iter()
         .take(MAX_IDS_SHOWN)
@@ -160,38 +161,6 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// The sentence a user reads for a termination (the C API's termination message).
-impl fmt::Display for crate::Termination {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        use crate::Termination::*;
-        match self {
-            Converged => write!(f, "converged: eps_inf is below the tolerance"),
-            MaxIterations => write!(f, "reached the iteration limit"),
-            Stalled { vertices } if vertices.is_empty() => {
-                write!(f, "stalled: eps_inf stopped improving")
-            }
-            Stalled { vertices } => {
-                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
-                write!(
-                    f,
-                    "stalled: eps_inf stopped improving; vertices {} carry (almost) no stress \
-                     (raise q_min)",
-                    ids(&list)
-                )
-            }
-            Infeasible { constraint } => {
-                write!(f, "infeasible stress constraints: relax {constraint}")
-            }
-            NumericalError { what } => write!(f, "numerical error: {what}"),
-            Cancelled => write!(f, "cancelled by the progress callback"),
-            Blocked { vertices, hint } => {
-                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
-                write!(f, "blocked: {hint}; vertices {}", ids(&list))
-            }
-        }
-    }
-}
-
 /// A failed sparse Cholesky factorisation of `matrix` as an [`Error::Numerical`] in words
 /// (faer's own `Display` of these errors is their `Debug` text), for the shape step's
 /// factorisations (`src/shape`).
@@ -228,7 +197,6 @@ pub type Result<T> = std::result::Result<T, Error>;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Termination;
 
     #[test]
     fn factorisation_failures_are_sentences() {
@@ -244,34 +212,5 @@ mod tests {
         let memory = LltError::Generic(faer::sparse::FaerError::OutOfMemory);
         let text = factorisation_failure("shape system", &memory).to_string();
         assert_eq!(text, "numerical failure: shape system: memory ran out");
-    }
-
-    #[test]
-    fn terminations_read_as_sentences() {
-        let stalled = Termination::Stalled {
-            vertices: vec![4, 9],
-        };
-        assert_eq!(
-            stalled.to_string(),
-            "stalled: eps_inf stopped improving; vertices 4, 9 carry (almost) no stress (raise q_min)"
-        );
-        let many = Termination::Stalled {
-            vertices: (0..20).collect(),
-        };
-        assert!(many.to_string().contains("... (20 in all)"), "{many}");
-        for t in [
-            Termination::Converged,
-            Termination::MaxIterations,
-            Termination::Cancelled,
-            Termination::Infeasible {
-                constraint: "q_min".into(),
-            },
-            Termination::NumericalError {
-                what: "stress QP failed".into(),
-            },
-        ] {
-            let text = t.to_string();
-            assert!(!text.contains(['{', '[', '(']), "{text}");
-        }
     }
 }

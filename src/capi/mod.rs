@@ -11,6 +11,7 @@
 #![allow(unsafe_code)]
 
 mod boundary;
+mod enum_args;
 mod files;
 mod mesh;
 mod result;

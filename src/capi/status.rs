@@ -1,14 +1,11 @@
 //! Status codes and the enumerations that cross the C ABI.
 //!
 //! Values are explicit and never reused: a removed variant leaves a gap. Enum *inputs* cross as
-//! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`); enum *outputs* are written as these
-//! types (`uint32_t` in C).
+//! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`, in `enum_args.rs`); enum *outputs*
+//! are written as these types (`uint32_t` in C).
 
-use super::boundary::{CResult, Failure};
-use crate::geometry::loads::LoadRule;
-use crate::stress::airy::HoleMode;
-use crate::stress::{EdgeScope, Formulation, QpSolver, StressStatus, TauMode};
-use crate::{FormMethod, Termination};
+use crate::stress::{QpSolver, StressStatus};
+use crate::Termination;
 
 /// Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
 /// function wrote no output (except `needed` with `VSR_STATUS_BUFFER_TOO_SMALL`) and
@@ -271,122 +268,4 @@ pub enum VsrMethod {
     /// The paper's loop: height steps pulled towards the current heights with the proximal
     /// schedule (`vsr_settings_set_schedule_*`).
     Paper = 1,
-}
-
-fn bad_enum(name: &str, value: u32, allowed: &str) -> Failure {
-    Failure::new(
-        super::VsrStatus::InvalidEnum,
-        format!("argument `{name}`: {value} is not one of {allowed}"),
-    )
-}
-
-pub(crate) fn tau_mode(name: &str, v: u32) -> CResult<TauMode> {
-    Ok(match v {
-        0 => TauMode::Optimized,
-        1 => TauMode::Zero,
-        2 => TauMode::Prescribed,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_TAU_MODE_OPTIMIZED (0), VSR_TAU_MODE_ZERO (1), VSR_TAU_MODE_PRESCRIBED (2)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn method(name: &str, v: u32) -> CResult<FormMethod> {
-    Ok(match v {
-        0 => FormMethod::Nearest,
-        1 => FormMethod::Paper,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_METHOD_NEAREST (0), VSR_METHOD_PAPER (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn hole_mode(name: &str, v: u32) -> CResult<HoleMode> {
-    Ok(match v {
-        0 => HoleMode::Constant,
-        1 => HoleMode::Affine,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_HOLE_MODE_CONSTANT (0), VSR_HOLE_MODE_AFFINE (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn load_rule(name: &str, v: u32) -> CResult<LoadRule> {
-    Ok(match v {
-        0 => LoadRule::Barycentric,
-        1 => LoadRule::Voronoi,
-        2 => LoadRule::PlanArea,
-        _ => return Err(bad_enum(
-            name,
-            v,
-            "VSR_LOAD_RULE_BARYCENTRIC (0), VSR_LOAD_RULE_VORONOI (1), VSR_LOAD_RULE_PLAN_AREA (2)",
-        )),
-    })
-}
-
-pub(crate) fn qp_solver(name: &str, v: u32) -> CResult<QpSolver> {
-    Ok(match v {
-        0 => QpSolver::Native,
-        1 => QpSolver::Clarabel,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_QP_SOLVER_NATIVE (0), VSR_QP_SOLVER_CLARABEL (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn formulation(name: &str, v: u32) -> CResult<Formulation> {
-    Ok(match v {
-        0 => Formulation::Reduced,
-        1 => Formulation::EdgeBased,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_FORMULATION_REDUCED (0), VSR_FORMULATION_EDGE_BASED (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn edge_scope(name: &str, v: u32) -> CResult<EdgeScope> {
-    Ok(match v {
-        0 => EdgeScope::Interior,
-        1 => EdgeScope::All,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_EDGE_SCOPE_INTERIOR (0), VSR_EDGE_SCOPE_ALL (1)",
-            ))
-        }
-    })
-}
-
-/// True for `VSR_BOUND_KIND_RELATIVE`.
-pub(crate) fn bound_kind(name: &str, v: u32) -> CResult<bool> {
-    match v {
-        0 => Ok(false),
-        1 => Ok(true),
-        _ => Err(bad_enum(
-            name,
-            v,
-            "VSR_BOUND_KIND_ABSOLUTE (0), VSR_BOUND_KIND_RELATIVE (1)",
-        )),
-    }
 }

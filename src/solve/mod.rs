@@ -5,7 +5,7 @@
 mod nearest;
 mod paper;
 
-use crate::error::Result;
+use crate::error::{ids, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
 use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus};
@@ -41,6 +41,38 @@ pub enum Termination {
         vertices: Vec<u32>,
         hint: String,
     },
+}
+
+/// The sentence a user reads for a termination (the C API's termination message).
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use Termination::*;
+        match self {
+            Converged => write!(f, "converged: eps_inf is below the tolerance"),
+            MaxIterations => write!(f, "reached the iteration limit"),
+            Stalled { vertices } if vertices.is_empty() => {
+                write!(f, "stalled: eps_inf stopped improving")
+            }
+            Stalled { vertices } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(
+                    f,
+                    "stalled: eps_inf stopped improving; vertices {} carry (almost) no stress \
+                     (raise q_min)",
+                    ids(&list)
+                )
+            }
+            Infeasible { constraint } => {
+                write!(f, "infeasible stress constraints: relax {constraint}")
+            }
+            NumericalError { what } => write!(f, "numerical error: {what}"),
+            Cancelled => write!(f, "cancelled by the progress callback"),
+            Blocked { vertices, hint } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(f, "blocked: {hint}; vertices {}", ids(&list))
+            }
+        }
+    }
 }
 
 /// How form finding moves the shape.
@@ -384,6 +416,35 @@ fn distances(problem: &Problem, positions: &[[f64; 3]]) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn terminations_read_as_sentences() {
+        let stalled = Termination::Stalled {
+            vertices: vec![4, 9],
+        };
+        assert_eq!(
+            stalled.to_string(),
+            "stalled: eps_inf stopped improving; vertices 4, 9 carry (almost) no stress (raise q_min)"
+        );
+        let many = Termination::Stalled {
+            vertices: (0..20).collect(),
+        };
+        assert!(many.to_string().contains("... (20 in all)"), "{many}");
+        for t in [
+            Termination::Converged,
+            Termination::MaxIterations,
+            Termination::Cancelled,
+            Termination::Infeasible {
+                constraint: "q_min".into(),
+            },
+            Termination::NumericalError {
+                what: "stress QP failed".into(),
+            },
+        ] {
+            let text = t.to_string();
+            assert!(!text.contains(['{', '[', '(']), "{text}");
+        }
+    }
 
     #[test]
     fn only_a_step_short_of_its_optimum_that_balances_worse_gives_way() {
