@@ -228,6 +228,9 @@ enum VsrStressStatus
    * native solver beyond 20k unknowns) 10 iterations went by without progress.
    */
   VSR_STRESS_STATUS_MAX_ITERATIONS = 3,
+  /**
+   * A solver failed numerically; `vsr_result_termination_message` says where.
+   */
   VSR_STRESS_STATUS_NUMERICAL_ERROR = 4,
 };
 #ifndef __cplusplus
@@ -1028,10 +1031,12 @@ VsrStatus vsr_result_stalled_vertices(const struct VsrResult *result, uint32_t *
 VsrStatus vsr_result_height_change(const struct VsrResult *result, double *rms, double *max);
 
 /**
- * Distances between the form-found and the input heights, over the plan bounding-box
- * diagonal (dimensionless): `hausdorff` = max |Δz|, `l2` = area-weighted RMS of Δz. Both
- * pointers required; written only on success. For an analysis result:
- * `VSR_STATUS_NOT_AVAILABLE`.
+ * Distances between the form-found and the input surfaces, over the plan bounding-box
+ * diagonal (dimensionless), sampled at vertices: `hausdorff` = the symmetric Hausdorff
+ * distance (the largest distance from a vertex of either surface to the other surface),
+ * `l2` = the RMS distance from the form-found vertices to the input surface, weighted by
+ * vertex area (for the height change itself see `vsr_result_height_change`). Both pointers required; written only
+ * on success. For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
  *
  * # Safety
  * `result`: a valid handle; the out-pointers writable.

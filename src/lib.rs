@@ -15,6 +15,7 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 #![deny(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod capi;
 mod error;

@@ -8,6 +8,7 @@ use crate::mesh::Mesh;
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct Problem {
+    /// The validated mesh.
     pub mesh: Mesh,
     /// Weight per unit area of each face (density × thickness × g). Default 1.
     pub face_density: Vec<f64>,
@@ -33,6 +34,8 @@ fn check_len(name: &'static str, len: usize, expected: usize, what: &str) -> Res
 }
 
 impl Problem {
+    /// `mesh` with the default loads: density 1 on every face, no extra loads, no horizontal
+    /// forces, τ = 0, no polygon diagonals.
     pub fn new(mesh: Mesh) -> Problem {
         let (nv, nf, ne) = (mesh.positions.len(), mesh.faces.len(), mesh.edges.len());
         Problem {

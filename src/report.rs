@@ -23,8 +23,11 @@ pub enum Run<'a> {
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct Timings {
+    /// Stress steps.
     pub stress: f64,
+    /// Height steps.
     pub shape: f64,
+    /// The whole run.
     pub total: f64,
 }
 
@@ -32,9 +35,13 @@ pub struct Timings {
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct MeshCounts {
+    /// Vertices (unreferenced ones included).
     pub vertices: usize,
+    /// Faces.
     pub faces: usize,
+    /// Edges.
     pub edges: usize,
+    /// Holes.
     pub holes: usize,
 }
 
@@ -60,6 +67,7 @@ pub struct ReportSettings {
     pub stress_only: bool,
     /// The face density, when it is the same on every face (null otherwise).
     pub density: Option<f64>,
+    /// Every solver setting (serialised flat).
     #[serde(flatten)]
     pub solver: FormFindSettings,
     /// The unit of relative force-density bounds at the final shape: mean load over
@@ -91,6 +99,7 @@ pub struct Report {
     pub iterations: usize,
     /// The QP solver that answered each stress step.
     pub step_solvers: Vec<QpSolver>,
+    /// ε∞ of the final forces: max |r_i| / mean load.
     pub eps_inf: f64,
     /// ε∞ after each stress step (see [`FormFindResult::history`]).
     pub history: Vec<f64>,
@@ -98,27 +107,47 @@ pub struct Report {
     pub positions: Vec<[f64; 3]>,
     /// Vertex pairs, smaller id first, sorted: the rows of the per-edge arrays.
     pub edges: Vec<[u32; 2]>,
+    /// Force density per edge (force / length).
     pub force_densities: Vec<f64>,
+    /// Vertical load per vertex.
     pub loads: Vec<f64>,
     /// `[vertex, x, y]` for each vertex with a non-zero external horizontal force.
     pub external_horizontal: Vec<(u32, f64, f64)>,
+    /// Inward normal push per vertex (free boundary vertices).
     pub tau: Vec<f64>,
+    /// Vertex weights of the power diagram (the force diagram).
     pub weights: Vec<f64>,
+    /// Airy stress function per vertex.
     pub airy: Vec<f64>,
+    /// The Airy function's jump around each hole, (c, a_x, a_y).
     pub hole_coefficients: Vec<[f64; 3]>,
+    /// Vertical residual per vertex (0 at anchored ones).
     pub residuals: Vec<f64>,
+    /// Σ r_i² over non-anchored vertices.
     pub objective: f64,
+    /// Symmetric Hausdorff distance to the input surface / plan diagonal (0 for an analysis).
     pub hausdorff: f64,
+    /// Area-weighted RMS distance to the input surface / plan diagonal.
     pub l2: f64,
+    /// Area-weighted RMS height change / plan diagonal.
     pub rms_change: f64,
+    /// Largest height change / plan diagonal.
     pub max_change: f64,
+    /// Wall times, seconds.
     pub timings_s: Timings,
+    /// The mesh's counts.
     pub mesh: MeshCounts,
+    /// The anchored vertices.
     pub anchored: Vec<u32>,
+    /// The plan repairs made while reading.
     pub plan_repairs: Vec<PlanRepair>,
+    /// Vertices no face uses (ignored by the solvers).
     pub unreferenced: Vec<u32>,
+    /// The units, in words.
     pub units: &'static str,
+    /// How the input was read and solved.
     pub settings: ReportSettings,
+    /// The library's version.
     pub voussoir_version: &'static str,
 }
 

@@ -143,6 +143,7 @@ pub enum VsrStressStatus {
     /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
     /// native solver beyond 20k unknowns) 10 iterations went by without progress.
     MaxIterations = 3,
+    /// A solver failed numerically; `vsr_result_termination_message` says where.
     NumericalError = 4,
 }
 

@@ -47,7 +47,12 @@ pub enum Supports {
     /// Every vertex of some face within `tolerance` of the lowest such vertex's height:
     /// `tolerance` is relative to the bounding box diagonal of those vertices unless
     /// `absolute`.
-    Lowest { tolerance: f64, absolute: bool },
+    Lowest {
+        /// The reach above the lowest height.
+        tolerance: f64,
+        /// Whether `tolerance` is a length (else a multiple of the bounding box diagonal).
+        absolute: bool,
+    },
 }
 
 /// The axis that points up in a mesh file.

@@ -17,18 +17,23 @@ use std::time::Instant;
 pub enum Termination {
     /// ε∞ < tolerance.
     Converged,
+    /// The iteration limit was reached first.
     MaxIterations,
     /// ε∞ stopped improving; the vertices with the largest residual that carry (almost) no
     /// stress are listed: they cannot be balanced by moving heights (raise q_min).
     Stalled {
+        /// The vertices that carry (almost) no stress.
         vertices: Vec<u32>,
     },
     /// The stress constraints admit no solution (q_min, q_max, prescribed forces, straight free
     /// edges without τ); `constraint` names the setting to relax.
     Infeasible {
+        /// The settings to relax.
         constraint: String,
     },
+    /// A solver failed numerically.
     NumericalError {
+        /// Where, in words.
         what: String,
     },
     /// The progress callback asked to stop.
@@ -38,7 +43,9 @@ pub enum Termination {
     /// force densities down, or the height limit) and `vertices` lists where (the vertices at
     /// the height limit, or those beside edges at q_max with the largest residuals).
     Blocked {
+        /// Where it is blocked.
         vertices: Vec<u32>,
+        /// What blocks, in words.
         hint: String,
     },
 }
@@ -94,6 +101,7 @@ pub enum FormMethod {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct FormFindSettings {
+    /// Settings of every stress step.
     #[serde(flatten)]
     pub stress: StressSettings,
     /// Default [`FormMethod::Nearest`].
@@ -178,6 +186,7 @@ pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct FormFindResult {
+    /// Why the loop stopped.
     pub termination: Termination,
     /// Final positions (heights moved; the plan too when ODT is on): without convergence, those
     /// of the lowest-ε∞ state reached.
@@ -203,6 +212,7 @@ pub struct FormFindResult {
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
+    /// Area-weighted RMS distance to the input surface / plan diagonal.
     pub l2: f64,
     /// The nearest method's objective: the RMS height change of the non-anchored vertices
     /// weighted by their plan area shares, over the plan bounding-box diagonal.
@@ -211,7 +221,9 @@ pub struct FormFindResult {
     pub max_change: f64,
     /// Seconds summed over iterations.
     pub stress_seconds: f64,
+    /// Seconds in height steps.
     pub shape_seconds: f64,
+    /// Seconds in all.
     pub total_seconds: f64,
 }
 

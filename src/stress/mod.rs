@@ -46,6 +46,7 @@ pub enum StressStatus {
     /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
     /// native solver beyond 20k unknowns) 10 iterations went by without progress.
     MaxIterations,
+    /// The solver failed numerically.
     NumericalError,
 }
 
@@ -82,6 +83,7 @@ impl StressStatus {
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct StressResult {
+    /// How the QP ended.
     pub status: StressStatus,
     /// Force density per mesh edge (compression positive; 0 on edges that carry none).
     pub force_densities: Vec<f64>,
@@ -112,6 +114,7 @@ pub struct StressResult {
     pub eps_inf: f64,
     /// Σ r_i² over non-anchored vertices.
     pub objective: f64,
+    /// The force diagram (reciprocal figure) of the forces.
     pub force_diagram: ForceDiagram,
     /// Iterations of the QP solver; 0 when the native solver reached the optimum from the
     /// previous step's active set alone (form finding reuses it between steps).
@@ -125,6 +128,7 @@ pub struct StressResult {
     pub lifted: bool,
     /// The regulariser ε actually used (larger than the setting after a numerical failure).
     pub regularisation: f64,
+    /// Wall time of the step.
     pub seconds: f64,
 }
 

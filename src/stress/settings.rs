@@ -36,7 +36,9 @@ pub enum TauMode {
 #[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum QBound {
+    /// Force per length, in the model's units.
     Absolute(f64),
+    /// A multiple of p̄ / L₀.
     Relative(f64),
 }
 
@@ -96,10 +98,13 @@ pub struct StressSettings {
     pub q_min_scope: EdgeScope,
     /// Optional upper bound on force densities (allowable stress × thickness).
     pub q_max: Option<QBound>,
+    /// Normal stress at free boundary vertices (default optimised).
     pub tau: TauMode,
     /// How the Airy function may jump around a hole (default affine: the true optimum).
     pub holes: HoleMode,
+    /// How face weights become vertex loads (default barycentric).
     pub load_rule: LoadRule,
+    /// The formulation of the QP (default reduced).
     pub formulation: Formulation,
     /// Bounds (lo, hi) on the dual (force-diagram) edge length of interior edges, in units of
     /// the mean load p̄: lo ≤ q_e l_e / p̄ ≤ hi. A lower bound keeps every force-diagram edge
@@ -116,6 +121,7 @@ pub struct StressSettings {
     /// numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is repeated with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
+    /// The QP solver (default native).
     #[serde(rename = "qp_solver")]
     pub solver: QpSolver,
 }
