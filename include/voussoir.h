@@ -753,6 +753,37 @@ VsrStatus vsr_mesh_counts(const struct VsrMesh *mesh, size_t *n_vertices, size_t
 VsrStatus vsr_mesh_edges(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
 
 /**
+ * Marks the edges that split the polygons of the model into triangles, as `vsr_mesh_read`
+ * marks those of a file's polygons: q_min does not bind them (only q >= 0), since a force
+ * network on a polygon mesh needs no force along them. Without them a mesh of quads split
+ * along one diagonal per ring (a latitude-longitude dome) may admit no stress with every
+ * q >= q_min > 0. Replaces the diagonals marked before (`n_diagonals` = 0 clears them).
+ *
+ * `diagonals`: #D by 2 `uint32_t` vertex ids, row-major, each pair an interior edge of the
+ * mesh (either order); NULL only when `n_diagonals` is 0. Copied.
+ *
+ * Errors: NULL `mesh`, or `diagonals` with a non-zero count (`VSR_STATUS_NULL_POINTER`);
+ * `n_diagonals * 2` overflowing (`VSR_STATUS_LENGTH_OVERFLOW`); a vertex id `>= #V`
+ * (`VSR_STATUS_INDEX_OUT_OF_RANGE`); a pair that is no interior edge
+ * (`VSR_STATUS_INVALID_ARGUMENT`). The message names the pair; on failure the mesh keeps
+ * the diagonals it had.
+ *
+ * # Safety
+ * `mesh`: a valid handle with exclusive access; `diagonals`: `2 n_diagonals` readable ids.
+ */
+VsrStatus vsr_mesh_set_polygon_diagonals(struct VsrMesh *mesh, const uint32_t *diagonals, size_t n_diagonals);
+
+/**
+ * Copies the marked polygon diagonals (`vsr_mesh_set_polygon_diagonals`, or those of the
+ * polygons of a file `vsr_mesh_read` read): #D by 2 `uint32_t` vertex ids, row-major,
+ * smaller id first, in edge order. Copy-out as described in the header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_polygon_diagonals(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
  * Frees a result. NULL is a no-op.
  *
  * # Safety

@@ -108,16 +108,25 @@ impl Problem {
     }
 
     /// Marks the edges (vertex pairs, either order) that split the model's polygons into
-    /// triangles, as [`crate::io::read_mesh_with_diagonals`] lists them: a force network on a
-    /// polygon mesh needs no force along them, so q_min does not bind them. Such a split can
+    /// triangles, as [`crate::io::read_mesh_with_diagonals`] lists them (and
+    /// [`crate::io::read_model`] marks them), replacing any marked before: a force network on
+    /// a polygon mesh needs no force along them, so q_min does not bind them. Such a split can
     /// leave no network with every q ≥ q_min > 0 (rings of quads all split along the same
     /// diagonal, as in a latitude-longitude dome). A pair that is no interior edge of the mesh
-    /// is an error naming it.
+    /// (a vertex id out of range included) is an [`Error::InvalidArgument`] naming it.
     pub fn with_polygon_diagonals(mut self, diagonals: &[[u32; 2]]) -> Result<Problem> {
         let mesh = &self.mesh;
+        let n = mesh.n_vertices();
+        let mut marked = vec![false; mesh.n_edges()];
         for (k, &[a, b]) in diagonals.iter().enumerate() {
+            if let Some(&v) = [a, b].iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidArgument {
+                    name: "diagonals",
+                    reason: format!("pair {k} has vertex {v}, but there are only {n} vertices"),
+                });
+            }
             match mesh.edge_between(a, b) {
-                Some(e) if !mesh.edges[e].is_boundary() => self.polygon_diagonal[e] = true,
+                Some(e) if !mesh.edges[e].is_boundary() => marked[e] = true,
                 _ => {
                     return Err(Error::InvalidArgument {
                         name: "diagonals",
@@ -126,7 +135,17 @@ impl Problem {
                 }
             }
         }
+        self.polygon_diagonal = marked;
         Ok(self)
+    }
+
+    /// The marked polygon diagonals (see [`Problem::with_polygon_diagonals`]) as vertex
+    /// pairs, smaller id first, in edge order.
+    pub fn polygon_diagonals(&self) -> Vec<[u32; 2]> {
+        (self.mesh.edges.iter().zip(&self.polygon_diagonal))
+            .filter(|(_, &d)| d)
+            .map(|(e, _)| e.v)
+            .collect()
     }
 
     /// The mean of `loads` (one per vertex, as [`crate::StressResult::loads`]) over the

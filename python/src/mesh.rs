@@ -157,6 +157,20 @@ fn with_loads(
     })
 }
 
+/// The problem with the polygon diagonals `pairs` ((k, 2) vertex ids) marked.
+fn with_diagonals(problem: Problem, pairs: &PyReadonlyArrayDyn<'_, i64>) -> PyResult<Problem> {
+    let name = "polygon_diagonals";
+    let flat = match pairs.shape() {
+        [0] => Vec::new(),
+        _ => ids(name, rows(name, pairs, 2)?)?,
+    };
+    let pairs: Vec<[u32; 2]> = flat.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+    problem.with_polygon_diagonals(&pairs).map_err(|e| match e {
+        voussoir::Error::InvalidArgument { reason, .. } => invalid(name, reason),
+        e => from_error(name, e),
+    })
+}
+
 /// The one way of choosing supports among `Mesh.from_file`'s keywords.
 fn supports_of(
     file: Option<PathBuf>,
@@ -197,7 +211,8 @@ fn supports_of(
 #[pymethods]
 impl Mesh {
     #[new]
-    #[pyo3(signature = (vertices, faces, anchored, face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None))]
+    #[pyo3(signature = (vertices, faces, anchored, face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None, polygon_diagonals=None))]
+    #[allow(clippy::too_many_arguments)]
     fn py_new(
         vertices: PyReadonlyArrayDyn<'_, f64>,
         faces: PyReadonlyArrayDyn<'_, i64>,
@@ -206,6 +221,7 @@ impl Mesh {
         extra_loads: Array<'_>,
         horizontal_forces: Array<'_>,
         prescribed_tau: Array<'_>,
+        polygon_diagonals: Option<PyReadonlyArrayDyn<'_, i64>>,
     ) -> PyResult<Mesh> {
         let positions = triples(&rows("vertices", &vertices, 3)?);
         let faces = triples(&ids("faces", rows("faces", &faces, 3)?)?);
@@ -219,6 +235,10 @@ impl Mesh {
             horizontal_forces,
             prescribed_tau,
         )?;
+        let problem = match polygon_diagonals {
+            Some(pairs) => with_diagonals(problem, &pairs)?,
+            None => problem,
+        };
         Ok(Mesh {
             model: Model::from_problem(problem, "arrays"),
         })
@@ -320,6 +340,12 @@ impl Mesh {
     #[getter]
     fn welded_ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
         PyArray1::from_slice(py, &self.model.welded_ids)
+    }
+
+    /// The marked polygon diagonals, (k, 2) uint32, smaller id first, in edge order.
+    #[getter]
+    fn polygon_diagonals<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<u32>> {
+        crate::results::matrix(py, &self.model.problem.polygon_diagonals())
     }
 
     /// The plan repairs made while reading the file, one sentence each.

@@ -20,6 +20,7 @@ class Mesh:
         extra_loads: Optional[np.ndarray] = ...,
         horizontal_forces: Optional[np.ndarray] = ...,
         prescribed_tau: Optional[np.ndarray] = ...,
+        polygon_diagonals: Optional[np.ndarray] = ...,
     ) -> None: ...
     @staticmethod
     def read(
@@ -47,6 +48,8 @@ class Mesh:
     def edges(self) -> np.ndarray: ...
     @property
     def welded_ids(self) -> np.ndarray: ...
+    @property
+    def polygon_diagonals(self) -> np.ndarray: ...
     @property
     def plan_repairs(self) -> List[str]: ...
     @property

@@ -207,10 +207,7 @@ impl Model {
         let mesh = &problem.mesh;
         let n = mesh.n_vertices() as u32;
         let anchored = (0..n).filter(|&v| mesh.anchored[v as usize]).collect();
-        let diagonals = (mesh.edges.iter().zip(&problem.polygon_diagonal))
-            .filter(|(_, &d)| d)
-            .map(|(e, _)| e.v)
-            .collect();
+        let diagonals = problem.polygon_diagonals();
         Model {
             welded_ids: (0..n).collect(),
             weld: None,
