@@ -42,10 +42,12 @@ fn quad_dome() -> (String, Vec<u32>) {
     (obj, rim)
 }
 
-/// The dome read from its file by the library's read path.
-fn dome_model() -> voussoir::io::Model {
+/// The dome read from its file (named after `test`: tests run in parallel) by the library's
+/// read path.
+fn dome_model(test: &str) -> voussoir::io::Model {
     let (obj, rim) = quad_dome();
-    let path = std::env::temp_dir().join(format!("voussoir-diagonals-{}.obj", std::process::id()));
+    let name = format!("voussoir-diagonals-{}-{test}.obj", std::process::id());
+    let path = std::env::temp_dir().join(name);
     std::fs::write(&path, obj).unwrap();
     let model = read_model(&path, &ReadOptions::new(Supports::Ids(rim))).unwrap();
     std::fs::remove_file(&path).unwrap();
@@ -97,7 +99,7 @@ fn force_densities(mesh: *const VsrMesh) -> Vec<f64> {
 
 #[test]
 fn arrays_with_marked_diagonals_solve_as_the_file_does() {
-    let model = dome_model();
+    let model = dome_model("arrays");
     assert_eq!(model.diagonals.len(), (RINGS - 1) * SECTORS);
     let from_file = analyse(&model.problem, &StressSettings::default()).unwrap();
     let bits = |q: &[f64]| q.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -146,7 +148,7 @@ fn arrays_with_marked_diagonals_solve_as_the_file_does() {
 
 #[test]
 fn hostile_diagonals_are_refused_and_change_nothing() {
-    let model = dome_model();
+    let model = dome_model("hostile");
     let mesh = create(&model);
     let first = model.diagonals[0];
     assert_ok(unsafe { vsr_mesh_set_polygon_diagonals(mesh, first.as_ptr(), 1) });
