@@ -5,13 +5,15 @@
 #      C++17 with -Wall -Wextra -Werror -pedantic, under g++ and under clang++ when there is one;
 #   2. cmake/ builds the library with cargo (release) and installs it into a staging prefix;
 #      the shared library has its SONAME;
-#   3. examples/ (C dome, C hostile-input test, C++ OpenMesh and CGAL examples) builds against the
-#      installed package with find_package(Voussoir CONFIG REQUIRED) and runs under ctest:
-#      shared library; static library with AddressSanitizer + UBSan (Debug);
-#   4. the C dome, the hostile-input test and a C++ square (voussoir.hpp) build with
-#      `pkg-config --cflags --libs voussoir` alone;
-#   5. the hostile-input test links against the build tree (cargo's target/release, where the
-#      CMake build leaves the SONAME'd library and its libvoussoir.so.1 link) with an rpath;
+#   3. examples/ (C dome, C hostile-input and assessment tests, C++ OpenMesh and CGAL
+#      examples) builds against the installed package with find_package(Voussoir CONFIG
+#      REQUIRED) and runs under ctest: shared library; static library with AddressSanitizer +
+#      UBSan (Debug);
+#   4. the C dome, the hostile-input and assessment tests and a C++ square (voussoir.hpp)
+#      build with `pkg-config --cflags --libs voussoir` alone;
+#   5. the hostile-input and assessment tests link against the build tree (cargo's
+#      target/release, where the CMake build leaves the SONAME'd library and its
+#      libvoussoir.so.1 link) with an rpath;
 #   6. the Rust example (examples/dome.rs) runs.
 # Needs cmake, pkg-config, a C/C++ compiler, OpenMesh and CGAL (Debian: cmake pkg-config g++
 # libopenmesh-dev libcgal-dev); clang++ (Debian: clang) is optional. Work files go to $VSR_CHECK_DIR (default target/cmake-checks).
@@ -86,7 +88,7 @@ pkg-config --modversion voussoir
 flags=$(pkg-config --cflags --libs voussoir)
 libdir=$(pkg-config --variable=libdir voussoir)
 mkdir -p "$work/pkgconfig"
-for prog in examples/c/dome.c tests/c/hostile.c; do
+for prog in examples/c/dome.c tests/c/hostile.c tests/c/assess.c; do
   exe="$work/pkgconfig/$(basename "$prog" .c)"
   # shellcheck disable=SC2086
   cc -std=c11 -Wall -Wextra -Wpedantic -Werror "$prog" -o "$exe" $flags -lm -Wl,-rpath,"$libdir"
@@ -119,6 +121,10 @@ readelf -d "$work/tree/hostile" | grep -q 'Shared library: \[libvoussoir.so.1\]'
   || { echo "the build tree's library lacks the SONAME libvoussoir.so.1" >&2; exit 1; }
 "$work/tree/hostile" >"$work/tree/hostile.log" || { cat "$work/tree/hostile.log"; exit 1; }
 tail -n 1 "$work/tree/hostile.log"
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror -I include tests/c/assess.c -o "$work/tree/assess" \
+  -L "$tree" -lvoussoir -lm -Wl,-rpath,"$tree"
+"$work/tree/assess" >"$work/tree/assess.log" || { cat "$work/tree/assess.log"; exit 1; }
+tail -n 1 "$work/tree/assess.log"
 
 step "Rust example: cargo run --example dome"
 cargo run --quiet --locked --example dome | tail -n 3

@@ -2,7 +2,8 @@
 // the C call's status and exact message (and the try_ twin returns that status); Mesh,
 // Settings and Result move without double frees (ASan build); results equal the C API's bit
 // for bit; getters into caller storage; the progress std::function cancels and carries
-// exceptions out; concurrent solves on shared const objects.
+// exceptions out; concurrent solves on shared const objects; the assessment classes
+// (Envelope, AssessSettings, Assessment) equal the C API bit for bit and throw its statuses.
 #include "support.hpp"
 
 #include <voussoir.hpp>
@@ -679,6 +680,179 @@ TEST(CppApi, ConcurrentSolvesOnSharedConstObjectsAgree) {
     EXPECT_TRUE(same_bits(z[0], z[1]));
     EXPECT_TRUE(same_bits(z[0], alone.positions()));
     EXPECT_EQ(calls.load(), 3 * static_cast<int>(alone.termination().iterations));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Masonry assessment.
+
+// The C API's assessment of `mesh` (0.1 thick) with `objective`, for comparison.
+struct CAssessment {
+    std::vector<double> positions, q, loads, residuals, lower, upper, reactions;
+    uint32_t feasible = 0;
+    VsrTermination termination = VSR_TERMINATION_NUMERICAL_ERROR;
+    std::size_t iterations = 0;
+    double figures[4] = {0, 0, 0, 0};
+};
+
+std::vector<double> c_doubles(
+    VsrStatus (*get)(const VsrAssessment *, double *, std::size_t, std::size_t *),
+    const VsrAssessment *a) {
+    std::size_t n = 0;
+    EXPECT_EQ(get(a, nullptr, 0, &n), VSR_STATUS_OK);
+    std::vector<double> v(n);
+    EXPECT_EQ(get(a, v.data(), n, &n), VSR_STATUS_OK);
+    return v;
+}
+
+CAssessment c_assess(const voussoir::Mesh &mesh, VsrObjective objective) {
+    const double t = 0.1;
+    VsrEnvelope *e = nullptr;
+    VsrAssessSettings *s = nullptr;
+    VsrAssessment *a = nullptr;
+    EXPECT_EQ(vsr_envelope_from_thickness(mesh.get(), &t, 1, &e), VSR_STATUS_OK);
+    EXPECT_EQ(vsr_assess_settings_create(&s), VSR_STATUS_OK);
+    EXPECT_EQ(vsr_assess_settings_set_objective(s, objective), VSR_STATUS_OK);
+    EXPECT_EQ(vsr_assess(mesh.get(), e, s, &a), VSR_STATUS_OK);
+    CAssessment c;
+    c.positions = c_doubles(vsr_assessment_positions, a);
+    c.q = c_doubles(vsr_assessment_force_densities, a);
+    c.loads = c_doubles(vsr_assessment_loads, a);
+    c.residuals = c_doubles(vsr_assessment_residuals, a);
+    c.lower = c_doubles(vsr_assessment_lower, a);
+    c.upper = c_doubles(vsr_assessment_upper, a);
+    c.reactions = c_doubles(vsr_assessment_reactions, a);
+    double seconds = 0;
+    EXPECT_EQ(vsr_assessment_outcome(a, &c.feasible, &c.termination, &c.iterations, &seconds),
+              VSR_STATUS_OK);
+    EXPECT_EQ(vsr_assessment_figures(a, &c.figures[0], &c.figures[1], &c.figures[2],
+                                     &c.figures[3]),
+              VSR_STATUS_OK);
+    vsr_assessment_destroy(a);
+    vsr_assess_settings_destroy(s);
+    vsr_envelope_destroy(e);
+    return c;
+}
+
+TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
+    const voussoir::Mesh mesh = vsrt::make_mesh(vsrt::generated("disk_cap"));
+    for (VsrObjective objective : {VSR_OBJECTIVE_FIT, VSR_OBJECTIVE_MIN_THICKNESS}) {
+        voussoir::AssessSettings settings;
+        settings.objective(objective);
+        const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);
+        const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
+        const CAssessment c = c_assess(mesh, objective);
+        EXPECT_EQ(a.objective(), objective);
+        EXPECT_TRUE(same_bits(c.positions, a.positions()));
+        EXPECT_TRUE(same_bits(c.q, a.force_densities()));
+        EXPECT_TRUE(same_bits(c.loads, a.loads()));
+        EXPECT_TRUE(same_bits(c.residuals, a.residuals()));
+        EXPECT_TRUE(same_bits(c.lower, a.lower()));
+        EXPECT_TRUE(same_bits(c.upper, a.upper()));
+        EXPECT_TRUE(same_bits(c.reactions, a.reactions()));
+        EXPECT_EQ(a.edges(), mesh.edges());
+        const voussoir::AssessmentOutcome o = a.outcome();
+        EXPECT_TRUE(o.feasible);
+        EXPECT_EQ(o.feasible, c.feasible == 1u);
+        EXPECT_EQ(o.termination, c.termination);
+        EXPECT_EQ(o.iterations, c.iterations);
+        const voussoir::AssessmentFigures f = a.figures();
+        EXPECT_TRUE(same_bits(std::vector<double>(c.figures, c.figures + 4),
+                              std::vector<double>{f.thickness_scale, f.safety_factor,
+                                                  f.thrust_horizontal, f.load_factor}));
+        const voussoir::Certificate cert = a.certificate();
+        EXPECT_LT(cert.eps_inf, 1e-6);
+        EXPECT_EQ(cert.worst_bound_vertex, VSR_NO_VERTEX);
+        EXPECT_FALSE(a.termination_message().empty());
+        // The bounds the surface lies within, at the reported thickness.
+        const std::vector<double> z = a.positions(), lo = a.lower(), hi = a.upper();
+        for (std::size_t v = 0; v < lo.size(); ++v) {
+            EXPECT_GE(z[3 * v + 2], lo[v] - 1e-9);
+            EXPECT_LE(z[3 * v + 2], hi[v] + 1e-9);
+        }
+        if (objective == VSR_OBJECTIVE_MIN_THICKNESS) {
+            EXPECT_LT(f.thickness_scale, 1.0);
+            EXPECT_DOUBLE_EQ(f.safety_factor, 1.0 / f.thickness_scale);
+        }
+    }
+}
+
+TEST(CppApi, AssessmentInputErrorsThrowTheCStatus) {
+    const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
+    auto status_of = [](const std::function<void()> &call) {
+        try {
+            call();
+        } catch (const voussoir::Error &e) {
+            EXPECT_EQ(e.message(), voussoir::last_error_message());
+            return e.status();
+        }
+        return VSR_STATUS_OK;
+    };
+    EXPECT_EQ(status_of([&] { (void)voussoir::Envelope::from_thickness(mesh, 0.0); }),
+              VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_EQ(status_of([&] { (void)voussoir::Envelope::from_thickness(mesh, kNaN); }),
+              VSR_STATUS_NON_FINITE);
+    EXPECT_EQ(status_of([&] {
+                  (void)voussoir::Envelope::from_thickness(mesh, std::vector<double>{0.1, 0.1});
+              }),
+              VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_EQ(status_of([&] {
+                  (void)voussoir::Envelope::from_surfaces(mesh, {0, 0, 0, 1}, kTriangles,
+                                                          kPositions, kTriangles);
+              }),
+              VSR_STATUS_INVALID_ARGUMENT);
+    voussoir::AssessSettings settings;
+    EXPECT_EQ(status_of([&] { settings.objective(static_cast<VsrObjective>(99)); }),
+              VSR_STATUS_INVALID_ENUM);
+    EXPECT_EQ(settings.try_unit_weight(-1.0), VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(voussoir::last_error_message()).find("unit_weight"), std::string::npos);
+    EXPECT_EQ(settings.try_tolerance(kNaN), VSR_STATUS_NON_FINITE);
+    const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);
+    settings.objective(VSR_OBJECTIVE_MAX_LOAD);
+    EXPECT_EQ(status_of([&] { (void)voussoir::assess(mesh, envelope, settings); }),
+              VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(voussoir::last_error_message()).find("load_pattern"),
+              std::string::npos);
+    voussoir::Assessment out;
+    EXPECT_EQ(voussoir::try_assess(mesh, voussoir::Envelope(), settings, out),
+              VSR_STATUS_NULL_POINTER);
+    EXPECT_FALSE(out);
+    // The pattern reaches vsr_assess (its length is checked there).
+    settings.load_pattern({0, 0, 0, 1});
+    EXPECT_EQ(status_of([&] { (void)voussoir::assess(mesh, envelope, settings); }),
+              VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(voussoir::last_error_message()).find("has 4 entries"),
+              std::string::npos);
+    // The least thrust lowers free supports to their intrados; fixed ones stay, also in
+    // moved settings.
+    settings.objective(VSR_OBJECTIVE_MIN_THRUST).q_min(0.0, VSR_BOUND_KIND_ABSOLUTE);
+    const double free_z = voussoir::assess(mesh, envelope, settings).positions()[2];
+    settings.fixed_supports(true);
+    const voussoir::AssessSettings moved = std::move(settings);
+    const voussoir::Assessment a = voussoir::assess(mesh, envelope, moved);
+    EXPECT_TRUE(a.outcome().converged());
+    EXPECT_EQ(a.positions()[2], 0.0);
+    EXPECT_LT(free_z, -1e-3);
+}
+
+TEST(CppApi, AssessmentProgressCancelsAndExceptionsPropagate) {
+    const voussoir::Mesh mesh = vsrt::make_mesh(vsrt::generated("disk_cap"));
+    const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);
+    std::vector<std::size_t> steps;
+    voussoir::AssessSettings settings;
+    settings.objective(VSR_OBJECTIVE_MIN_THRUST).progress([&steps](std::size_t step, double) {
+        steps.push_back(step);
+        return steps.size() >= 2 ? voussoir::Progress::Cancel : voussoir::Progress::Continue;
+    });
+    const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
+    EXPECT_EQ(a.outcome().termination, VSR_TERMINATION_CANCELLED);
+    EXPECT_EQ(steps, (std::vector<std::size_t>{1, 2}));
+    settings.progress([](std::size_t, double) -> voussoir::Progress {
+        throw std::out_of_range("stop the assessment");
+    });
+    EXPECT_THROW((void)voussoir::assess(mesh, envelope, settings), std::out_of_range);
+    voussoir::Assessment r;
+    EXPECT_EQ(voussoir::try_assess(mesh, envelope, settings, r), VSR_STATUS_OK);
+    EXPECT_EQ(r.outcome().termination, VSR_TERMINATION_CANCELLED);
 }
 
 TEST(CppApi, Versions) {

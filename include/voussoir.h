@@ -4,11 +4,15 @@
  * Link with -lvoussoir (CMake: find_package(Voussoir CONFIG REQUIRED) and
  * target_link_libraries(app PRIVATE Voussoir::voussoir); pkg-config: voussoir).
  *
- * Objects. Three opaque handles, each created by one function and freed by its _destroy
- * function (destroy(NULL) does nothing):
+ * Objects. Opaque handles, each created by one function and freed by its _destroy function
+ * (destroy(NULL) does nothing):
  *   VsrMesh      vsr_mesh_create: a validated triangle mesh, its supports and loads;
  *   VsrSettings  vsr_settings_create: solver options with documented defaults;
- *   VsrResult    vsr_analyse / vsr_form_find: everything a solve reports, read by copy-out.
+ *   VsrResult    vsr_analyse / vsr_form_find: everything a solve reports, read by copy-out;
+ * and for masonry assessment (a thrust surface inside the masonry, Heyman's safe theorem):
+ *   VsrEnvelope        vsr_envelope_from_thickness / _from_surfaces: intrados and extrados;
+ *   VsrAssessSettings  vsr_assess_settings_create: the analysis and its options;
+ *   VsrAssessment      vsr_assess: the thrust surface and its figures, read by copy-out.
  * The caller owns every handle it receives. Arrays passed in are copied; the library never
  * keeps or frees caller memory.
  *
@@ -29,11 +33,11 @@
  * cross the boundary (VSR_STATUS_PANIC).
  *
  * Thread safety. Every function may be called from any thread. A handle passed as `const`
- * (VsrMesh, VsrSettings to the solves, VsrResult to its getters) may be used by several
- * threads at once; a handle passed non-const (setters, destroy) needs exclusive access: no
- * other thread may use it during the call. Solves on different or shared-const handles run
+ * (VsrMesh, VsrSettings, VsrEnvelope and VsrAssessSettings to the solves, results to their
+ * getters) may be used by several threads at once; a handle passed non-const (setters,
+ * destroy) needs exclusive access: no other thread may use it during the call. Solves on different or shared-const handles run
  * concurrently and give the same results as run one after another. The last error message is
- * per thread. A progress callback runs on the thread that called vsr_form_find. Within a
+ * per thread. A progress callback runs on the thread that called the solve. Within a
  * solve, large stress QPs (from about 10k vertices) factor and solve their normal matrix on
  * the calling thread and one more, started and joined inside each factorisation or solve;
  * the results do not depend on the threads' timing.
@@ -65,6 +69,11 @@
  * SONAME (`libvoussoir.so.1`).
  */
 #define VSR_ABI_VERSION 1
+
+/**
+ * The vertex id that stands for "no vertex" in `vsr_assessment_certificate`.
+ */
+#define VSR_NO_VERTEX UINT32_MAX
 
 /**
  * Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
@@ -291,6 +300,48 @@ typedef uint32_t VsrTermination;
 #endif // __cplusplus
 
 /**
+ * What `vsr_assess` optimises (`vsr_assess_settings_set_objective`,
+ * `vsr_assessment_objective`).
+ */
+enum VsrObjective
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : uint32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+  /**
+   * Default: does a thrust surface fit? The one nearest the middle surface (least
+   * area-weighted squared height difference).
+   */
+  VSR_OBJECTIVE_FIT = 0,
+  /**
+   * The least thickness: the smallest scale s of the envelope's half extents about the
+   * middle surface that still holds a thrust surface (the loads stay those of the given
+   * thickness); the geometric safety factor is 1 / s.
+   */
+  VSR_OBJECTIVE_MIN_THICKNESS = 1,
+  /**
+   * The least horizontal thrust, Σ over supports of |H| (the passive state).
+   */
+  VSR_OBJECTIVE_MIN_THRUST = 2,
+  /**
+   * The greatest horizontal thrust (the active state).
+   */
+  VSR_OBJECTIVE_MAX_THRUST = 3,
+  /**
+   * The largest factor λ on the load pattern (`vsr_assess_settings_set_load_pattern`)
+   * added to the self-weight.
+   */
+  VSR_OBJECTIVE_MAX_LOAD = 4,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum VsrObjective VsrObjective;
+#else
+typedef uint32_t VsrObjective;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * Normal stress τ at free boundary vertices (`vsr_settings_set_tau_mode`).
  */
 enum VsrTauMode
@@ -477,6 +528,29 @@ typedef enum VsrMethod VsrMethod;
 typedef uint32_t VsrMethod;
 #endif // __STDC_VERSION__ >= 202311L
 #endif // __cplusplus
+
+/**
+ * Opaque handle: the options of `vsr_assess`. Create with `vsr_assess_settings_create`
+ * (defaults documented there), change with the `vsr_assess_settings_set_*` functions, free
+ * with `vsr_assess_settings_destroy`.
+ */
+typedef struct VsrAssessSettings VsrAssessSettings;
+
+/**
+ * Opaque handle: the outcome of `vsr_assess`. It owns copies of everything it reports; free
+ * with `vsr_assessment_destroy`. Immutable: a `const VsrAssessment*` may be read from several
+ * threads at once.
+ */
+typedef struct VsrAssessment VsrAssessment;
+
+/**
+ * Opaque handle: the masonry's envelope over a mesh's plan, per vertex an intrados (lower)
+ * and an extrados (upper) height and per face the thickness whose weight loads the vault.
+ * Create with `vsr_envelope_from_thickness` or `vsr_envelope_from_surfaces`, free with
+ * `vsr_envelope_destroy`. Immutable: a `const VsrEnvelope*` may be read from several threads
+ * at once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
+ */
+typedef struct VsrEnvelope VsrEnvelope;
 
 /**
  * Opaque handle: a validated triangle mesh (plan x, y; height z), its supports and its loads.
@@ -1456,6 +1530,375 @@ VsrStatus vsr_analyse(const struct VsrMesh *mesh, const struct VsrSettings *sett
  * valid for the duration of the call.
  */
 VsrStatus vsr_form_find(const struct VsrMesh *mesh, const struct VsrSettings *settings, struct VsrResult **out);
+
+/**
+ * The envelope of a masonry of thickness `thickness` about the mesh as middle surface:
+ * `n_thickness` is 1 (a uniform thickness) or the mesh's face count (one per face, in the
+ * order of its triangles). The masonry extends t/2 to either side along the unit vertex
+ * normal n (area-weighted mean of the faces' normals), read vertically as t / (2 n_z) above
+ * and below each vertex; a vertex takes the area-weighted mean of its faces' thicknesses.
+ * Lengths in the units of the positions.
+ *
+ * `out` receives a new envelope owned by the caller (free with `vsr_envelope_destroy`);
+ * untouched on failure.
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a thickness that is NaN or infinite
+ * (`VSR_STATUS_NON_FINITE`, naming the entry); `n_thickness` neither 1 nor the face count,
+ * a thickness <= 0 (naming the face), or a vertex where the mesh is vertical or overhangs
+ * (normal z-component <= 1e-6: give intrados and extrados there instead)
+ * (`VSR_STATUS_INVALID_ARGUMENT`).
+ *
+ * # Safety
+ * `mesh`: a valid handle; `thickness`: `n_thickness` readable doubles; `out` writable.
+ */
+VsrStatus vsr_envelope_from_thickness(const struct VsrMesh *mesh, const double *thickness, size_t n_thickness, struct VsrEnvelope **out);
+
+/**
+ * The envelope between an intrados and an extrados given as triangle surfaces (any
+ * triangulation; positions #V by 3 doubles, triangles #F by 3 `uint32_t` ids, row-major),
+ * sampled on the vertical through each vertex of the mesh by linear interpolation on the
+ * triangle whose plan contains it (where several do, the highest intrados and the lowest
+ * extrados count). The middle surface is halfway between; the load's thickness is the
+ * vertical extent times the middle surface's normal z-component there.
+ *
+ * `out` receives a new envelope owned by the caller (free with `vsr_envelope_destroy`);
+ * untouched on failure.
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a count times 3 that overflows
+ * (`VSR_STATUS_LENGTH_OVERFLOW`); a triangle id beyond its surface's vertices
+ * (`VSR_STATUS_INDEX_OUT_OF_RANGE`); a coordinate that is NaN or infinite
+ * (`VSR_STATUS_NON_FINITE`); a mesh vertex a surface does not cover, or where the intrados
+ * lies above the extrados (`VSR_STATUS_INVALID_ARGUMENT`, naming the vertex).
+ *
+ * # Safety
+ * `mesh`: a valid handle; each array readable for its count of rows; `out` writable.
+ */
+VsrStatus vsr_envelope_from_surfaces(const struct VsrMesh *mesh, const double *intrados_positions, size_t n_intrados_vertices, const uint32_t *intrados_triangles, size_t n_intrados_triangles, const double *extrados_positions, size_t n_extrados_vertices, const uint32_t *extrados_triangles, size_t n_extrados_triangles, struct VsrEnvelope **out);
+
+/**
+ * Frees an envelope. NULL is a no-op.
+ *
+ * # Safety
+ * `envelope` must be NULL or a handle from a `vsr_envelope_from_*` function not yet
+ * destroyed, used by no other thread.
+ */
+void vsr_envelope_destroy(struct VsrEnvelope *envelope);
+
+/**
+ * Intrados height per vertex, #V doubles (0 at vertices used by no triangle). Copy-out as
+ * described in the header's introduction.
+ *
+ * # Safety
+ * `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_envelope_lower(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Extrados height per vertex, #V doubles (0 at vertices used by no triangle).
+ *
+ * # Safety
+ * `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_envelope_upper(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Thickness per face measured along the middle surface's normal, #F doubles: area ×
+ * thickness × unit weight is the face's weight.
+ *
+ * # Safety
+ * `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_envelope_face_thickness(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Creates assessment settings with the documented defaults (those of the Rust
+ * `AssessSettings`):
+ *
+ * | option | default |
+ * |---|---|
+ * | objective | `VSR_OBJECTIVE_FIT` |
+ * | fixed supports | 0 (the thrust meets each support anywhere within the envelope) |
+ * | unit weight (weight per volume) | 1 |
+ * | load rule | `VSR_LOAD_RULE_BARYCENTRIC` |
+ * | load pattern (max-load) | none |
+ * | q_min | 0, `VSR_BOUND_KIND_ABSOLUTE` (compression only) |
+ * | tolerance (on ε∞ of a certified surface) | 1e-6 |
+ * | max iterations (sequential QP steps) | 200 |
+ * | progress callback | none |
+ *
+ * `out` receives a handle owned by the caller (free with `vsr_assess_settings_destroy`);
+ * untouched on failure.
+ *
+ * # Safety
+ * `out` must be writable.
+ */
+VsrStatus vsr_assess_settings_create(struct VsrAssessSettings **out);
+
+/**
+ * Frees assessment settings. NULL is a no-op.
+ *
+ * # Safety
+ * `settings` must be NULL or a handle from `vsr_assess_settings_create` not yet destroyed,
+ * used by no other thread.
+ */
+void vsr_assess_settings_destroy(struct VsrAssessSettings *settings);
+
+/**
+ * Sets the analysis: a `VsrObjective`. Default `VSR_OBJECTIVE_FIT`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_objective(struct VsrAssessSettings *settings, uint32_t objective);
+
+/**
+ * 1 keeps the supports at the mesh's heights (they must lie inside the envelope); 0 (default)
+ * lets the thrust meet each support anywhere between its intrados and extrados.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_fixed_supports(struct VsrAssessSettings *settings, uint32_t fixed);
+
+/**
+ * Sets the weight per unit volume of the masonry: a face weighs its area on the middle
+ * surface × its thickness × `unit_weight`. Finite and > 0. Default 1.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_unit_weight(struct VsrAssessSettings *settings, double unit_weight);
+
+/**
+ * Sets how a face's weight is shared among its corners: a `VsrLoadRule`. Default
+ * `VSR_LOAD_RULE_BARYCENTRIC`.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_load_rule(struct VsrAssessSettings *settings, uint32_t rule);
+
+/**
+ * Sets the live load of `VSR_OBJECTIVE_MAX_LOAD`: a downward load per mesh vertex, #V
+ * doubles (copied), multiplied by λ and added to the self-weight. `n` 0 removes it (the
+ * default: none). Other objectives ignore it; `vsr_assess` checks its length against the
+ * mesh and, for max-load, that it loads a non-anchored vertex.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access; `loads`: `n` readable doubles.
+ */
+VsrStatus vsr_assess_settings_set_load_pattern(struct VsrAssessSettings *settings, const double *loads, size_t n);
+
+/**
+ * Sets the lower bound on the force densities: `kind` a `VsrBoundKind` (absolute, force
+ * per length; or relative, × mean load / half the plan diagonal). Finite and >= 0. Default 0
+ * absolute: compression only.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_q_min(struct VsrAssessSettings *settings, double value, uint32_t kind);
+
+/**
+ * Sets the largest ε∞ (max vertical residual / mean load, dimensionless) of a certified
+ * thrust surface. In (0, 1). Default 1e-6.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_tolerance(struct VsrAssessSettings *settings, double tolerance);
+
+/**
+ * Sets the most sequential QP steps of the search (>= 1). Default 200.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access.
+ */
+VsrStatus vsr_assess_settings_set_max_iterations(struct VsrAssessSettings *settings, size_t max_iterations);
+
+/**
+ * Sets the progress callback of `vsr_assess` (a `VsrProgressFn`, called once per step with
+ * the 1-based step and, in place of ε∞, the infeasibility of the state reached: its largest
+ * vertical residual over the mean load) and the `user` pointer passed back to it unchanged.
+ * A non-zero return cancels (`VSR_TERMINATION_CANCELLED`). `callback` NULL removes it
+ * (default: none). As `vsr_settings_set_progress` otherwise.
+ *
+ * # Safety
+ * `settings`: a valid handle with exclusive access; `callback`: NULL or a function with the
+ * `VsrProgressFn` signature.
+ */
+VsrStatus vsr_assess_settings_set_progress(struct VsrAssessSettings *settings, VsrProgressFn callback, void *user);
+
+/**
+ * Masonry assessment (Heyman's safe theorem): a compression-only thrust surface over the
+ * mesh's plan in equilibrium with the masonry's self-weight (the envelope's thickness × unit
+ * weight on its middle surface, plus the mesh's extra loads and, for max-load, λ × the load
+ * pattern) that lies between intrados and extrados, optimal for the settings' objective.
+ * The mesh's face densities are not used. Calls the progress callback of `settings`, if
+ * any, once per step on this thread.
+ *
+ * A search that finds no certified surface is still `VSR_STATUS_OK`: read
+ * `vsr_assessment_outcome` (feasible 0 with the least infeasible state, and where it fails).
+ * `out` receives a new assessment owned by the caller (free with `vsr_assessment_destroy`);
+ * untouched on failure. `mesh`, `envelope` and `settings` are only read.
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); an envelope made for another mesh, a
+ * load pattern of the wrong length (or, for max-load, missing or 0 on every non-anchored
+ * vertex), fixed supports outside the envelope, a mesh whose every vertex is anchored
+ * (`VSR_STATUS_INVALID_ARGUMENT`, naming the argument); `VSR_STATUS_NUMERICAL` when a QP
+ * fails.
+ *
+ * # Safety
+ * `mesh`, `envelope`, `settings`: valid handles; `out` writable; the callback and its `user`
+ * pointer valid for the duration of the call.
+ */
+VsrStatus vsr_assess(const struct VsrMesh *mesh, const struct VsrEnvelope *envelope, const struct VsrAssessSettings *settings, struct VsrAssessment **out);
+
+/**
+ * Frees an assessment. NULL is a no-op.
+ *
+ * # Safety
+ * `assessment` must be NULL or a handle from `vsr_assess` not yet destroyed, used by no other
+ * thread.
+ */
+void vsr_assessment_destroy(struct VsrAssessment *assessment);
+
+/**
+ * The analysis that was run (a `VsrObjective`). Written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out` writable.
+ */
+VsrStatus vsr_assessment_objective(const struct VsrAssessment *assessment, VsrObjective *out);
+
+/**
+ * How the search ended: `feasible` 1 when the positions with the force densities are a
+ * certified thrust surface (ε∞ below the tolerance, every force density within its bounds,
+ * every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
+ * least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
+ * when the objective's optimum was reached (else why the search stopped: max iterations,
+ * stalled, cancelled, ...); the steps taken; the wall-clock seconds. Every pointer
+ * required; written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_assessment_outcome(const struct VsrAssessment *assessment, uint32_t *feasible, VsrTermination *termination, size_t *iterations, double *seconds);
+
+/**
+ * The analysis' figures: `thickness_scale` s, the scale of the envelope's half extents
+ * (the least one for min-thickness, else 1); `safety_factor` 1 / s; `thrust_horizontal`,
+ * Σ over supports of the horizontal reaction's magnitude (force); `load_factor` λ of
+ * max-load (else 0). Every pointer required; written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_assessment_figures(const struct VsrAssessment *assessment, double *thickness_scale, double *safety_factor, double *thrust_horizontal, double *load_factor);
+
+/**
+ * The certificate's figures: `eps_inf`, max |vertical residual| / mean load over the
+ * non-anchored vertices; `horizontal_imbalance`, the largest horizontal imbalance at a
+ * non-anchored vertex over the mean load; `worst_bound`, the largest excess of a height over
+ * its bounds (0 when all are inside) and `worst_bound_vertex` its vertex; and
+ * `worst_residual_vertex`, the vertex of the largest residual (`VSR_NO_VERTEX` where there
+ * is none). Every pointer required; written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_assessment_certificate(const struct VsrAssessment *assessment, double *eps_inf, double *horizontal_imbalance, double *worst_bound, uint32_t *worst_bound_vertex, uint32_t *worst_residual_vertex);
+
+/**
+ * A one-line description of the termination, as a NUL-terminated UTF-8 string copied into
+ * `out` (`len` bytes; `needed` counts the terminating NUL); for `VSR_TERMINATION_STALLED` it
+ * lists the vertices with the largest residuals.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable bytes; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_termination_message(const struct VsrAssessment *assessment, char *out, size_t len, size_t *needed);
+
+/**
+ * The thrust surface, #V by 3 doubles: the mesh's plan with the heights found.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_positions(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Force density per edge (rows of `vsr_assessment_edges`), #E doubles (force per length,
+ * compression positive).
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_force_densities(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Vertical load per vertex, #V doubles (downward positive): the self-weight, the mesh's
+ * extra loads and λ × the load pattern.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_loads(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Vertical residual per vertex, #V doubles (0 at supports).
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_residuals(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Lower bound per vertex at the reported thickness (the envelope's intrados, scaled by the
+ * thickness scale about the middle surface), #V doubles.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_lower(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Upper bound per vertex at the reported thickness, #V doubles.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_upper(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Horizontal reaction per vertex, #V by 2 doubles (non-zero at supports): the force the
+ * vault pushes the support with.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_reactions(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * Edges, #E by 2 `uint32_t` vertex ids (smaller first), row-major, sorted: the rows of
+ * `vsr_assessment_force_densities` (the mesh's edges, as `vsr_mesh_edges`).
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_edges(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
 
 #ifdef __cplusplus
 }  // extern "C"

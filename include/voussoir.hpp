@@ -7,13 +7,20 @@
  *   voussoir::Result result = voussoir::form_find(mesh, settings);
  *   std::vector<double> shape = result.positions();
  *
+ *   // Masonry assessment: a thrust surface inside a 0.1 thick masonry about the mesh.
+ *   voussoir::AssessSettings assess_settings;
+ *   assess_settings.objective(VSR_OBJECTIVE_MIN_THICKNESS);
+ *   voussoir::Assessment a = voussoir::assess(mesh, voussoir::Envelope::from_thickness(mesh, 0.1),
+ *                                             assess_settings);
+ *   double safety = a.figures().safety_factor;
+ *
  * Link with Voussoir::voussoir (CMake: find_package(Voussoir CONFIG REQUIRED)) or with
  * `pkg-config --libs voussoir`; nothing else is needed. The adapters voussoir/cgal.hpp and
  * voussoir/openmesh.hpp convert CGAL and OpenMesh meshes.
  *
- * Ownership. Mesh, Settings and Result own one C handle each: move-only, freed by the
- * destructor. A moved-from object is empty (get() is NULL); every call on it fails with
- * VSR_STATUS_NULL_POINTER. get() lends the handle to the C API; release() gives it up.
+ * Ownership. Mesh, Settings, Result, Envelope, AssessSettings and Assessment own one C
+ * handle each: move-only, freed by the destructor. A moved-from object is empty (get() is
+ * NULL); every call on it fails with VSR_STATUS_NULL_POINTER. get() lends the handle to the C API; release() gives it up.
  *
  * Errors. Calls throw voussoir::Error, which carries the C status and a copy of the library's
  * one-line message (vsr_last_error_message) taken on the throwing thread. Each fallible call
@@ -550,6 +557,228 @@ class Result {
     detail::Owner<VsrResult, vsr_result_destroy> owner_;
 };
 
+// ---------------------------------------------------------------------------------------------
+// Masonry assessment: a thrust surface inside the masonry (vsr_assess).
+
+/// The masonry between intrados and extrados over a mesh's plan (VsrEnvelope): per vertex a
+/// lower and an upper height, per face the thickness whose weight loads the vault.
+class Envelope {
+  public:
+    Envelope() noexcept = default;
+    /// Adopts a handle from vsr_envelope_from_* (NULL: an empty Envelope).
+    explicit Envelope(VsrEnvelope *handle) noexcept : owner_(handle) {}
+
+    /// A uniform (one value) or per-face (#F values) thickness about the mesh as middle
+    /// surface, along its normals (vsr_envelope_from_thickness). Throws Error.
+    static Envelope from_thickness(const Mesh &mesh, const std::vector<double> &thickness) {
+        Envelope e;
+        check(try_from_thickness(mesh, thickness.data(), thickness.size(), e));
+        return e;
+    }
+    static Envelope from_thickness(const Mesh &mesh, double thickness) {
+        return from_thickness(mesh, std::vector<double>{thickness});
+    }
+    [[nodiscard]] static VsrStatus try_from_thickness(const Mesh &mesh, const double *thickness,
+                                                      std::size_t n, Envelope &out) noexcept {
+        VsrEnvelope *raw = nullptr;
+        const VsrStatus status = vsr_envelope_from_thickness(mesh.get(), thickness, n, &raw);
+        if (status == VSR_STATUS_OK) out.owner_.reset(raw);
+        return status;
+    }
+
+    /// Intrados and extrados as triangle surfaces (#V by 3 positions, #F by 3 triangles each,
+    /// any triangulation), sampled over the mesh's vertices (vsr_envelope_from_surfaces).
+    /// Throws Error.
+    static Envelope from_surfaces(const Mesh &mesh, const std::vector<double> &intrados,
+                                  const std::vector<std::uint32_t> &intrados_triangles,
+                                  const std::vector<double> &extrados,
+                                  const std::vector<std::uint32_t> &extrados_triangles) {
+        Envelope e;
+        check(try_from_surfaces(
+            mesh, intrados.data(), detail::rows(intrados.size(), 3, "intrados"),
+            intrados_triangles.data(),
+            detail::rows(intrados_triangles.size(), 3, "intrados_triangles"), extrados.data(),
+            detail::rows(extrados.size(), 3, "extrados"), extrados_triangles.data(),
+            detail::rows(extrados_triangles.size(), 3, "extrados_triangles"), e));
+        return e;
+    }
+    [[nodiscard]] static VsrStatus try_from_surfaces(
+        const Mesh &mesh, const double *intrados, std::size_t n_intrados_vertices,
+        const std::uint32_t *intrados_triangles, std::size_t n_intrados_triangles,
+        const double *extrados, std::size_t n_extrados_vertices,
+        const std::uint32_t *extrados_triangles, std::size_t n_extrados_triangles,
+        Envelope &out) noexcept {
+        VsrEnvelope *raw = nullptr;
+        const VsrStatus status = vsr_envelope_from_surfaces(
+            mesh.get(), intrados, n_intrados_vertices, intrados_triangles, n_intrados_triangles,
+            extrados, n_extrados_vertices, extrados_triangles, n_extrados_triangles, &raw);
+        if (status == VSR_STATUS_OK) out.owner_.reset(raw);
+        return status;
+    }
+
+    VsrEnvelope *get() const noexcept { return owner_.get(); }
+    VsrEnvelope *release() noexcept { return owner_.release(); }
+    explicit operator bool() const noexcept { return static_cast<bool>(owner_); }
+
+    VOUSSOIR_DETAIL_GETTER(double, lower, vsr_envelope_lower, VsrEnvelope)
+    VOUSSOIR_DETAIL_GETTER(double, upper, vsr_envelope_upper, VsrEnvelope)
+    VOUSSOIR_DETAIL_GETTER(double, face_thickness, vsr_envelope_face_thickness, VsrEnvelope)
+
+  private:
+    detail::Owner<VsrEnvelope, vsr_envelope_destroy> owner_;
+};
+
+// One fluent setter over vsr_assess_settings_set_<name> and its try_ twin.
+#define VOUSSOIR_DETAIL_ASSESS_SETTER(name, Type)             \
+    AssessSettings &name(Type value) {                        \
+        check(try_##name(value));                             \
+        return *this;                                         \
+    }                                                         \
+    [[nodiscard]] VsrStatus try_##name(Type value) noexcept { \
+        return vsr_assess_settings_set_##name(get(), value);  \
+    }
+
+/// Options of assess with the C API's defaults (vsr_assess_settings_create), set fluently:
+/// `settings.objective(VSR_OBJECTIVE_MIN_THICKNESS).unit_weight(20)`. Each setter throws
+/// Error and keeps the previous value when the new one is rejected; try_<name> returns the
+/// status instead.
+class AssessSettings {
+  public:
+    /// The defaults. Throws Error (only when the library cannot allocate).
+    AssessSettings() {
+        VsrAssessSettings *raw = nullptr;
+        check(vsr_assess_settings_create(&raw));
+        owner_.reset(raw);
+    }
+    AssessSettings(AssessSettings &&) noexcept = default;
+    AssessSettings &operator=(AssessSettings &&) noexcept = default;
+
+    VsrAssessSettings *get() const noexcept { return owner_.get(); }
+    explicit operator bool() const noexcept { return static_cast<bool>(owner_); }
+
+    VOUSSOIR_DETAIL_ASSESS_SETTER(objective, VsrObjective)
+    VOUSSOIR_DETAIL_ASSESS_SETTER(unit_weight, double)
+    VOUSSOIR_DETAIL_ASSESS_SETTER(load_rule, VsrLoadRule)
+    VOUSSOIR_DETAIL_ASSESS_SETTER(tolerance, double)
+    VOUSSOIR_DETAIL_ASSESS_SETTER(max_iterations, std::size_t)
+
+    AssessSettings &fixed_supports(bool fixed) {
+        check(try_fixed_supports(fixed));
+        return *this;
+    }
+    [[nodiscard]] VsrStatus try_fixed_supports(bool fixed) noexcept {
+        return vsr_assess_settings_set_fixed_supports(get(), fixed ? 1u : 0u);
+    }
+    /// The live load of max-load, one value per mesh vertex (empty: none).
+    AssessSettings &load_pattern(const std::vector<double> &loads) {
+        check(try_load_pattern(loads.data(), loads.size()));
+        return *this;
+    }
+    [[nodiscard]] VsrStatus try_load_pattern(const double *loads, std::size_t n) noexcept {
+        return vsr_assess_settings_set_load_pattern(get(), loads, n);
+    }
+    AssessSettings &q_min(double value, VsrBoundKind kind) {
+        check(try_q_min(value, kind));
+        return *this;
+    }
+    [[nodiscard]] VsrStatus try_q_min(double value, VsrBoundKind kind) noexcept {
+        return vsr_assess_settings_set_q_min(get(), value, kind);
+    }
+    /// Called once per step with the step (1-based) and the infeasibility of the state
+    /// reached; Cancel stops the search (VSR_TERMINATION_CANCELLED). An empty function
+    /// removes it; an exception it throws cancels and is rethrown by assess.
+    AssessSettings &progress(ProgressFn callback) {
+        auto fn = callback ? std::make_unique<ProgressFn>(std::move(callback)) : nullptr;
+        check(vsr_assess_settings_set_progress(get(), fn ? detail::progress_trampoline : nullptr,
+                                               fn.get()));
+        progress_ = std::move(fn);
+        return *this;
+    }
+
+  private:
+    detail::Owner<VsrAssessSettings, vsr_assess_settings_destroy> owner_;
+    std::unique_ptr<ProgressFn> progress_;  // heap: its address survives moves
+};
+
+#undef VOUSSOIR_DETAIL_ASSESS_SETTER
+
+/// vsr_assessment_outcome.
+struct AssessmentOutcome {
+    bool feasible = false;
+    VsrTermination termination = VSR_TERMINATION_NUMERICAL_ERROR;
+    std::size_t iterations = 0;
+    double seconds = 0;
+    /// A certified thrust surface, optimal for the objective.
+    bool converged() const noexcept {
+        return feasible && termination == VSR_TERMINATION_CONVERGED;
+    }
+};
+/// vsr_assessment_figures.
+struct AssessmentFigures {
+    double thickness_scale = 1, safety_factor = 1, thrust_horizontal = 0, load_factor = 0;
+};
+/// vsr_assessment_certificate; vertices are VSR_NO_VERTEX where there is none.
+struct Certificate {
+    double eps_inf = 0, horizontal_imbalance = 0, worst_bound = 0;
+    std::uint32_t worst_bound_vertex = VSR_NO_VERTEX, worst_residual_vertex = VSR_NO_VERTEX;
+};
+
+/// The outcome of assess (VsrAssessment): immutable, every getter is const.
+class Assessment {
+  public:
+    Assessment() noexcept = default;
+    /// Adopts a handle from vsr_assess (NULL: an empty Assessment).
+    explicit Assessment(VsrAssessment *handle) noexcept : owner_(handle) {}
+
+    VsrAssessment *get() const noexcept { return owner_.get(); }
+    VsrAssessment *release() noexcept { return owner_.release(); }
+    explicit operator bool() const noexcept { return static_cast<bool>(owner_); }
+
+    VOUSSOIR_DETAIL_GETTER(double, positions, vsr_assessment_positions, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(std::uint32_t, edges, vsr_assessment_edges, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, force_densities, vsr_assessment_force_densities, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, loads, vsr_assessment_loads, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, residuals, vsr_assessment_residuals, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, lower, vsr_assessment_lower, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, upper, vsr_assessment_upper, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(double, reactions, vsr_assessment_reactions, VsrAssessment)
+
+    VsrObjective objective() const {
+        VsrObjective o = VSR_OBJECTIVE_FIT;
+        check(vsr_assessment_objective(get(), &o));
+        return o;
+    }
+    AssessmentOutcome outcome() const {
+        AssessmentOutcome o;
+        std::uint32_t feasible = 0;
+        check(vsr_assessment_outcome(get(), &feasible, &o.termination, &o.iterations,
+                                     &o.seconds));
+        o.feasible = feasible != 0;
+        return o;
+    }
+    AssessmentFigures figures() const {
+        AssessmentFigures f;
+        check(vsr_assessment_figures(get(), &f.thickness_scale, &f.safety_factor,
+                                     &f.thrust_horizontal, &f.load_factor));
+        return f;
+    }
+    Certificate certificate() const {
+        Certificate c;
+        check(vsr_assessment_certificate(get(), &c.eps_inf, &c.horizontal_imbalance,
+                                         &c.worst_bound, &c.worst_bound_vertex,
+                                         &c.worst_residual_vertex));
+        return c;
+    }
+    std::string termination_message() const {
+        std::vector<char> text;
+        detail::copy_into<char, VsrAssessment>(vsr_assessment_termination_message, get(), text);
+        return text.empty() ? std::string() : std::string(text.data());
+    }
+
+  private:
+    detail::Owner<VsrAssessment, vsr_assessment_destroy> owner_;
+};
+
 #undef VOUSSOIR_DETAIL_GETTER
 
 /// Stress analysis of the mesh as given (vsr_analyse). Throws Error.
@@ -587,6 +816,33 @@ inline Result form_find(const Mesh &mesh, const Settings &settings = Settings())
         std::rethrow_exception(thrown);
     check(status);
     return result;
+}
+
+/// Masonry assessment (vsr_assess): a compression-only thrust surface in equilibrium with the
+/// envelope's self-weight, between intrados and extrados, optimal for the settings'
+/// objective. A search that certifies none is not an error: read Assessment::outcome().
+/// The try_ twin returns the status; an exception thrown by the progress callback cancels
+/// the search and then propagates from assess (try_assess drops it).
+[[nodiscard]] inline VsrStatus try_assess(const Mesh &mesh, const Envelope &envelope,
+                                          const AssessSettings &settings,
+                                          Assessment &out) noexcept {
+    VsrAssessment *raw = nullptr;
+    detail::progress_exception() = nullptr;
+    const VsrStatus status = vsr_assess(mesh.get(), envelope.get(), settings.get(), &raw);
+    detail::progress_exception() = nullptr;
+    if (status == VSR_STATUS_OK) out = Assessment(raw);
+    return status;
+}
+inline Assessment assess(const Mesh &mesh, const Envelope &envelope,
+                         const AssessSettings &settings = AssessSettings()) {
+    VsrAssessment *raw = nullptr;
+    detail::progress_exception() = nullptr;
+    const VsrStatus status = vsr_assess(mesh.get(), envelope.get(), settings.get(), &raw);
+    Assessment assessment(raw);
+    if (std::exception_ptr thrown = std::exchange(detail::progress_exception(), nullptr))
+        std::rethrow_exception(thrown);
+    check(status);
+    return assessment;
 }
 
 }  // namespace voussoir

@@ -17,6 +17,7 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
+mod assess;
 pub mod capi;
 mod error;
 pub mod generate;
@@ -34,6 +35,7 @@ mod solve;
 mod stress;
 mod validate;
 
+pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;

@@ -1168,6 +1168,12 @@ fn solves_reject_weightless_and_unrepresentable_loads() {
                 "loads",
             );
             assert!(last_error().contains(why), "{}", last_error());
+            // Issue 48: "argument `loads`: invalid argument `loads`: ..." said it twice.
+            assert!(
+                !last_error().contains("invalid argument"),
+                "{}",
+                last_error()
+            );
             assert_eq!(out, sentinel());
         }
         unsafe { vsr_mesh_destroy(mesh) };

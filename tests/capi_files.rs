@@ -290,7 +290,20 @@ fn mesh_read_rejects_hostile_paths_and_files() {
         S::NoSupport,
         "anchored",
     );
-    let bad_files: [(&str, &[u8], &str); 6] = [
+    // Issue 48: a PLY count beyond 64 bits returned VSR_STATUS_PANIC.
+    let huge_count = b"ply\nformat ascii 1.0\nelement vertex 99999999999999999999999\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let long_face = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2 3\n";
+    let bad_files: [(&str, &[u8], &str); 8] = [
+        (
+            "h.ply",
+            huge_count,
+            "h.ply:3: bad header: element `vertex`: count `99999999999999999999999` is larger",
+        ),
+        (
+            "f.ply",
+            long_face,
+            "f.ply:14: face 0: 1 more number than its properties take",
+        ),
         ("missing.obj", b"", "missing.obj"),
         ("m.xyz", b"OFF", "unknown extension"),
         ("t.off", b"OFF\n5 4 0\n0 0 0\n", "t.off:3: the file ends before vertex 1"),
@@ -365,6 +378,25 @@ fn result_write_rejects_hostile_arguments_and_writes_nothing() {
             "mesh",
         );
         vsr_mesh_destroy(big);
+        // Issue 48: a device or FIFO behind the path was replaced by a regular file.
+        #[cfg(unix)]
+        for (name, target) in [("full.off", "/dev/full"), ("null.off", "/dev/null")] {
+            let link = dir.path(name);
+            std::os::unix::fs::symlink(target, &link).unwrap();
+            let p = c(&link);
+            assert_failed(
+                vsr_result_write(result, mesh, p.as_ptr()),
+                S::InvalidArgument,
+                "path",
+            );
+            assert!(
+                last_error().contains("character device"),
+                "{}",
+                last_error()
+            );
+            fs::remove_file(&link).unwrap();
+            assert!(!fs::metadata(target).unwrap().is_file());
+        }
     }
     assert_eq!(
         fs::read_dir(&dir.0).unwrap().count(),

@@ -556,6 +556,10 @@ fn twisted_rings_of_split_quads_are_named_when_infeasible() {
         "{constraint}"
     );
     assert!(!constraint.contains("free edge"), "{constraint}");
+    // Issue 48: the hint named a Rust function (`Problem::with_polygon_diagonals`), which C,
+    // Python and command-line users cannot call.
+    assert!(constraint.contains("read as polygons"), "{constraint}");
+    assert!(!constraint.contains("::"), "{constraint}");
     let alternating = Problem::new(lat_long_dome(5, 24, true));
     let r = form_find(&alternating, &settings, None).unwrap();
     assert_eq!(r.termination, Termination::Converged);

@@ -184,7 +184,7 @@ fn bad_files_exit_2_naming_the_line_or_element() {
     rejects_file(
         "g.ply",
         b"ply\nformat ascii 1.0\nelement vertex x\nend_header\n",
-        "g.ply:4: bad header",
+        "g.ply:3: bad header",
     );
     rejects_file("m.xyz", b"", "unknown extension `.xyz`");
 }

@@ -1,11 +1,17 @@
 //! The `formfind` example on mutated shared models: every mutation makes the input invalid
 //! (a malformed or unknown line, a bad index, a reversed, repeated or stacked face, a NaN or
 //! unrepresentable coordinate, bad supports), and every run must end with exit status 2, one
-//! line on stderr and no file written.
+//! line on stderr and no file written. The same holds for the models written as PLY (ASCII and
+//! binary), OFF and STL (ASCII and binary) with their header counts and face lines set to
+//! values at the limits of their types (0, -1, one off, 2^31, 2^32, 2^63, 2^64 and beyond), and
+//! for outputs that are devices, FIFOs, links to those or to the inputs, or the inputs.
 //!
-//! `VSR_FUZZ_CASES` sets the number of runs (24 by default, as in CI; a few thousand locally),
-//! `VSR_FUZZ_SEED` the seed of the first (each run's seed is printed with its failure).
+//! `VSR_FUZZ_CASES` sets the number of runs of each kind (24 by default, as in CI; a few
+//! thousand locally), `VSR_FUZZ_SEED` the seed of the first (each run's seed is printed with
+//! its failure).
 
+#[path = "formfind_fuzz/formats.rs"]
+mod formats;
 mod formfind_support;
 
 use std::fs;
@@ -183,39 +189,30 @@ fn env_number(name: &str, default: u64) -> u64 {
     }
 }
 
-fn run_case(models: &Path, names: &[String], seed: u64) {
-    let mut rng = Rng::new(seed);
-    let name = rng.pick(names).clone();
-    let mut model = Model {
+fn load(models: &Path, name: &str) -> Model {
+    Model {
         lines: fs::read_to_string(models.join(format!("{name}.obj")))
             .unwrap()
             .lines()
             .map(String::from)
             .collect(),
         supports: fs::read_to_string(models.join(format!("{name}.json"))).unwrap(),
-    };
-    let which = rng.below(MUTATIONS.len());
-    mutate(&mut model, which, &mut rng);
-    let dir = Scratch::new(&format!("fuzz-{seed}"));
-    fs::write(dir.path("m.obj"), model.lines.join("\n") + "\n").unwrap();
-    fs::write(dir.path("s.json"), &model.supports).unwrap();
+    }
+}
+
+/// Runs formfind on `input` (a file name in `dir`) with `extra` arguments; asserts exit status
+/// 2, one line on stderr and no file written or changed.
+fn assert_refused(dir: &Scratch, args: &[&str], case: &str) {
     let before = dir.snapshot();
-    let args = [
-        "m.obj",
-        "--supports",
-        "s.json",
-        "--out",
-        "outs/o.obj",
-        "--report",
-        "outs/r.json",
-        "--pictures",
-        "outs/pics",
-    ];
-    let out = run(&dir.0, &args);
+    let out = run(&dir.0, args);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    let case = format!("seed {seed}: {name}, {}", MUTATIONS[which]);
     assert_eq!(out.status.code(), Some(2), "{case}: {stderr}");
     assert_eq!(stderr.lines().count(), 1, "{case}: not one line: {stderr}");
+    assert!(
+        stderr.len() < 1000,
+        "{case}: {} bytes on stderr",
+        stderr.len()
+    );
     assert!(
         dir.snapshot() == before,
         "{case}: files written: {:?}",
@@ -223,10 +220,25 @@ fn run_case(models: &Path, names: &[String], seed: u64) {
     );
 }
 
-#[test]
-fn mutated_shared_models_get_exit_2_one_line_and_no_file() {
-    let Some(models) = models_dir() else { return };
-    let mut names: Vec<String> = fs::read_dir(&models)
+fn run_case(models: &Path, names: &[String], seed: u64) {
+    let mut rng = Rng::new(seed);
+    let name = rng.pick(names).clone();
+    let mut model = load(models, &name);
+    let which = rng.below(MUTATIONS.len());
+    mutate(&mut model, which, &mut rng);
+    let dir = Scratch::new(&format!("fuzz-{seed}"));
+    fs::write(dir.path("m.obj"), model.lines.join("\n") + "\n").unwrap();
+    fs::write(dir.path("s.json"), &model.supports).unwrap();
+    let args = ["m.obj", "--supports", "s.json", "--out", "outs/o.obj"];
+    let case = format!("seed {seed}: {name}, {}", MUTATIONS[which]);
+    assert_refused(&dir, &[&args[..], &OUTS[..]].concat(), &case);
+}
+
+/// The report's and pictures' paths of every run, inside a folder the run would create.
+const OUTS: [&str; 4] = ["--report", "outs/r.json", "--pictures", "outs/pics"];
+
+fn model_names(models: &Path) -> Vec<String> {
+    let mut names: Vec<String> = fs::read_dir(models)
         .unwrap()
         .filter_map(|e| {
             let path = e.unwrap().path();
@@ -238,6 +250,115 @@ fn mutated_shared_models_get_exit_2_one_line_and_no_file() {
         .collect();
     names.sort();
     assert!(!names.is_empty(), "no model in {}", models.display());
+    names
+}
+
+#[test]
+fn counts_and_face_lines_at_their_limits_in_every_format_get_exit_2() {
+    let Some(models) = models_dir() else { return };
+    let names = model_names(&models);
+    let cases = env_number("VSR_FUZZ_CASES", 24);
+    let first = env_number("VSR_FUZZ_SEED", 1);
+    for seed in first..first + cases {
+        let mut rng = Rng::new(seed ^ 0x5eed_f0f0);
+        let name = rng.pick(&names).clone();
+        let model = load(&models, &name);
+        let (file, bytes, what) = formats::mutated(&model, &mut rng);
+        let dir = Scratch::new(&format!("fuzz-format-{seed}"));
+        fs::write(dir.path(&file), bytes).unwrap();
+        let case = format!("seed {seed}: {name} as {file}, {what}");
+        let args = [&file, "--anchor-boundary", "--out", "outs/o.obj"];
+        assert_refused(&dir, &[&args[..], &OUTS[..]].concat(), &case);
+    }
+    println!("{cases} models with counts or face lines at their limits: exit 2, one line, no file");
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_that_are_devices_fifos_links_or_inputs_get_exit_2() {
+    use std::os::unix::fs::symlink;
+    let Some(models) = models_dir() else { return };
+    let names = model_names(&models);
+    let cases = env_number("VSR_FUZZ_CASES", 24);
+    let first = env_number("VSR_FUZZ_SEED", 1);
+    // Targets no output may replace; `link-*` are symbolic links made in each folder.
+    let targets = [
+        "/dev/null",
+        "/dev/full",
+        "/dev/zero",
+        "/proc/self/fd/1",
+        "/proc/self/fd/2",
+        "fifo",
+        "link-fifo",
+        "link-null",
+        "m.obj",
+        "s.json",
+        "link-mesh",
+        "hard-mesh",
+        "link-supports",
+    ];
+    for seed in first..first + cases {
+        let mut rng = Rng::new(seed ^ 0x0075_7075);
+        let name = rng.pick(&names).clone();
+        let model = load(&models, &name);
+        let dir = Scratch::new(&format!("fuzz-out-{seed}"));
+        fs::write(dir.path("m.obj"), model.lines.join("\n") + "\n").unwrap();
+        fs::write(dir.path("s.json"), &model.supports).unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(dir.path("fifo"))
+            .status();
+        assert!(made.unwrap().success());
+        let option = *rng.pick(&["--out", "--report", "--solid"]);
+        // --out and --solid need a mesh extension: their links carry one.
+        let ext = if option == "--report" { "json" } else { "obj" };
+        let target = *rng.pick(&targets);
+        let path = match target.strip_prefix("link-") {
+            Some(to) => {
+                let to = match to {
+                    "fifo" => "fifo".to_string(),
+                    "null" => "/dev/null".to_string(),
+                    "mesh" => "m.obj".to_string(),
+                    _ => "s.json".to_string(),
+                };
+                let link = format!("link.{ext}");
+                symlink(to, dir.path(&link)).unwrap();
+                link
+            }
+            None if target == "hard-mesh" => {
+                let hard = format!("hard.{ext}");
+                fs::hard_link(dir.path("m.obj"), dir.path(&hard)).unwrap();
+                hard
+            }
+            None => target.to_string(),
+        };
+        // --out and --solid refuse a path without a mesh extension before looking at it: the
+        // report takes those.
+        let option = if path.ends_with(".obj") {
+            option
+        } else {
+            "--report"
+        };
+        let mut args = vec!["m.obj", "--supports", "s.json", "--stress-only"];
+        args.extend(match option {
+            "--solid" => vec!["--solid", "0.01", path.as_str()],
+            _ => vec![option, path.as_str()],
+        });
+        let case = format!("seed {seed}: {name}, {option} {path} ({target})");
+        assert_refused(&dir, &args, &case);
+        for device in ["/dev/null", "/dev/full", "/dev/zero"] {
+            assert!(
+                !fs::metadata(device).unwrap().is_file(),
+                "{case}: {device} replaced"
+            );
+        }
+    }
+    println!("{cases} runs with hostile output paths: exit 2, one line, nothing written");
+}
+
+#[test]
+fn mutated_shared_models_get_exit_2_one_line_and_no_file() {
+    let Some(models) = models_dir() else { return };
+    let names = model_names(&models);
     let cases = env_number("VSR_FUZZ_CASES", 24);
     let first = env_number("VSR_FUZZ_SEED", 1);
     for seed in first..first + cases {

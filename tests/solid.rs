@@ -204,6 +204,58 @@ fn too_thick_is_refused_naming_the_face_and_what_fits() {
     assert!(smaller.is_ok(), "{:?}", smaller.err());
 }
 
+/// Issue 48: a thickness of 1e154 or more overflowed the fold check and passed (or failed
+/// only when written), one of 1e-20 vanished in `p + offset - p` and was refused as "no
+/// thickness fits". Both now get the largest thickness that fits or a range error.
+#[test]
+fn extreme_thicknesses_get_what_fits_or_the_range() {
+    let mesh = cap_dome(0.9, 200).unwrap();
+    let p = &mesh.positions;
+    let fits = |t: f64| {
+        let err = thicken(&mesh, p, &Thickness::Uniform(t))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("turns over"), "{t:e}: {err}");
+        let tail = err.split("at most ").nth(1).unwrap();
+        tail.split(' ').next().unwrap().parse::<f64>().unwrap()
+    };
+    let reference = fits(3.0);
+    for t in [1e154, 1e160, 1e200, 1e300, f64::MAX] {
+        assert_eq!(fits(t), reference, "{t:e}");
+    }
+    for t in [1e-11, 1e-9, 1e-3] {
+        let solid = thicken(&mesh, p, &Thickness::Uniform(t)).unwrap();
+        assert!(solid.volume() > 0.0, "{t:e}");
+    }
+    let named = |err: &str, before: &str| -> f64 {
+        let tail = err.split(before).nth(1).unwrap();
+        tail.trim_end_matches(|c: char| !c.is_ascii_digit())
+            .parse()
+            .unwrap()
+    };
+    for t in [1e-13, 1e-20, 1e-300, 5e-324] {
+        let err = thicken(&mesh, p, &Thickness::Uniform(t))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("too small for a solid"), "{t:e}: {err}");
+        let least = named(&err, "give at least ");
+        assert!(least > 1e-12 && least < 1e-11, "{err}");
+    }
+    // A flat plate folds at no thickness: beyond the range, the range is the answer.
+    let mut flat = p.clone();
+    for q in &mut flat {
+        q[2] = 0.0;
+    }
+    let plate = Mesh::new(flat.clone(), mesh.faces.clone(), &[0]).unwrap();
+    let err = thicken(&plate, &flat, &Thickness::Uniform(1e154))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("too large for a solid"), "{err}");
+    let most = named(&err, "give at most ");
+    assert!(most > 1e12 && most < 1e13, "{err}");
+    assert!(thicken(&plate, &flat, &Thickness::Uniform(most)).is_ok());
+}
+
 #[test]
 fn bad_thickness_and_positions_are_refused() {
     let mesh = cap_dome(0.9, 100).unwrap();

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
+use crate::assess::args::AssessOptions;
 use voussoir::io::{ReadOptions, Supports, UpAxis};
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
@@ -72,7 +73,12 @@ are replaced only when every output is written; two outputs may not share a path
                          and the form-found shape side by side, seen from
                          azimuth −60° and 30° above the horizon, shaded, the
                          faces coloured by height change; about 70 bytes per
-                         face and view (14 MB for 100k faces)
+                         face and view (14 MB for 100k faces). With --assess:
+                         plan_forces, section.svg (a vertical section: intrados,
+                         extrados, the thrust surface and the supports) and
+                         shape_3d.svg (the middle surface; the thrust surface,
+                         coloured by where it lies between intrados and
+                         extrados, under the translucent extrados)
   --solid T OUT          also a printable solid: the result thickened by T (half above,
                          half below, along vertex normals), closed by walls along every
                          boundary; OUT is .stl, .3mf (read as millimetres), .off, .obj or
@@ -84,6 +90,30 @@ are replaced only when every output is written; two outputs may not share a path
   --ascii                write STL and PLY outputs as ASCII text, not binary
   Without MESH, the embedded input is also written next to OUT, as NAME-input.obj
   and NAME-supports.json, to try other options on.
+
+Assessment (instead of form finding; MESH is the masonry's middle surface):
+  --assess A             fit | min-thickness | min-thrust | max-thrust | max-load: find a
+                         compression-only thrust surface in equilibrium with the masonry's
+                         self-weight between intrados and extrados, over MESH's plan (by
+                         Heyman's safe theorem the vault then stands): fit, the one nearest
+                         the middle surface; min-thickness, the least uniform scale s of the
+                         thickness that still holds one (safety factor 1/s); min-thrust and
+                         max-thrust, the least and greatest horizontal thrust at the
+                         supports; max-load, the largest factor on --load-pattern. OUT is
+                         the thrust surface; the report's \"assessment\" holds the figures
+  --thickness T          the masonry's thickness along MESH's normals, half above, half below
+                         (read vertically as T / (2 n_z)); or `density`: --density / W
+  --intrados A           instead of --thickness: the intrados and the extrados as meshes
+  --extrados B           (.obj, .off, .stl, .ply), sampled on the vertical through each vertex
+  --unit-weight W        weight per unit volume: self-weight = area x thickness x W      [1]
+  --fixed-supports       keep the supports at MESH's heights (by default the thrust meets
+                         each support anywhere within the envelope)
+  --load-pattern L.json  max-load: a downward load per vertex of MESH (ids before welding;
+                         loads of merged vertices add): {{\"loads\": [..]}}, [..] or
+                         {{\"loads\": {{\"ID\": load, ..}}}}
+  --section S            the section picture's vertical plane: y (through the plan's centre,
+                         along x), x, y=VALUE or x=VALUE                                  [y]
+  --tol, --max-iter, --qmin and --load apply too [1e-6, 200, 0abs, barycentric]
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
@@ -111,15 +141,18 @@ Solver:
                          lengths at each face (a smoother force diagram)   [{smooth}]
   --smoothing-decay D    form finding fades MU as MU D^k, 0 <= D < 1;
                          nearer 1: smoother, further from the input        [{decay}]
-  --odt N                ODT smoothing of the plan before each of the first N stress steps [0]
+  --odt N                ODT sweeps of the plan: the nearest method runs all N
+                         on the input first; the paper method one before
+                         each of its first N stress steps                  [0]
   --density D            weight per unit area of every face                [1]
   --load R               {loads}: how a face's
                          weight is shared among its vertices               [{load}]
   -h, --help             this text
 
-Exit status: 0 converged (or --stress-only solved), 3 finished without converging
-(outputs written, the report says why), 2 bad input, options or output paths (nothing
-written), 1 other failure (nothing written).
+Exit status: 0 converged (or --stress-only solved; with --assess: a certified thrust
+surface found and the analysis converged), 3 finished without converging or (--assess) with
+no thrust surface inside the envelope (outputs written, the report says why), 2 bad input,
+options or output paths (nothing written), 1 other failure (nothing written).
 ",
         methods = names(FormMethod::ALL, " | "),
         solvers = names(Formulation::ALL, " | "),
@@ -172,6 +205,10 @@ pub struct Options {
     pub odt: Option<usize>,
     pub density: f64,
     pub settings: FormFindSettings,
+    /// `--assess` and its options.
+    pub assess: AssessOptions,
+    /// Every option given, in order (to tell a default from a value given).
+    pub given: Vec<String>,
 }
 
 /// The thickness of `--solid`.
@@ -282,6 +319,25 @@ fn choice<T: FromStr<Err = voussoir::Error>>(flag: &str, text: &str) -> Result<T
     })
 }
 
+/// Records `flag` in `given`, refusing a second use of it (or of the other spelling of the
+/// same setting: `--weld` and `--no-weld`), which would otherwise keep the last value unseen.
+fn once(given: &mut Vec<String>, flag: &str) -> Result<(), String> {
+    let key = |f: &str| match f {
+        "--no-weld" => "--weld".to_string(),
+        other => other.to_string(),
+    };
+    match given.iter().find(|g| key(g) == key(flag)) {
+        Some(first) if first == flag => Err(format!("{flag} is given twice; give it once")),
+        Some(first) => Err(format!(
+            "{first} and {flag} are both given; give one of them"
+        )),
+        None => {
+            given.push(flag.to_string());
+            Ok(())
+        }
+    }
+}
+
 /// Parses `args` (without the program name).
 pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parsed, String> {
     use lexopt::Arg::{Long, Short, Value};
@@ -304,8 +360,11 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
         odt: None,
         density: 1.0,
         settings: FormFindSettings::default(),
+        assess: AssessOptions::default(),
+        given: Vec::new(),
     };
     let s = &mut o.settings;
+    let mut given: Vec<String> = Vec::new();
     while let Some(arg) = parser.next().map_err(|e| e.to_string())? {
         // Owned copies: `arg` borrows the parser, which `value()` needs.
         let (flag, positional) = match arg {
@@ -318,6 +377,9 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             v.into_string()
                 .map_err(|v| format!("{flag}: `{}` is not valid text", v.to_string_lossy()))
         };
+        if positional.is_none() {
+            once(&mut given, &flag)?;
+        }
         if let Some(path) = positional {
             if o.mesh.is_some() {
                 return Err(format!(
@@ -328,6 +390,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             o.mesh = Some(path.into());
             continue;
         }
+        o.given.push(flag.clone());
         match flag.as_str() {
             "-h" | "--help" => return Ok(Parsed::Help),
             "--supports" => o.supports = Some(value()?.into()),
@@ -403,7 +466,11 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 o.density = d;
             }
             "--load" => s.stress.load_rule = choice(&flag, &value()?)?,
-            _ => return Err(format!("unknown option `{flag}`; try --help")),
+            _ => {
+                if !crate::assess::args::flag(&flag, &mut value, &mut o.assess)? {
+                    return Err(format!("unknown option `{flag}`; try --help"));
+                }
+            }
         }
     }
     check(&o)?;
@@ -468,6 +535,7 @@ fn check(o: &Options) -> Result<(), String> {
         }
     }
     check_solid(o)?;
+    crate::assess::args::check(o, &o.given)?;
     if o.mesh.is_some() {
         o.read_options().validate().map_err(flag_error)?;
     }

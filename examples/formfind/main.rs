@@ -11,7 +11,16 @@
 //! on stderr, a non-zero exit status and no output files, and existing files are replaced only
 //! when every output is written.
 
+/// `println!` that ignores a closed stdout (as in `formfind | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod args;
+mod assess;
 mod draw;
 mod model;
 mod output;
@@ -30,14 +39,6 @@ const BAD_INPUT: u8 = 2;
 const NOT_CONVERGED: u8 = 3;
 /// Folder of the default output paths.
 const OUT_DIR: &str = "formfind-out";
-
-/// `println!` that ignores a closed stdout (as in `formfind | head`) instead of panicking.
-macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout(), $($arg)*);
-    }};
-}
 
 struct Failure {
     code: u8,
@@ -89,9 +90,10 @@ struct Paths {
 }
 
 impl Paths {
-    fn of(o: &args::Options, name: &str) -> Paths {
+    /// The paths of a run on the model `name`; OUT defaults to `NAME-SUFFIX.obj`.
+    fn of(o: &args::Options, name: &str, suffix: &str) -> Paths {
         let dir = PathBuf::from(OUT_DIR);
-        let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{name}-formfound.obj")));
+        let out = (o.out.clone()).unwrap_or_else(|| dir.join(format!("{name}-{suffix}.obj")));
         let input_copy = o.mesh.is_none().then(|| {
             let base = out.parent().unwrap_or(Path::new(""));
             (
@@ -108,8 +110,8 @@ impl Paths {
         }
     }
 
-    /// Every file a run writes, with the option that names it.
-    fn targets(&self, stress_only: bool) -> Vec<output::Target> {
+    /// Every file a run writes, with the option that names it; `pictures` are file names.
+    fn targets(&self, pictures: &[&str]) -> Vec<output::Target> {
         let target = |option: &str, path: &Path| output::Target {
             option: option.into(),
             path: path.to_path_buf(),
@@ -118,7 +120,7 @@ impl Paths {
         if let Some(solid) = &self.solid {
             targets.push(target("--solid", solid));
         }
-        for file in pictures::names(stress_only) {
+        for file in pictures {
             targets.push(target("--pictures", &self.pictures.join(file)));
         }
         if let Some((obj, json)) = &self.input_copy {
@@ -141,77 +143,44 @@ fn formfind() -> Result<ExitCode, Failure> {
         None => model::embedded_default(),
         Some(path) => model::from_files(path, &o).map_err(bad_input)?,
     };
-    let paths = Paths::of(&o, &model.name);
-    output::check(&paths.targets(o.stress_only)).map_err(bad_input)?;
-    let Paths {
-        out,
-        report: report_path,
-        pictures: pictures_dir,
-        solid: solid_path,
-        input_copy,
-    } = paths;
+    if o.assess.objective.is_some() {
+        return assess::main(&o, model);
+    }
+    let paths = Paths::of(&o, &model.name, "formfound");
+    output::check(
+        &paths.targets(&pictures::names(o.stress_only)),
+        &input_paths(&o),
+    )
+    .map_err(bad_input)?;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
     let mut report = serde_json::to_value(outcome.report(&o.settings)).map_err(failed)?;
     let solid = match o.thickness() {
         Some(thickness) => {
             let solid = voussoir::thicken(outcome.model.mesh(), &outcome.positions, &thickness)
-                .map_err(|e| bad_input(format!("--solid: {e}")))?;
+                .map_err(|e| bad_input(format!("--solid: {}", reason(&e))))?;
             report["solid"] = report::solid(&solid, &outcome, &o);
             Some(solid)
         }
         None => None,
     };
     let pictures = pictures::all(&outcome);
-
-    // Nothing is on disk before this point; the staging writes all files or none.
-    let mut staging = output::Staging::default();
-    let mesh = outcome.model.mesh();
-    // Written meshes keep the input's axes.
-    let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
-        positions.iter().map(|&p| o.up.to_file(p)).collect()
+    let outputs = Outputs {
+        positions: &outcome.positions,
+        solid: solid.as_ref(),
+        report: &report,
+        pictures: &pictures,
     };
-    let positions = axes_of_input(&outcome.positions);
-    staging
-        .write_mesh(&out, &positions, &outcome.model.faces, o.ascii)
-        .map_err(failed)?;
-    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
-        staging
-            .write_mesh(
-                path,
-                &axes_of_input(&solid.positions),
-                &solid.faces,
-                o.ascii,
-            )
-            .map_err(failed)?;
-    }
-    staging
-        .write(
-            &report_path,
-            voussoir::report::json_text(&report).as_bytes(),
-        )
-        .map_err(failed)?;
-    for (file, svg) in &pictures {
-        staging
-            .write(&pictures_dir.join(file), svg.as_bytes())
-            .map_err(failed)?;
-    }
-    if let Some((obj, json)) = &input_copy {
-        let anchored: Vec<usize> = (0..mesh.n_vertices())
-            .filter(|&v| mesh.anchored[v])
-            .collect();
-        let supports = serde_json::json!({ "anchored": anchored }).to_string() + "\n";
-        staging
-            .write_obj(obj, &mesh.positions, &outcome.model.faces)
-            .map_err(failed)?;
-        staging.write(json, supports.as_bytes()).map_err(failed)?;
-    }
-    staging.commit().map_err(failed)?;
+    write_outputs(&o, &paths, &outcome.model, &outputs)?;
 
     print_summary(&outcome, &report);
     say!("wrote:");
-    say!("  {:<40} {}", out.display(), "form-found mesh (same faces)");
-    if let (Some(solid), Some(path)) = (&solid, &solid_path) {
+    say!(
+        "  {:<40} {}",
+        paths.out.display(),
+        "form-found mesh (same faces)"
+    );
+    if let (Some(solid), Some(path)) = (&solid, &paths.solid) {
         say!(
             "  {:<40} printable solid: {} faces, volume {:.6e}",
             path.display(),
@@ -219,26 +188,7 @@ fn formfind() -> Result<ExitCode, Failure> {
             solid.volume()
         );
     }
-    say!("  {:<40} {}", report_path.display(), "report (JSON)");
-    let names: Vec<&str> = pictures.iter().map(|(n, _)| *n).collect();
-    say!(
-        "  {:<40} {}",
-        format!("{}/", pictures_dir.display()),
-        names.join(" ")
-    );
-    if let Some((obj, json)) = &input_copy {
-        say!(
-            "  {:<40} {}",
-            obj.display(),
-            "the embedded input, with its supports in"
-        );
-        say!("  {:<40}", json.display());
-        say!(
-            "try your own options on it, e.g.:\n  cargo run --release --example formfind -- {} --supports {} --tau zero",
-            obj.display(),
-            json.display()
-        );
-    }
+    print_written(&paths, &pictures, "--tau zero");
     if outcome.succeeded() {
         Ok(ExitCode::SUCCESS)
     } else {
@@ -251,6 +201,106 @@ fn formfind() -> Result<ExitCode, Failure> {
     }
 }
 
+/// What a run writes besides the embedded input's copy.
+struct Outputs<'a> {
+    /// OUT's positions (Z-up).
+    positions: &'a [[f64; 3]],
+    solid: Option<&'a voussoir::Solid>,
+    report: &'a Value,
+    pictures: &'a [(&'static str, String)],
+}
+
+/// Writes every output (all or nothing): OUT and the solid in the input's axes, the report,
+/// the pictures and, for the embedded input, its copy and supports.
+fn write_outputs(
+    o: &args::Options,
+    paths: &Paths,
+    model: &model::Model,
+    outputs: &Outputs,
+) -> Result<(), Failure> {
+    // Nothing is on disk before this point; the staging writes all files or none.
+    let mut staging = output::Staging::default();
+    let mesh = model.mesh();
+    // Written meshes keep the input's axes.
+    let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        positions.iter().map(|&p| o.up.to_file(p)).collect()
+    };
+    staging
+        .write_mesh(
+            &paths.out,
+            &axes_of_input(outputs.positions),
+            &model.faces,
+            o.ascii,
+        )
+        .map_err(failed)?;
+    if let (Some(solid), Some(path)) = (outputs.solid, &paths.solid) {
+        staging
+            .write_mesh(
+                path,
+                &axes_of_input(&solid.positions),
+                &solid.faces,
+                o.ascii,
+            )
+            .map_err(failed)?;
+    }
+    staging
+        .write(
+            &paths.report,
+            voussoir::report::json_text(outputs.report).as_bytes(),
+        )
+        .map_err(failed)?;
+    for (file, svg) in outputs.pictures {
+        staging
+            .write(&paths.pictures.join(file), svg.as_bytes())
+            .map_err(failed)?;
+    }
+    if let Some((obj, json)) = &paths.input_copy {
+        let anchored: Vec<usize> = (0..mesh.n_vertices())
+            .filter(|&v| mesh.anchored[v])
+            .collect();
+        let supports = serde_json::json!({ "anchored": anchored }).to_string() + "\n";
+        staging
+            .write_obj(obj, &mesh.positions, &model.faces)
+            .map_err(failed)?;
+        staging.write(json, supports.as_bytes()).map_err(failed)?;
+    }
+    staging.commit().map_err(failed)
+}
+
+/// The lines of the summary after OUT's: the report, the pictures, the embedded input.
+/// `options` are those the hint suggests to try on the embedded input.
+fn print_written(paths: &Paths, pictures: &[(&str, String)], options: &str) {
+    say!("  {:<40} {}", paths.report.display(), "report (JSON)");
+    let names: Vec<&str> = pictures.iter().map(|(n, _)| *n).collect();
+    say!(
+        "  {:<40} {}",
+        format!("{}/", paths.pictures.display()),
+        names.join(" ")
+    );
+    if let Some((obj, json)) = &paths.input_copy {
+        say!(
+            "  {:<40} {}",
+            obj.display(),
+            "the embedded input, with its supports in"
+        );
+        say!("  {:<40}", json.display());
+        say!(
+            "try your own options on it, e.g.:\n  cargo run --release --example formfind -- {} --supports {} {options}",
+            obj.display(),
+            json.display()
+        );
+    }
+}
+
+/// A library error in words for an option's message: an invalid argument's reason alone
+/// (its `invalid argument `name`` prefix names a library parameter, not the option).
+fn reason(e: &voussoir::Error) -> String {
+    match e {
+        voussoir::Error::InvalidArgument { reason, .. } => reason.clone(),
+        other => other.to_string(),
+    }
+}
+
 /// A report's status name in words: `max_iterations` → "stopped at --max-iter".
 fn phrase(name: &Value) -> String {
     match name.as_str().unwrap_or("?") {
@@ -259,26 +309,43 @@ fn phrase(name: &Value) -> String {
     }
 }
 
-fn print_summary(outcome: &run::Outcome, report: &Value) {
-    let m = &outcome.model;
+/// `n` and the noun, singular for 1: "1 hole", "2 holes".
+fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// The input files an output may not overwrite, with the option that names each.
+pub fn input_paths(o: &args::Options) -> Vec<(&'static str, &Path)> {
+    let mut inputs: Vec<(&'static str, &Path)> = Vec::new();
+    if let Some(mesh) = &o.mesh {
+        inputs.push(("MESH", mesh));
+    }
+    if let Some(supports) = &o.supports {
+        inputs.push(("--supports", supports));
+    }
+    inputs
+}
+
+/// The lines about the input: sizes, welding, plan repairs.
+fn print_model(m: &model::Model) {
     let mesh = m.mesh();
     say!(
-        "{} ({}): {} vertices, {} faces, {} edges, {} holes, {} anchored",
+        "{} ({}): {}, {}, {}, {}, {} anchored",
         m.name,
         m.read.source,
-        mesh.n_vertices(),
-        mesh.n_faces(),
-        mesh.n_edges(),
-        mesh.holes().count(),
+        count(mesh.n_vertices(), "vertex", "vertices"),
+        count(mesh.n_faces(), "face", "faces"),
+        count(mesh.n_edges(), "edge", "edges"),
+        count(mesh.holes().count(), "hole", "holes"),
         mesh.anchored.iter().filter(|a| **a).count()
     );
     if let Some(w) = m.read.weld.as_ref().filter(|w| w.merged > 0) {
         say!(
-            "welded: {} of {} input vertices merged (closer than {:.3e}), {} faces collapsed",
+            "welded: {} of {} input vertices merged (closer than {:.3e}), {} collapsed",
             w.merged,
             w.input_vertices,
             w.tolerance,
-            w.collapsed_faces.len()
+            count(w.collapsed_faces.len(), "face", "faces")
         );
     }
     let repairs = &m.read.repairs;
@@ -288,10 +355,15 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
             .filter(|r| matches!(r, voussoir::PlanRepair::Flip { .. }))
             .count();
         say!(
-            "plan repaired: {flips} edge flips, {} vertex nudges (listed in the report; --strict rejects instead)",
-            repairs.len() - flips
+            "plan repaired: {}, {} (listed in the report; --strict rejects instead)",
+            count(flips, "edge flip", "edge flips"),
+            count(repairs.len() - flips, "vertex nudge", "vertex nudges")
         );
     }
+}
+
+fn print_summary(outcome: &run::Outcome, report: &Value) {
+    print_model(&outcome.model);
     let s = &outcome.stress;
     match &outcome.termination {
         None => say!(
@@ -329,7 +401,13 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
     }
     let tied = s.tau.iter().filter(|t| **t > 0.0).count();
     if tied > 0 {
-        say!("{tied} free boundary vertices need a tie or buttress (τ > 0; see the report)");
+        say!(
+            "{} a tie or buttress (τ > 0; see the report)",
+            match tied {
+                1 => "1 free boundary vertex needs".to_string(),
+                n => format!("{n} free boundary vertices need"),
+            }
+        );
     }
     say!(
         "time: stress {:.2} s, shape {:.2} s, total {:.2} s",

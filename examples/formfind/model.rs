@@ -102,6 +102,10 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
                 Err(_) => e.to_string(),
             });
         }
+        Err(voussoir::Error::InvalidArgument {
+            name: "weld tolerance",
+            reason,
+        }) => return Err(format!("--weld: {reason} (or --no-weld)")),
         other => other.map_err(|e| e.to_string())?,
     };
     let name = mesh_path

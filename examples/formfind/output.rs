@@ -1,12 +1,13 @@
 //! All-or-nothing output.
 //!
 //! Before the run, [`check`] looks at every target: no two name the same file (or one a folder
-//! holding the other), none is a folder, and each one's folder exists or can be created. After
-//! the run, [`Staging`] writes every file to a hidden temporary file beside its target; only
-//! when all are written are they renamed into place, each replaced file first kept under a
-//! hidden name. On any failure (or a drop without commit) the temporary files, the folders
-//! created for them and the files already renamed are removed and the replaced files restored,
-//! so a failed run leaves the file system as it found it.
+//! holding the other), none is a folder, a device, a FIFO or an input file, and each one's
+//! folder exists or can be created. After the run, [`Staging`] writes every file to a hidden
+//! temporary file beside its target (beside the file a symbolic link names: links are written
+//! through); only when all are written are they renamed into place, each replaced file first
+//! kept under a hidden name. On any failure (or a drop without commit) the temporary files,
+//! the folders created for them and the files already renamed are removed and the replaced
+//! files restored, so a failed run leaves the file system as it found it.
 
 use std::ffi::OsString;
 use std::fs;
@@ -59,8 +60,29 @@ fn existing_ancestor(path: &Path) -> Option<&Path> {
         .find(|p| p.as_os_str().is_empty() || fs::symlink_metadata(p).is_ok())
 }
 
-/// Checks every target before anything is computed or written.
-pub fn check(targets: &[Target]) -> Result<(), String> {
+/// The file a target's write replaces (through symbolic links), spelt so that two names of one
+/// file compare equal.
+fn file_key(path: &Path) -> PathBuf {
+    resolved(&voussoir::io::output_target(path).unwrap_or_else(|_| path.to_path_buf()))
+}
+
+/// Whether `a` and `b` are one existing file (two hard links, or two spellings of its path).
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(x), Ok(y)) = (fs::metadata(a), fs::metadata(b)) {
+            return (x.dev(), x.ino()) == (y.dev(), y.ino());
+        }
+    }
+    resolved(a) == resolved(b)
+}
+
+/// Checks every target before anything is computed or written: each names a regular file or
+/// none yet (symbolic links are written through: see [`voussoir::io::output_target`]), in a
+/// folder that exists or can be created; no two name the same file (or one a folder holding
+/// the other); none names one of `inputs` (an option or argument and its path).
+pub fn check(targets: &[Target], inputs: &[(&str, &Path)]) -> Result<(), String> {
     for t in targets {
         let shown = t.path.display();
         if t.path.file_name().is_none() {
@@ -72,6 +94,7 @@ pub fn check(targets: &[Target]) -> Result<(), String> {
                 t.option
             ));
         }
+        voussoir::io::output_target(&t.path).map_err(|e| format!("{}: {e}", t.option))?;
         if let Some(dir) = existing_ancestor(&t.path) {
             if !dir.as_os_str().is_empty() && !dir.is_dir() {
                 return Err(format!(
@@ -81,8 +104,21 @@ pub fn check(targets: &[Target]) -> Result<(), String> {
                 ));
             }
         }
+        let target = voussoir::io::output_target(&t.path).unwrap_or_else(|_| t.path.clone());
+        if let Some((input, _)) = inputs.iter().find(|(_, p)| same_file(&target, p)) {
+            return Err(format!(
+                "{} `{shown}` names the input file of {input}: writing it would destroy the \
+                 input; give the output another path",
+                t.option
+            ));
+        }
     }
-    let keys: Vec<PathBuf> = targets.iter().map(|t| resolved(&t.path)).collect();
+    check_distinct(targets)
+}
+
+/// No two targets name the same file, and none lies inside another.
+fn check_distinct(targets: &[Target]) -> Result<(), String> {
+    let keys: Vec<PathBuf> = targets.iter().map(|t| file_key(&t.path)).collect();
     for (i, a) in targets.iter().enumerate() {
         for (j, b) in targets.iter().enumerate().skip(i + 1) {
             let (ka, kb) = (&keys[i], &keys[j]);
@@ -154,11 +190,13 @@ impl Staging {
         Ok(())
     }
 
-    /// A temporary path beside `target` (in the same folder, so renaming it is atomic).
+    /// A temporary path beside the file `target` names (through symbolic links; in the same
+    /// folder, so renaming it is atomic).
     fn temp_for(&mut self, target: &Path) -> Result<PathBuf, String> {
-        let tmp = hidden_beside(target, "tmp")?;
-        self.ensure_dir(target.parent().unwrap_or(Path::new("")))?;
-        self.files.push((tmp.clone(), target.to_path_buf()));
+        let real = voussoir::io::output_target(target).map_err(|e| e.to_string())?;
+        let tmp = hidden_beside(&real, "tmp")?;
+        self.ensure_dir(real.parent().unwrap_or(Path::new("")))?;
+        self.files.push((tmp.clone(), real));
         Ok(tmp)
     }
 

@@ -2,6 +2,8 @@
 //! a shaded 3-D view.
 
 mod axonometric;
+mod envelope;
+pub mod section;
 
 use svg::node::element::{Circle, Group, Polygon, Rectangle};
 use svg::Document;
@@ -143,8 +145,18 @@ fn anchor_key(x: f64, y: f64) -> Group {
 
 /// (a) Edges coloured and sized by force density; supports and free vertices that need τ.
 fn plan_forces(o: &Outcome) -> Document {
-    let (mesh, pos, s) = (o.model.mesh(), &o.positions, &o.stress);
-    let q = &s.force_densities;
+    let s = &o.stress;
+    plan_forces_of(
+        &o.model.name,
+        o.model.mesh(),
+        &o.positions,
+        &s.force_densities,
+        &s.tau,
+    )
+}
+
+/// The forces in plan of model `name`: force densities `q` per edge, `tau` per vertex.
+fn plan_forces_of(name: &str, mesh: &Mesh, pos: &[[f64; 3]], q: &[f64], tau: &[f64]) -> Document {
     let q_max = q.iter().copied().fold(0.0, f64::max);
     let (q_top, ticks) = q_scale(q.iter().copied());
     let (lo, hi) = plan_box(mesh, pos);
@@ -154,7 +166,7 @@ fn plan_forces(o: &Outcome) -> Document {
     let mut doc = page(
         WIDTH,
         height,
-        &format!("{}: force densities in plan", o.model.name),
+        &format!("{name}: force densities in plan"),
         &format!(
             "compression per edge (force / length): max {}, mean {}; colour and width grow with q",
             fmt(q_max),
@@ -179,15 +191,15 @@ fn plan_forces(o: &Outcome) -> Document {
         });
     }
     doc = doc.add(edges).add(anchors(mesh, pos, view));
-    let tau_max = s.tau.iter().copied().fold(0.0, f64::max);
+    let tau_max = tau.iter().copied().fold(0.0, f64::max);
     let mut ties = Group::new();
-    for v in (0..mesh.n_vertices()).filter(|&v| s.tau[v] > 1e-9 * tau_max.max(1e-300)) {
+    for v in (0..mesh.n_vertices()).filter(|&v| tau[v] > 1e-9 * tau_max.max(1e-300)) {
         let (x, y) = view.px(plan(&pos[v]));
         ties = ties.add(
             Circle::new()
                 .set("cx", x)
                 .set("cy", y)
-                .set("r", 2.5 + 3.5 * s.tau[v] / tau_max)
+                .set("r", 2.5 + 3.5 * tau[v] / tau_max)
                 .set("fill", "none")
                 .set("stroke", "#d62728")
                 .set("stroke-width", 1.5),
@@ -418,4 +430,29 @@ pub fn all(o: &Outcome) -> Vec<(&'static str, String)> {
         .into_iter()
         .zip(out)
         .collect()
+}
+
+/// The file names of an assessment's pictures.
+pub const ASSESSMENT: [&str; 3] = ["plan_forces.svg", "section.svg", "shape_3d.svg"];
+
+/// The pictures of an assessment as (file name, SVG text), in the order of [`ASSESSMENT`].
+pub fn assessment(
+    a: &crate::assess::run::Assessed,
+    at: crate::assess::args::Section,
+) -> Vec<(&'static str, String)> {
+    let r = &a.result;
+    let no_tau = vec![0.0; r.positions.len()];
+    let out = [
+        plan_forces_of(
+            &a.model.name,
+            a.model.mesh(),
+            &r.positions,
+            &r.force_densities,
+            &no_tau,
+        )
+        .to_string(),
+        section::section(a, at).to_string(),
+        envelope::shape_3d(a).to_string(),
+    ];
+    ASSESSMENT.into_iter().zip(out).collect()
 }

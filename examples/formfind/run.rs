@@ -58,14 +58,16 @@ impl Outcome {
     }
 }
 
-fn progress_bar(max_iterations: usize) -> Option<ProgressBar> {
+/// A progress bar on a terminal: `what` is the run ("form finding"), `figure` the number
+/// shown per iteration ("ε∞").
+pub fn progress_bar(max_iterations: usize, what: &str, figure: &str) -> Option<ProgressBar> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
     let bar = ProgressBar::new(max_iterations as u64);
-    let style = ProgressStyle::with_template(
-        "{spinner} form finding [{bar:30}] iteration {pos}/{len}  ε∞ {msg}  {elapsed}",
-    )
+    let style = ProgressStyle::with_template(&format!(
+        "{{spinner}} {what} [{{bar:30}}] iteration {{pos}}/{{len}}  {figure} {{msg}}  {{elapsed}}"
+    ))
     .expect("valid template")
     .progress_chars("=> ");
     bar.set_style(style);
@@ -98,7 +100,7 @@ pub fn run(mut model: Model, o: &Options) -> voussoir::Result<Outcome> {
             model,
         });
     }
-    let bar = progress_bar(settings.max_iterations);
+    let bar = progress_bar(settings.max_iterations, "form finding", "ε∞");
     let mut report = |k: usize, eps: f64| {
         if let Some(bar) = &bar {
             bar.set_position(k as u64 + 1);

@@ -38,7 +38,11 @@ pub fn from_error(arg: &str, e: Error) -> PyErr {
         InvalidAnchor { .. } | UnsupportedComponent { .. } | NoSupports => "anchored",
         _ => arg,
     };
-    invalid(arg, e)
+    match e {
+        // Its own wording starts "invalid argument `name`": said once.
+        InvalidArgument { reason, .. } => invalid(arg, reason),
+        e => invalid(arg, e),
+    }
 }
 
 /// The Python spelling of an argument the library names: its arrays are `vertices` and

@@ -75,7 +75,7 @@ pub fn stress<'py>(
 }
 
 /// (the vertices it lists, the constraint, hint or failure it names).
-fn termination(t: &Termination) -> (Vec<u32>, Option<String>) {
+pub fn termination(t: &Termination) -> (Vec<u32>, Option<String>) {
     match t {
         Termination::Stalled { vertices } => (vertices.clone(), None),
         Termination::Infeasible { constraint } => (vec![], Some(constraint.clone())),

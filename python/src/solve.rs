@@ -33,6 +33,8 @@ pub fn analyse<'py>(
     let stress = py
         .detach(|| voussoir::analyse(m.problem(), &form.stress))
         .map_err(|e| from_error("mesh", e))?;
+    // A Ctrl-C during the solve is a KeyboardInterrupt now, not somewhere after.
+    py.check_signals()?;
     let d = results::stress(py, &m.problem().mesh, &m.problem().mesh.positions, &stress)?;
     if report {
         let run = voussoir::report::Run::Analysis(&stress);

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import os
 import subprocess
 import sys
 import typing
@@ -185,6 +186,32 @@ def test_command_line_rejects_bad_input_and_writes_nothing(tmp_path):
     assert not (tmp_path / "formfind-out").exists()
     done = run_cli("bad.off", cwd=tmp_path)
     assert done.returncode == 2 and "--supports" in done.stderr
+
+
+def test_command_line_outputs_go_through_links_and_spare_inputs_and_fifos(tmp_path):
+    # Issue 48: outputs replaced whatever their path named (a link, a FIFO, the input).
+    square().write(tmp_path / "sq.obj")
+    (tmp_path / "s.json").write_text("[0, 1, 2, 3]")
+    os.mkfifo(tmp_path / "fifo.json")
+    os.symlink("sq.obj", tmp_path / "to-input.obj")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    for args, message in [
+        (["--out", "sq.obj"], "--out sq.obj names the input file of MESH"),
+        (["--out", "to-input.obj"], "--out to-input.obj names the input file of MESH"),
+        (["--report", "s.json"], "--report s.json names the input file of --supports"),
+        (["--report", "fifo.json"], "--report: fifo.json: is a FIFO (named pipe), not a regular"),
+    ]:
+        done = run_cli("sq.obj", "--supports", "s.json", "--stress-only", *args, cwd=tmp_path)
+        assert done.returncode == 2, done.stderr
+        assert message in done.stderr and done.stderr.count("\n") == 1, done.stderr
+        assert sorted(p.name for p in tmp_path.iterdir()) == before
+    (tmp_path / "real.json").write_text("old")
+    os.symlink("real.json", tmp_path / "link.json")
+    done = run_cli("sq.obj", "--supports", "s.json", "--stress-only", "--out", "o.obj",
+                   "--report", "link.json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "link.json").is_symlink()
+    assert json.loads((tmp_path / "real.json").read_text())["anchored"] == [0, 1, 2, 3]
 
 
 def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import _thread
 import dataclasses
+import subprocess
+import sys
 import threading
 import time
 
@@ -69,6 +71,40 @@ def test_ctrl_c_cancels_a_running_solve_without_a_callback(lilium):
     finally:
         timer.cancel()
     assert time.perf_counter() - start < 15
+
+
+def test_ctrl_c_during_the_first_analyse_of_a_process_is_a_keyboard_interrupt(tmp_path):
+    # Issue 48: the first call to return arrays looked numpy's C API up by importing it, which
+    # a pending Ctrl-C interrupted: rust-numpy panicked (PanicException, which `except
+    # Exception` and `except KeyboardInterrupt` both miss). A fresh process, so that analyse is
+    # that first call; the interrupt comes 50 ms into a solve of about a second (if the solve
+    # is quicker, it comes during the sleep after it, a KeyboardInterrupt all the same).
+    n = 120
+    lines = [f"v {i / n} {j / n} {0.3 - (i / n - 0.5) ** 2 - (j / n - 0.5) ** 2}"
+             for j in range(n + 1) for i in range(n + 1)]
+    for j in range(n):
+        for i in range(n):
+            a, b, c, d = (j * (n + 1) + i + 1 + k for k in (0, 1, n + 2, n + 1))
+            lines += [f"f {a} {b} {c}", f"f {a} {c} {d}"]
+    (tmp_path / "grid.obj").write_text("\n".join(lines) + "\n")
+    rim = [j * (n + 1) + i for j in range(n + 1) for i in range(n + 1)
+           if i in (0, n) or j in (0, n)]
+    (tmp_path / "grid.json").write_text(str(rim))
+    script = f"""
+import _thread, threading, time, voussoir
+mesh = voussoir.Mesh.from_file({str(tmp_path / "grid.obj")!r}, {str(tmp_path / "grid.json")!r})
+threading.Timer(0.05, _thread.interrupt_main).start()
+try:
+    voussoir.analyse(mesh)
+    time.sleep(30)
+    print("not interrupted")
+except KeyboardInterrupt:
+    print("KeyboardInterrupt")
+"""
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=300)
+    assert out.stdout.strip() == "KeyboardInterrupt", out.stderr
+    assert "PanicException" not in out.stderr, out.stderr
 
 
 def test_the_gil_is_released_while_solving(lilium):

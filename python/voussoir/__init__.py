@@ -6,21 +6,25 @@
     result.positions          # (n, 3) float64: the self-supporting shape
 
 `Mesh` holds a validated triangle mesh with its supports and loads; `analyse` finds the best
-compressive stress of a shape as it stands, `form_find` the nearest self-supporting shape.
+compressive stress of a shape as it stands, `form_find` the nearest self-supporting shape,
+`assess` a thrust surface inside the masonry's thickness (Heyman's safe theorem).
 Both take the library's settings as keyword arguments (see `Settings`; `defaults()` lists
 every default) and release the GIL while they solve. Bad input raises `VoussoirError`, a
 `ValueError`, with the library's one-line message naming the argument at fault.
+
+Interchange, imported on their own: `voussoir.rhino` (.3dm meshes; the `rhino` extra) and
+`voussoir.compas` (compas meshes, the `compas` extra; FormDiagram JSON, no extra needed).
 """
 
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Union
+from typing import TYPE_CHECKING, Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
 from . import _voussoir as _native
-from ._results import FormFindResult, StressResult
+from ._results import AssessmentResult, FormFindResult, StressResult
 from ._settings import Settings
 
 if TYPE_CHECKING:
@@ -33,7 +37,9 @@ __all__ = [
     "Mesh",
     "analyse",
     "form_find",
+    "assess",
     "defaults",
+    "AssessmentResult",
     "FormFindResult",
     "StressResult",
     "Settings",
@@ -261,9 +267,13 @@ class Mesh:
         _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
 
     def __repr__(self) -> str:
+        def count(n: int, one: str, many: str) -> str:
+            return f"{n} {one if n == 1 else many}"
+
         return (
-            f"Mesh({len(self.vertices)} vertices, {len(self.faces)} faces, "
-            f"{len(self.anchored)} anchored, {self.n_holes} holes)"
+            f"Mesh({count(len(self.vertices), 'vertex', 'vertices')}, "
+            f"{count(len(self.faces), 'face', 'faces')}, {len(self.anchored)} anchored, "
+            f"{count(self.n_holes, 'hole', 'holes')})"
         )
 
 
@@ -312,6 +322,89 @@ def form_find(
     """
     fields = _native.form_find(_check_mesh(mesh), settings, progress)
     return FormFindResult._from_native(fields)
+
+
+Surface = Tuple[Any, Any]
+"""A surface as (vertices (n, 3), faces (m, 3) integer ids)."""
+
+
+def _surface(name: str, value: Any) -> Optional[Tuple[np.ndarray, np.ndarray]]:
+    if value is None:
+        return None
+    try:
+        vertices, faces = value
+    except (TypeError, ValueError):
+        raise VoussoirError(f"argument `{name}`: is not a pair (vertices, faces)") from None
+    points = _floats(name, vertices)
+    ids = _ids(name, faces)
+    return points, ids
+
+
+def assess(
+    mesh: Mesh,
+    thickness: Any = None,
+    *,
+    intrados: Optional[Surface] = None,
+    extrados: Optional[Surface] = None,
+    objective: str = "fit",
+    fixed_supports: bool = False,
+    unit_weight: float = 1.0,
+    load_pattern: Any = None,
+    progress: Optional[Progress] = None,
+    **settings: Any,
+) -> AssessmentResult:
+    """A compression-only thrust surface in equilibrium with the masonry's self-weight that
+    lies inside the masonry: by Heyman's safe theorem the vault then stands.
+
+    The mesh is the masonry's middle surface and its plan the form diagram. Give the
+    masonry's envelope as `thickness` or as `intrados` and `extrados`.
+
+    Args:
+        mesh: the vault (its face densities are not used: the envelope's thickness x
+            `unit_weight` is the self-weight; its extra loads are added).
+        thickness: one thickness, or one per face (m,), along the middle surface's normals,
+            half above and half below (read vertically as t / (2 n_z) at each vertex).
+        intrados, extrados: instead of `thickness`, the two surfaces as (vertices (k, 3),
+            faces (l, 3)) in any triangulation, sampled on the vertical through each vertex.
+        objective: "fit" (the surface nearest the middle surface), "min-thickness" (the
+            least uniform scale of the thickness that still holds one; `safety_factor` is its
+            inverse), "min-thrust" / "max-thrust" (the least / greatest horizontal thrust at
+            the supports) or "max-load" (the largest factor on `load_pattern`).
+        fixed_supports: keep the supports at the mesh's heights (by default the thrust meets
+            each support anywhere within the envelope).
+        unit_weight: weight per unit volume (> 0).
+        load_pattern: (n,) downward load per vertex that "max-load" multiplies.
+        progress: called as ``progress(step, infeasibility)`` after every step (1-based;
+            infeasibility: the largest vertical residual over the mean load). Returning False
+            stops the search (``termination == "cancelled"``); an exception it raises stops
+            it too and propagates.
+        **settings: ``load_rule`` ("barycentric", "voronoi", "plan_area"), ``q_min`` and
+            ``q_min_kind`` (default 0, "absolute": compression only), ``tolerance`` (on
+            eps_inf, default 1e-6), ``max_iterations`` (default 200).
+
+    The GIL is released while it searches; Ctrl-C stops it within one step and propagates.
+
+    Raises:
+        VoussoirError: a bad envelope (thickness <= 0 or not finite, intrados above extrados,
+            a surface that does not cover a vertex: the message names the vertex or face), a
+            bad setting, or a load pattern of the wrong length.
+    """
+    native = _check_mesh(mesh)
+    kwargs: Dict[str, Any] = dict(settings)
+    kwargs.update(objective=objective, fixed_supports=fixed_supports, unit_weight=unit_weight)
+    if load_pattern is not None:
+        kwargs["load_pattern"] = _floats("load_pattern", load_pattern)
+    uniform: Optional[float] = None
+    t = None
+    if thickness is not None:
+        t = np.atleast_1d(_floats("thickness", thickness)).ravel()
+        if np.ndim(thickness) == 0:
+            uniform = float(t[0])
+    fields = _native.assess(
+        native, t, _surface("intrados", intrados), _surface("extrados", extrados), kwargs, progress
+    )
+    least = None if uniform is None else fields["thickness_scale"] * uniform
+    return AssessmentResult._from_native(fields, least)
 
 
 WELD_TOLERANCE: float = _native.WELD_TOLERANCE

@@ -1,4 +1,5 @@
-"""``python -m voussoir MESH --supports S.json [options]``: the formfind command line in Python.
+"""``python -m voussoir MESH --supports S.json [options]``: the formfind command line in Python,
+form finding or (``--assess``) masonry assessment.
 
 Reads OBJ, OFF, STL or PLY; writes the form-found mesh (the format of ``--out``) and a JSON
 report, all or nothing: bad input or output paths get a one-line message on stderr, a non-zero
@@ -9,13 +10,16 @@ finished without converging (outputs written), 2 bad input or options, 1 other f
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
+import stat
 import sys
 import tempfile
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
+import numpy as np
 
 import voussoir
 from voussoir import _voussoir as _native
@@ -90,6 +94,18 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--odt", type=int, help=f"ODT sweeps of the plan [{d['odt_iterations']}]")
     p.add_argument("--density", type=float, default=1.0, help="weight per unit area of every face [1]")
     p.add_argument("--load", choices=names["load_rule"], help=f"[{d['load_rule']}]")
+    a = p.add_argument_group("assessment (instead of form finding; MESH is the middle surface)")
+    a.add_argument("--assess", choices=["fit", "min-thickness", "min-thrust", "max-thrust", "max-load"],
+                   help="a compression-only thrust surface inside the masonry: the one nearest the "
+                   "middle surface, the least thickness, the least or greatest thrust, the largest "
+                   "factor on --load-pattern")
+    a.add_argument("--thickness", help="thickness along MESH's normals, or `density` (--density / W)")
+    a.add_argument("--intrados", type=Path, help="instead of --thickness: the intrados as a mesh file")
+    a.add_argument("--extrados", type=Path, help="and the extrados as a mesh file")
+    a.add_argument("--unit-weight", type=float, help="weight per unit volume [1]")
+    a.add_argument("--fixed-supports", action="store_true", help="keep the supports at MESH's heights")
+    a.add_argument("--load-pattern", type=Path,
+                   help='max-load: {"loads": [..]}, [..] or {"loads": {"ID": load}}, ids of MESH\'s own vertices')
     return p
 
 
@@ -140,9 +156,37 @@ def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
     )
 
 
+def _file_kind(mode: int) -> str:
+    for test, name in ((stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                       (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return name
+    return "a special file"
+
+
+def _output_target(option: str, path: Path, inputs: Sequence[Tuple[str, Path]]) -> Path:
+    """The file an output replaces (through symbolic links, as the library writes), checked:
+    a regular file or none yet, and none of `inputs` (option, path)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        mode = None
+    if mode is not None and not stat.S_ISREG(mode):
+        raise Failure(f"{option}: {path}: is {_file_kind(mode)}, not a regular file: outputs "
+                      "replace regular files only")
+    target = Path(os.path.realpath(path))
+    for name, given in inputs:
+        if mode is not None and os.path.exists(given) and os.path.samefile(target, given):
+            raise Failure(f"{option} {path} names the input file of {name}: writing it would "
+                          "destroy the input; give the output another path")
+    return target
+
+
 def _write_all(files: Sequence[Tuple[Path, Any]]) -> None:
     """Writes every (path, writer) beside its target under a temporary name, then renames
-    them all: on any failure no target is touched."""
+    them all: on any failure no target is touched. Targets are the files symbolic links name
+    (see `_output_target`)."""
     staged: List[Tuple[Path, str]] = []
     try:
         for target, write in files:
@@ -159,8 +203,174 @@ def _write_all(files: Sequence[Tuple[Path, Any]]) -> None:
                 os.remove(temp)
 
 
+ASSESS_ONLY = ("thickness", "intrados", "extrados", "unit_weight", "load_pattern")
+FORM_FINDING_ONLY = ("stress_only", "fairness", "max_height_change", "solver", "qp", "qmin_scope",
+                     "qmax", "tau", "holes", "dual_smoothing", "smoothing_decay", "odt")
+
+
+def _check_assess(a: argparse.Namespace) -> None:
+    """The combinations formfind rejects, with its messages."""
+    flag = lambda name: "--" + name.replace("_", "-")  # noqa: E731
+    if not a.assess:
+        given = [n for n in ASSESS_ONLY if getattr(a, n) is not None] + (
+            ["fixed_supports"] if a.fixed_supports else [])
+        if given:
+            raise Failure(f"{flag(given[0])} needs --assess ANALYSIS")
+        return
+    for name in FORM_FINDING_ONLY:
+        if getattr(a, name) not in (None, False):
+            raise Failure(f"{flag(name)} is an option of form finding, not of --assess")
+    if a.thickness is None and (a.intrados is None or a.extrados is None):
+        raise Failure("--assess needs the masonry's envelope: --thickness T, or --intrados A --extrados B")
+    if a.thickness is not None and (a.intrados or a.extrados):
+        raise Failure("give --thickness or --intrados and --extrados, not both")
+    if a.unit_weight is not None and not (math.isfinite(a.unit_weight) and a.unit_weight > 0):
+        raise Failure(f"--unit-weight: expected a finite number > 0, got `{a.unit_weight}`")
+    if a.thickness == "density" and a.unit_weight is None:
+        raise Failure("--thickness density needs --unit-weight W (thickness = --density / W)")
+    if (a.assess == "max-load") != (a.load_pattern is not None):
+        raise Failure("--assess max-load needs --load-pattern L.json (the load to multiply)"
+                      if a.assess == "max-load" else
+                      f"--load-pattern goes with --assess max-load, not with --assess {a.assess}")
+
+
+def _thickness(a: argparse.Namespace) -> float:
+    if a.thickness == "density":
+        return a.density / a.unit_weight
+    try:
+        t = float(a.thickness)
+    except ValueError:
+        t = math.nan
+    if not (math.isfinite(t) and t > 0):
+        raise Failure(f"--thickness: expected a thickness > 0 or `density`, got `{a.thickness}`")
+    return t
+
+
+def _load_pattern(path: Path, mesh: voussoir.Mesh) -> np.ndarray:
+    """The loads of a JSON file per mesh vertex; loads of file vertices welded into one add."""
+    welded = mesh.welded_ids
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError) as e:
+        raise Failure(f"--load-pattern: {path}: {e}") from None
+    loads = data.get("loads") if isinstance(data, dict) else data
+    n = len(welded)
+    if isinstance(loads, list):
+        if len(loads) != n:
+            raise Failure(f"--load-pattern: {path}: has {len(loads)} loads, expected one per vertex "
+                          f"of MESH ({n}, ids before welding)")
+        entries = list(enumerate(loads))
+    elif isinstance(loads, dict):
+        entries = []
+        for key in sorted(loads):
+            if not key.strip().isdigit() or int(key) >= n:
+                raise Failure(f"--load-pattern: {path}: `{key}` is not a vertex id of MESH "
+                              f"(0 to {n - 1}, ids before welding)")
+            entries.append((int(key), loads[key]))
+    else:
+        raise Failure(f'--load-pattern: {path}: expected {{"loads": [..]}}, [..] or '
+                      f'{{"loads": {{"ID": load, ..}}}}')
+    pattern = np.zeros(len(mesh.vertices))
+    for v, x in entries:
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+            raise Failure(f"--load-pattern: {path}: the load of vertex {v} is {x}, not a finite number")
+        pattern[welded[v]] += x
+    return pattern
+
+
+def _surface(path: Path) -> Tuple[np.ndarray, np.ndarray]:
+    try:
+        vertices, faces, _ = _native.read_welded(os.fspath(path), 0.0)
+    except voussoir.VoussoirError as e:
+        raise Failure(f"{e}") from None
+    return vertices, faces.astype(np.int64)
+
+
+def assessment_report(r: voussoir.AssessmentResult, thickness: Optional[float],
+                      pattern: Optional[np.ndarray]) -> Dict[str, Any]:
+    """The report's "assessment", as formfind writes it."""
+    detail = r.termination_detail
+    if r.termination == "stalled":
+        detail = {"vertices": r.termination_vertices.tolist()}
+    elif detail is not None:
+        detail = {"what": detail}
+    nonzero = np.flatnonzero(np.abs(r.reactions).sum(axis=1))
+    return {
+        "objective": r.objective, "feasible": r.feasible, "termination": r.termination,
+        "termination_detail": detail, "iterations": r.iterations, "seconds": r.seconds,
+        "thickness": thickness, "thickness_min": r.thickness_min,
+        "thickness_scale": r.thickness_scale, "safety_factor": r.safety_factor,
+        "thrust_horizontal": r.thrust_horizontal, "load_factor": r.load_factor,
+        "eps_inf": r.eps_inf, "horizontal_imbalance": r.horizontal_imbalance,
+        "worst_bound": {"excess": r.worst_bound, "vertex": r.worst_bound_vertex},
+        "worst_residual_vertex": r.worst_residual_vertex,
+        "bounds": {"lower": r.lower.tolist(), "upper": r.upper.tolist()},
+        "envelope": {"lower": r.envelope_lower.tolist(), "upper": r.envelope_upper.tolist(),
+                     "middle": r.envelope_middle.tolist(),
+                     "face_thickness": r.face_thickness.tolist()},
+        "reactions": [[int(v), *r.reactions[v].tolist()] for v in nonzero],
+        "load_pattern": None if pattern is None else pattern.tolist(),
+    }
+
+
+def run_assess(a: argparse.Namespace) -> int:
+    """`--assess`: the thrust surface as OUT, the report with its "assessment"."""
+    name = a.mesh.stem
+    out = a.out or OUT_DIR / f"{name}-thrust.obj"
+    report_path = a.report or OUT_DIR / "report.json"
+    if out.suffix.lower() not in MESH_SUFFIXES:
+        raise Failure(f"--out: {out}: unknown mesh format (use .obj, .off, .stl or .ply)")
+    thickness = None if a.thickness is None else _thickness(a)
+    settings: Dict[str, Any] = {"objective": a.assess, "fixed_supports": a.fixed_supports,
+                                "unit_weight": 1.0 if a.unit_weight is None else a.unit_weight}
+    if a.load:
+        settings["load_rule"] = a.load
+    if a.tol is not None:
+        settings["tolerance"] = a.tol
+    if a.max_iter is not None:
+        settings["max_iterations"] = a.max_iter
+    if a.qmin is not None:
+        settings["q_min"], settings["q_min_kind"] = _bound("--qmin", a.qmin)
+    try:
+        mesh = read_model(a, 1.0)
+        pattern = None if a.load_pattern is None else _load_pattern(a.load_pattern, mesh)
+        if thickness is not None:
+            r = voussoir.assess(mesh, thickness, load_pattern=pattern, **settings)
+        else:
+            r = voussoir.assess(mesh, intrados=_surface(a.intrados),
+                                extrados=_surface(a.extrados), load_pattern=pattern, **settings)
+    except voussoir.VoussoirError as e:
+        raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
+    report = {
+        "assessment": assessment_report(r, thickness, pattern),
+        "edges": r.edges.tolist(), "force_densities": r.force_densities.tolist(),
+        "loads": r.loads.tolist(), "residuals": r.residuals.tolist(),
+        "anchored": mesh.anchored.tolist(), "plan_repairs": mesh.plan_repairs,
+        "settings": {**settings, "mesh": os.fspath(a.mesh)},
+        "voussoir_version": voussoir.__version__,
+    }
+    text = json.dumps(report, indent=1) + "\n"
+    try:
+        _write_all([(out, lambda p: mesh.write(p, r.positions)),
+                    (report_path, lambda p: Path(p).write_text(text))])
+    except (OSError, voussoir.VoussoirError) as e:
+        raise Failure(str(e), 1) from None
+    verdict = "a thrust surface fits" if r.feasible else "no certified thrust surface"
+    print(f"{name}: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, {len(mesh.anchored)} anchored")
+    print(f"assessment {r.objective}: {verdict} ({r.termination.replace('_', ' ')} after "
+          f"{r.iterations} steps); safety factor {r.safety_factor:.4g}, thrust {r.thrust_horizontal:.6g}")
+    print(f"wrote: {out} (thrust surface), {report_path} (report)")
+    if not r.converged:
+        print("voussoir: no certified optimum: the outputs hold the best state reached", file=sys.stderr)
+        return NOT_CONVERGED
+    return 0
+
+
 def run(argv: Optional[Sequence[str]] = None) -> int:
     a = parser().parse_args(argv)
+    _check_assess(a)
+    if a.assess:
+        return run_assess(a)
     settings = settings_of(a)
     name = a.mesh.stem
     out = a.out or OUT_DIR / f"{name}-formfound.obj"
@@ -169,6 +379,11 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise Failure(f"--out: {out}: unknown mesh format (use .obj, .off, .stl or .ply)")
     if a.density <= 0:
         raise Failure(f"--density: must be > 0, got {a.density}")
+    inputs = [("MESH", a.mesh)] + ([("--supports", Path(a.supports))] if a.supports else [])
+    out_target = _output_target("--out", out, inputs)
+    report_target = _output_target("--report", report_path, inputs)
+    if out_target == report_target:
+        raise Failure(f"--out and --report name the same file {out}; give each its own path")
     try:
         mesh = read_model(a, a.density)
         # The natives, asked for the library's report (the formfind example's schema).
@@ -194,7 +409,8 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         Path(path).write_text(text)
 
     try:
-        _write_all([(out, lambda p: mesh.write(p, result.positions)), (report_path, write_report)])
+        _write_all([(out_target, lambda p: mesh.write(p, result.positions)),
+                    (report_target, write_report)])
     except (OSError, voussoir.VoussoirError) as e:
         raise Failure(str(e), 1) from None
     print(f"{name}: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, {len(mesh.anchored)} anchored")

@@ -114,3 +114,91 @@ class FormFindResult(StressResult):
     def converged(self) -> bool:
         """True when eps_inf fell below the tolerance."""
         return self.termination == "converged"
+
+
+@dataclass(frozen=True)
+class AssessmentResult:
+    """A masonry assessment: a thrust surface over the mesh's plan (`positions`) and the
+    force densities that hold it in equilibrium with the masonry's self-weight (`loads`),
+    between intrados and extrados (`lower`, `upper`), optimal for the objective. When
+    `feasible` is False the fields hold the least infeasible state reached."""
+
+    objective: str
+    """The analysis: "fit", "min-thickness", "min-thrust", "max-thrust" or "max-load"."""
+    feasible: bool
+    """True when the surface is certified: eps_inf below the tolerance, every force density
+    >= q_min (compression), every height within [lower, upper] to 1e-9 of the plan
+    diagonal."""
+    termination: str
+    """How the search ended: "converged" (the objective's optimum), "max_iterations",
+    "stalled", "numerical_error" or "cancelled"."""
+    termination_message: str
+    """The termination as a sentence."""
+    termination_vertices: np.ndarray
+    """(k,) uint32: the vertices with the largest residuals of a "stalled" search."""
+    termination_detail: Optional[str]
+    """The failure of a "numerical_error"; None otherwise."""
+    iterations: int
+    """Sequential QP steps taken."""
+    positions: np.ndarray
+    """(n, 3) float64: the thrust surface, the mesh's plan with the heights found."""
+    edges: np.ndarray
+    """(E, 2) uint32: the mesh's edges, the rows of `force_densities`."""
+    force_densities: np.ndarray
+    """(E,) float64: force density per edge (force / length, compression positive)."""
+    loads: np.ndarray
+    """(n,) float64: vertical load per vertex: self-weight (thickness x unit weight x area on
+    the middle surface), the mesh's extra loads, and load_factor x load_pattern."""
+    residuals: np.ndarray
+    """(n,) float64: vertical residual per vertex (0 at supports)."""
+    eps_inf: float
+    """max |residual| / mean load over the non-anchored vertices."""
+    horizontal_imbalance: float
+    """Largest horizontal imbalance at a non-anchored vertex / mean load."""
+    lower: np.ndarray
+    """(n,) float64: lower bound per vertex at the reported thickness (the intrados scaled by
+    `thickness_scale` about the middle surface)."""
+    upper: np.ndarray
+    """(n,) float64: upper bound per vertex at the reported thickness."""
+    thickness_scale: float
+    """Scale s of the envelope's half extents: the least one for "min-thickness", else 1."""
+    safety_factor: float
+    """1 / thickness_scale: the geometric safety factor of "min-thickness"."""
+    reactions: np.ndarray
+    """(n, 2) float64: horizontal reaction per vertex (non-zero at supports)."""
+    thrust_horizontal: float
+    """Sum over the supports of |reaction| (force)."""
+    load_factor: float
+    """The factor lambda on the load pattern ("max-load"; else 0)."""
+    worst_bound: float
+    """The largest excess of a height over its bounds (0 when all are inside)."""
+    worst_bound_vertex: Optional[int]
+    """Its vertex, or None."""
+    worst_residual_vertex: Optional[int]
+    """The vertex of the largest residual, or None."""
+    seconds: float
+    """Wall time of the search."""
+    envelope_lower: np.ndarray
+    """(n,) float64: the intrados height per vertex, as given."""
+    envelope_upper: np.ndarray
+    """(n,) float64: the extrados height per vertex, as given."""
+    envelope_middle: np.ndarray
+    """(n,) float64: the middle surface's height per vertex."""
+    face_thickness: np.ndarray
+    """(m,) float64: thickness per face along the middle surface's normal (its weight is
+    area x thickness x unit weight)."""
+    thickness_min: Optional[float] = None
+    """thickness_scale x the thickness when one uniform thickness was given (the least
+    thickness for "min-thickness"); None for per-face thicknesses and surfaces."""
+
+    @classmethod
+    def _from_native(
+        cls, fields: Dict[str, Any], thickness_min: Optional[float]
+    ) -> "AssessmentResult":
+        names = [f.name for f in dataclasses.fields(cls) if f.name != "thickness_min"]
+        return cls(**{name: fields[name] for name in names}, thickness_min=thickness_min)
+
+    @property
+    def converged(self) -> bool:
+        """A certified surface, optimal for the objective."""
+        return self.feasible and self.termination == "converged"

@@ -74,4 +74,12 @@ def form_find(
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
     report: bool = ...,
 ) -> Dict[str, Any]: ...
+def assess(
+    mesh: Mesh,
+    thickness: Optional[np.ndarray],
+    intrados: Optional[Tuple[np.ndarray, np.ndarray]],
+    extrados: Optional[Tuple[np.ndarray, np.ndarray]],
+    settings: Dict[str, Any],
+    progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
+) -> Dict[str, Any]: ...
 def write_mesh(mesh: Mesh, positions: np.ndarray, path: str) -> None: ...

@@ -242,10 +242,11 @@ pub(crate) unsafe fn copy_out<T: Copy>(
 pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
     use Error::*;
     let (status, arg) = match &e {
-        InvalidArgument { name, .. } => {
+        // Its own wording starts "invalid argument `name`": said once.
+        InvalidArgument { name, reason } => {
             return Failure::new(
                 VsrStatus::InvalidArgument,
-                format!("argument `{name}`: {e}"),
+                format!("argument `{name}`: {reason}"),
             )
         }
         EmptyMesh => (VsrStatus::EmptyMesh, "positions"),

@@ -4,6 +4,7 @@
 
 use super::boundary::{CResult, Failure};
 use super::status::VsrStatus;
+use crate::assess::Objective;
 use crate::geometry::loads::LoadRule;
 use crate::stress::airy::HoleMode;
 use crate::stress::{EdgeScope, Formulation, QpSolver, TauMode};
@@ -123,6 +124,23 @@ pub(crate) fn bound_kind(name: &str, v: u32) -> CResult<bool> {
             name,
             v,
             "VSR_BOUND_KIND_ABSOLUTE (0), VSR_BOUND_KIND_RELATIVE (1)",
+        )),
+    }
+}
+
+/// The analysis of `vsr_assess_settings_set_objective`.
+pub(crate) fn objective(name: &str, v: u32) -> CResult<Objective> {
+    match v {
+        0 => Ok(Objective::Fit),
+        1 => Ok(Objective::MinThickness),
+        2 => Ok(Objective::MinThrust),
+        3 => Ok(Objective::MaxThrust),
+        4 => Ok(Objective::MaxLoad),
+        _ => Err(bad_enum(
+            name,
+            v,
+            "VSR_OBJECTIVE_FIT (0), VSR_OBJECTIVE_MIN_THICKNESS (1), VSR_OBJECTIVE_MIN_THRUST \
+             (2), VSR_OBJECTIVE_MAX_THRUST (3), VSR_OBJECTIVE_MAX_LOAD (4)",
         )),
     }
 }

@@ -2,9 +2,10 @@
 //!
 //! This is the only module with `unsafe`. It does no math: it checks what crosses the boundary
 //! (NULL, length overflow, index range, finiteness, enum values), builds the Rust types and
-//! calls [`crate::analyse`] / [`crate::form_find`]. Every exported function body runs inside
-//! one `boundary!` (clear the thread-local last error, `catch_unwind`, map failures to a
-//! [`VsrStatus`] and a one-line message). Outputs are written only on success.
+//! calls [`crate::analyse`] / [`crate::form_find`] / [`crate::assess`]. Every exported
+//! function body runs inside one `boundary!` (clear the thread-local last error,
+//! `catch_unwind`, map failures to a [`VsrStatus`] and a one-line message). Outputs are
+//! written only on success.
 //!
 //! The header is generated from these doc comments by cbindgen (`tests/capi_header.rs`; run
 //! it with `VSR_BLESS=1` to rewrite `include/voussoir.h`).
@@ -19,7 +20,12 @@ mod settings;
 mod solid;
 mod solve;
 mod status;
+// Masonry assessment, after the rest: new functions come last in the header.
+mod assess;
+mod assessment;
 
+pub use assess::*;
+pub use assessment::*;
 pub use files::*;
 pub use mesh::*;
 pub use result::*;
@@ -27,8 +33,8 @@ pub use settings::*;
 pub use solid::*;
 pub use solve::*;
 pub use status::{
-    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrQpSolver,
-    VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
+    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrObjective,
+    VsrQpSolver, VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
 };
 
 use boundary::boundary;

@@ -4,6 +4,7 @@
 //! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`, in `enum_args.rs`); enum *outputs*
 //! are written as these types (`uint32_t` in C).
 
+use crate::assess::Objective;
 use crate::stress::{QpSolver, StressStatus};
 use crate::Termination;
 
@@ -269,4 +270,37 @@ pub enum VsrMethod {
     /// The paper's loop: height steps pulled towards the current heights with the proximal
     /// schedule (`vsr_settings_set_schedule_*`).
     Paper = 1,
+}
+
+/// What `vsr_assess` optimises (`vsr_assess_settings_set_objective`,
+/// `vsr_assessment_objective`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrObjective {
+    /// Default: does a thrust surface fit? The one nearest the middle surface (least
+    /// area-weighted squared height difference).
+    Fit = 0,
+    /// The least thickness: the smallest scale s of the envelope's half extents about the
+    /// middle surface that still holds a thrust surface (the loads stay those of the given
+    /// thickness); the geometric safety factor is 1 / s.
+    MinThickness = 1,
+    /// The least horizontal thrust, Σ over supports of |H| (the passive state).
+    MinThrust = 2,
+    /// The greatest horizontal thrust (the active state).
+    MaxThrust = 3,
+    /// The largest factor λ on the load pattern (`vsr_assess_settings_set_load_pattern`)
+    /// added to the self-weight.
+    MaxLoad = 4,
+}
+
+impl VsrObjective {
+    pub(crate) fn of(o: Objective) -> VsrObjective {
+        match o {
+            Objective::Fit => VsrObjective::Fit,
+            Objective::MinThickness => VsrObjective::MinThickness,
+            Objective::MinThrust => VsrObjective::MinThrust,
+            Objective::MaxThrust => VsrObjective::MaxThrust,
+            Objective::MaxLoad => VsrObjective::MaxLoad,
+        }
+    }
 }

@@ -123,7 +123,15 @@ pub fn load_jacobian(
     let mut diagonal = vec![0.0; positions.len()];
     let mut edge = vec![[0.0; 2]; mesh.edges.len()];
     for (t, f) in mesh.faces.iter().enumerate() {
+        // Relative to the first corner where the heights lie far from 0 (the shares depend on
+        // differences only, and a step of 1e-6 added to heights of 10⁷ would be rounded to a
+        // thousandth of itself).
         let corners = f.map(|i| positions[i as usize]);
+        let heights = corners.map(|c| c[2]);
+        let corners = match super::far_base(&heights[..1], &heights) {
+            0.0 => corners,
+            _ => corners.map(|c| sub3(c, corners[0])),
+        };
         let size = (0..3)
             .map(|k| {
                 dot3(

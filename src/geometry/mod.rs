@@ -45,6 +45,28 @@ impl Frame {
     }
 }
 
+/// The mean of `reference` heights where it lies far from the heights `all` span (beyond a
+/// thousand times their range: a model lifted by 10⁷, say), else 0: the base that solvers
+/// subtract from heights so that their differences keep their digits, while ordinary models
+/// keep the arithmetic they always had.
+pub(crate) fn far_base(reference: &[f64], all: &[f64]) -> f64 {
+    let finite = |h: &&f64| h.is_finite();
+    let (lo, hi) = (all.iter().filter(finite))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &z| {
+            (l.min(z), h.max(z))
+        });
+    let count = reference.iter().filter(finite).count();
+    if count == 0 || lo > hi {
+        return 0.0;
+    }
+    let mean = reference.iter().filter(finite).sum::<f64>() / count as f64;
+    if mean.abs() > 1e3 * (hi - lo) {
+        mean
+    } else {
+        0.0
+    }
+}
+
 /// Per-face plan areas and corner cotangents, per-edge plan lengths, in frame coordinates.
 #[derive(Debug, Clone)]
 pub struct Plan {

@@ -126,9 +126,12 @@ pub fn write_mesh(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Re
 /// keep positions bit for bit. STL stores `f32` by definition: positions are rounded to
 /// single precision (about 7 significant digits), enough to look at or print a shape but
 /// not to keep its equilibrium. 3MF writes shortest decimals too, and needs a closed mesh
-/// (every edge shared by two faces in opposite directions). The file is written to a temporary file in the same folder
-/// and renamed over `path`, so a failure never leaves a half-written file. A face index
-/// `>= positions.len()` or a non-finite coordinate is an [`Error::InvalidArgument`].
+/// (every edge shared by two faces in opposite directions). The file is written to a
+/// temporary file in the same folder and renamed over `path`, so a failure never leaves a
+/// half-written file; a symbolic link is written through (the file it leads to is replaced,
+/// the link kept), and a target that is not a regular file (a device, a FIFO, a folder) is
+/// refused ([`super::output_target`]). A face index `>= positions.len()` or a non-finite
+/// coordinate is an [`Error::InvalidArgument`].
 pub fn write_mesh_as(
     path: &Path,
     format: MeshFormat,

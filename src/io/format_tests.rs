@@ -183,6 +183,11 @@ fn malformed_off_files_report_their_line() {
         ),
         (format!("{HEAD}2 0 1\n"), "line 6", "2 vertices"),
         (
+            format!("{HEAD}3 0 2 2\n"),
+            "line 6",
+            "face 0 lists vertex 2 twice",
+        ),
+        (
             format!("{HEAD}3 0 -1 2\n"),
             "line 6",
             "bad vertex index `-1`",
@@ -231,6 +236,9 @@ fn ascii_stl_with_several_solids_and_a_nameless_one() {
     let text = format!("solid\n{facet}endsolid\nsolid two\n{facet}{facet}endsolid two\n");
     let (p, f) = parse_stl(text.as_bytes(), "x.stl").unwrap();
     assert_eq!((p.len(), f.len()), (9, 3));
+    // A solid without facets is no parse error: the mesh it makes is empty.
+    let (p, f) = parse_stl(b"solid x\nendsolid x\n", "x.stl").unwrap();
+    assert!(p.is_empty() && f.is_empty());
 }
 
 #[test]
@@ -240,7 +248,7 @@ fn malformed_stl_files_name_the_triangle() {
     let mut nan = t;
     nan[4] = f32::NAN;
     let facet = "facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 0 1 0\n endloop\nendfacet\n";
-    let cases: Vec<(Vec<u8>, &str, &str)> = vec![
+    let mut cases: Vec<(Vec<u8>, &str, &str)> = vec![
         (
             good[..good.len() - 7].to_vec(),
             "header",
@@ -259,21 +267,52 @@ fn malformed_stl_files_name_the_triangle() {
                 facet.replace("vertex 1 0 0", "vertex 1 zero 0")
             )
             .into(),
-            "triangle 1",
-            "invalid float",
+            "line 12",
+            "triangle 1: corner 1: `zero` is not a number",
         ),
         (
             format!("solid x\n{facet}facet normal 0 0 1\n outer loop\n").into(),
-            "triangle 1",
-            "EOF",
+            "line 10",
+            "ends where `vertex x y z` for corner 0 of triangle 1 is expected",
         ),
-        (format!("solid x\n{facet}").into(), "triangle 1", "EOF"),
+        (
+            format!("solid x\n{facet}").into(),
+            "line 8",
+            "ends where `facet normal` for triangle 1 or `endsolid` is expected",
+        ),
+        (
+            format!("solid x\n{facet}endsolid x\nstray bytes\n").into(),
+            "line 10",
+            "only another solid may follow",
+        ),
+        (
+            format!("solid x\n{facet}")
+                .replace("endloop", "endloop x")
+                .into(),
+            "line 7",
+            "expected `endloop` of triangle 0 (`endloop x`)",
+        ),
+        (
+            format!("solid x\n{}endsolid\n", facet.replace("0 1 0", "0 1e39 0")).into(),
+            "line 6",
+            "corner 2 has a NaN or infinite coordinate",
+        ),
     ];
+    let long = format!(
+        "solid x\n{}endsolid\n",
+        facet.replace("1 0 0", &"1".repeat(100_000))
+    );
+    let long_excerpt = format!(
+        "expected `vertex x y z` for corner 1 of triangle 0 (`vertex {}…`)",
+        "1".repeat(33)
+    );
+    cases.push((long.into(), "line 5", &long_excerpt));
     for (bytes, at, needle) in cases {
         let (where_, reason) = parse_error(parse_stl(&bytes, "bad.stl"));
         assert_eq!(where_, at, "{reason}");
         assert!(reason.contains(needle), "{reason}");
         assert!(!reason.contains('\n'), "{reason}");
+        assert!(reason.len() < 200, "{reason}");
     }
 }
 
@@ -315,8 +354,8 @@ fn malformed_ply_files_name_the_line_or_element() {
             PLY_HEAD
                 .replace("element vertex 4", "element vertex four")
                 .into_bytes(),
-            "line 11",
-            "bad header",
+            "line 4",
+            "bad header: element `vertex`: count `four` is not a whole number",
         ),
         (body(""), "line 14", "ends before vertex 3"),
         (body("0 1 zero 4\n"), "line 15", "vertex 3"),
@@ -352,7 +391,7 @@ fn malformed_ply_files_name_the_line_or_element() {
             "face 0",
             "ends before it",
         ),
-        ([binary.as_slice(), b"x"].concat(), "end", "1 bytes after"),
+        ([binary.as_slice(), b"x"].concat(), "end", "1 byte after"),
     ];
     for (bytes, at, needle) in cases {
         let (where_, reason) = parse_error(parse_ply(&bytes, "bad.ply"));
@@ -360,4 +399,101 @@ fn malformed_ply_files_name_the_line_or_element() {
         assert!(reason.contains(needle), "{at}: {reason}");
         assert!(!reason.contains('\n'), "{reason}");
     }
+}
+
+/// The header counts, versions and ASCII face lines of issue 48's reproducers: each a parse
+/// error naming its line, never a panic, never a face dropped.
+#[test]
+fn ply_counts_beyond_64_bits_and_face_lines_against_their_count() {
+    let head = |vertices: &str, faces: &str, format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex {vertices}\nproperty float x\n\
+             property float y\nproperty float z\nelement face {faces}\n\
+             property list uchar int vertex_indices\nend_header\n"
+        )
+    };
+    let vertices = "0 0 0\n1 0 0\n0 1 0\n1 1 1\n";
+    let huge = "99999999999999999999999";
+    let cases: Vec<(String, &str, &str)> = vec![
+        (
+            head(huge, "1", "ascii") + vertices,
+            "line 3",
+            "count `99999999999999999999999` is larger than 18446744073709551615",
+        ),
+        (
+            head("4", huge, "ascii") + vertices,
+            "line 7",
+            "element `face`: count `99999999999999999999999` is larger",
+        ),
+        (
+            head(huge, "1", "binary_little_endian"),
+            "line 3",
+            "is larger than 18446744073709551615",
+        ),
+        (
+            head("4", "1", "ascii") + vertices + "3 0 1 2 3\n",
+            "line 14",
+            "face 0: 1 more number than its properties take, in `3 0 1 2 3`",
+        ),
+        (
+            head("4", "2", "ascii") + vertices + "3 0 1 2 3 1 3 2\n3 0 1 3\n",
+            "line 14",
+            "face 0: 4 more numbers than its properties take",
+        ),
+        (
+            head("4", "1", "ascii") + vertices + "4 0 1 2\n",
+            "line 14",
+            "face 0: the line ends before item 3 of `vertex_indices` (4 numbers in `4 0 1 2`)",
+        ),
+        (
+            head("4", "1", "ascii") + vertices + "256 0 1 2\n",
+            "line 14",
+            "the count of `vertex_indices`: 256 is out of the range of uchar (0 to 255)",
+        ),
+        (
+            head("4", "1", "ascii") + vertices + "3 0 1 99999999999\n",
+            "line 14",
+            "item 2 of `vertex_indices`: 99999999999 is out of the range of int",
+        ),
+        (
+            head("4", "1", "ascii") + "0 0 0 7\n",
+            "line 10",
+            "vertex 0: 1 more number than its properties take",
+        ),
+        (
+            head("4", "1", "ascii") + vertices + "3 0 1 1\n",
+            "face 0",
+            "lists vertex 1 twice",
+        ),
+        (
+            head("4", "1", "ascii").replace("property float y", "property floot y"),
+            "line 5",
+            "unknown property type `floot`",
+        ),
+        (
+            head("4", "1", "ascii").replace("property float z\n", ""),
+            "line 3",
+            "element `vertex` has no number `z`",
+        ),
+    ];
+    for (text, at, needle) in cases {
+        let (where_, reason) = parse_error(parse_ply(text.as_bytes(), "bad.ply"));
+        assert_eq!(where_, at, "{text:?}: {reason}");
+        assert!(reason.contains(needle), "{at}: {reason}");
+    }
+    // Any version number is read (the crate this parser replaced panicked beyond 64 bits).
+    let text =
+        head("4", "1", "ascii").replace("1.0", &format!("{huge}.0")) + vertices + "3 0 1 2\n";
+    assert_eq!(
+        parse_ply(text.as_bytes(), "v.ply").unwrap().1,
+        vec![[0, 1, 2]]
+    );
+    // A binary face whose count runs past the end of the file allocates nothing first.
+    let mut bytes = head("3", "1", "binary_little_endian").into_bytes();
+    bytes.extend([0u8; 36]);
+    bytes.push(255);
+    bytes.extend(0i32.to_le_bytes());
+    let (where_, reason) = parse_error(parse_ply(&bytes, "bad.ply"));
+    assert_eq!(where_, "face 0");
+    assert!(reason.contains("declares 255 items, 1 fit"), "{reason}");
 }

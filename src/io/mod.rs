@@ -20,6 +20,8 @@ mod model;
 mod obj;
 mod off;
 mod ply;
+mod ply_data;
+mod ply_header;
 mod stl;
 mod supports;
 #[cfg(test)]
@@ -33,6 +35,7 @@ use std::path::Path;
 
 use crate::{Problem, Result};
 
+pub use atomic::output_target;
 pub use format::{read_mesh, read_mesh_with_diagonals, write_mesh, write_mesh_as, MeshFormat};
 pub use model::{read_model, Model, ReadOptions, Supports, UpAxis, WeldSummary};
 pub use obj::{parse_obj, read_obj, write_obj, IGNORED_KEYWORDS};
@@ -58,6 +61,45 @@ fn split_fan(polygon: &[u32], faces: &mut Vec<[u32; 3]>, diagonals: &mut Vec<[u3
             diagonals.push([polygon[0], polygon[k]]);
         }
     }
+}
+
+/// A vertex that `polygon` lists twice, if any (in O(n log n) for long polygons).
+fn repeated_vertex(polygon: &[u32]) -> Option<u32> {
+    if polygon.len() <= 8 {
+        let n = polygon.len();
+        return (0..n).find_map(|i| polygon[i + 1..].contains(&polygon[i]).then_some(polygon[i]));
+    }
+    let mut sorted = polygon.to_vec();
+    sorted.sort_unstable();
+    sorted.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
+}
+
+/// Why a face that lists `vertex` twice is refused (as the file numbers it).
+fn repeated_vertex_message(vertex: impl std::fmt::Display) -> String {
+    format!(
+        "lists vertex {vertex} twice: each corner of a face is a different vertex (remove the \
+         repeated one, or the face if it has fewer than 3 vertices left)"
+    )
+}
+
+/// At most 40 characters of `text`, control and invisible characters escaped, with `…`
+/// where it is cut: what an error message quotes of a line or token.
+fn excerpt(text: &str) -> String {
+    const MAX: usize = 40;
+    let mut out = String::new();
+    for (k, c) in text.chars().enumerate() {
+        if k == MAX {
+            out.push('…');
+            break;
+        }
+        let invisible = matches!(c, '\u{200b}'..='\u{200f}' | '\u{2060}' | '\u{feff}');
+        if c.is_control() || invisible {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// [`read_model`] of a mesh file (any format) with its JSON supports file and the default

@@ -3,7 +3,7 @@
 use std::fs;
 use std::path::Path;
 
-use super::{io_error, split_fan, RawMesh};
+use super::{excerpt, io_error, repeated_vertex, repeated_vertex_message, split_fan, RawMesh};
 use crate::{Error, Result};
 
 /// Reads the vertices and faces of an OBJ file (see [`parse_obj`]). Bytes that are not
@@ -35,8 +35,10 @@ pub const IGNORED_KEYWORDS: [&str; 9] = ["vn", "vt", "vp", "g", "o", "s", "usemt
 /// Errors are [`Error::Parse`] with `path_label` and the 1-based line: any other statement
 /// (a misspelt `F`, `f,`, a keyword behind an invisible character: skipping it would drop a
 /// face or a vertex unseen), a vertex with fewer than 3 coordinates or a bad number, a face
-/// with fewer than 3 vertices, an index that is not an integer, is 0, or refers past the last
-/// vertex of the file (or, when negative, before the first vertex).
+/// with fewer than 3 vertices or with a vertex listed twice (`f 1 2 2`: a face without area,
+/// which a mesh cannot hold; the message says to remove the repeated vertex), an index that is
+/// not an integer, is 0, or refers past the last vertex of the file (or, when negative, before
+/// the first vertex).
 pub fn parse_obj(text: &str, path_label: &str) -> Result<RawMesh> {
     parse_obj_split(text, path_label).map(|(mesh, _)| mesh)
 }
@@ -70,9 +72,9 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
                             format!("vertex has {k} coordinates, 3 are needed (v x y z)"),
                         ));
                     };
-                    *c = tok
-                        .parse::<f64>()
-                        .map_err(|_| err(line, format!("bad number `{tok}` in vertex")))?;
+                    *c = tok.parse::<f64>().map_err(|_| {
+                        err(line, format!("bad number `{}` in vertex", excerpt(tok)))
+                    })?;
                 }
                 positions.push(p);
             }
@@ -90,6 +92,10 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
                         format!("face has {} vertices, at least 3 are needed", polygon.len()),
                     ));
                 }
+                if let Some(v) = repeated_vertex(&polygon) {
+                    let reason = format!("face {}", repeated_vertex_message(u64::from(v) + 1));
+                    return Err(err(line, reason));
+                }
                 if largest >= positions.len() as u64 {
                     forward_refs.push((line, largest));
                 }
@@ -101,7 +107,7 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
                     line,
                     format!(
                         "unknown statement `{}`: only v and f are read, and {} are skipped",
-                        keyword.escape_debug(),
+                        excerpt(keyword),
                         IGNORED_KEYWORDS.join(", ")
                     ),
                 ))
@@ -128,7 +134,7 @@ fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, Strin
     let text = token.split('/').next().unwrap_or("");
     let value: i64 = text
         .parse()
-        .map_err(|_| format!("bad vertex index `{token}` in face"))?;
+        .map_err(|_| format!("bad vertex index `{}` in face", excerpt(token)))?;
     let index = match value {
         0 => return Err("vertex index 0 in face (OBJ indices start at 1)".to_string()),
         v if v > 0 => v - 1,
@@ -146,9 +152,9 @@ fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, Strin
 }
 
 /// Writes vertices and faces (1-based) as OBJ. Coordinates are written with Rust's shortest
-/// round-trip formatting, so [`read_obj`] gives back the same bits. The file is written to a
-/// temporary file in the same folder and renamed over `path`, so a failure never leaves a
-/// half-written file. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
+/// round-trip formatting, so [`read_obj`] gives back the same bits. The file is written as
+/// [`super::write_mesh_as`] writes it: all or nothing, through symbolic links, never over a
+/// device, FIFO or folder. A face index `>= positions.len()` is an [`Error::InvalidArgument`].
 pub fn write_obj(path: &Path, positions: &[[f64; 3]], faces: &[[u32; 3]]) -> Result<()> {
     super::atomic::check_face_indices(positions.len(), faces)?;
     super::atomic::write_atomically(path, |out| {

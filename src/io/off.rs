@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::atomic::write_atomically;
-use super::{split_fan, RawMesh};
+use super::{excerpt, repeated_vertex, repeated_vertex_message, split_fan, RawMesh};
 use crate::{Error, Result};
 
 /// Parses OFF text. The keyword is `OFF` with the optional prefixes `ST` (texture
@@ -15,8 +15,9 @@ use crate::{Error, Result};
 ///
 /// Errors are [`Error::Parse`] with `path_label` and the 1-based line: binary or 4D OFF, a bad
 /// or missing count, a vertex with fewer than 3 numbers or a NaN or infinite one, a face with
-/// fewer than 3 vertices, fewer indices than it declares or an index out of range, a file
-/// that ends before the declared vertices and faces, or content after them.
+/// fewer than 3 vertices, fewer indices than it declares, a vertex listed twice or an index
+/// out of range, a file that ends before the declared vertices and faces, or content after
+/// them.
 pub fn parse_off(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
     parse_off_split(bytes, path_label).map(|(mesh, _)| mesh)
 }
@@ -98,7 +99,10 @@ fn read_header<'a>(
         tok.parse::<u32>().map(|n| n as usize).map_err(|_| {
             err(
                 counts_line,
-                format!("bad {what} count `{tok}` (expected `vertices faces [edges]`)"),
+                format!(
+                    "bad {what} count `{}` (expected `vertices faces [edges]`)",
+                    excerpt(tok)
+                ),
             )
         })
     };
@@ -118,7 +122,8 @@ fn check_keyword(keyword: &str, next: Option<&str>) -> std::result::Result<(), S
     let rest = rest.strip_prefix('N').unwrap_or(rest);
     if !rest.is_empty() {
         return Err(format!(
-            "`{keyword}` is not a supported OFF variant (3D [ST][C][N]OFF only)"
+            "`{}` is not a supported OFF variant (3D [ST][C][N]OFF only)",
+            excerpt(keyword)
         ));
     }
     if next == Some("BINARY") {
@@ -136,9 +141,12 @@ fn parse_vertex(content: &str, v: usize) -> std::result::Result<[f64; 3], String
             .ok_or_else(|| format!("vertex {v} has {k} coordinates, 3 are needed"))?;
         *c = tok
             .parse::<f64>()
-            .map_err(|_| format!("vertex {v}: bad number `{tok}`"))?;
+            .map_err(|_| format!("vertex {v}: bad number `{}`", excerpt(tok)))?;
         if !c.is_finite() {
-            return Err(format!("vertex {v}: coordinate `{tok}` is not finite"));
+            return Err(format!(
+                "vertex {v}: coordinate `{}` is not finite",
+                excerpt(tok)
+            ));
         }
     }
     Ok(p)
@@ -150,7 +158,7 @@ fn parse_face(content: &str, f: usize, n_vertices: usize) -> std::result::Result
     let first = tokens.next().unwrap_or("");
     let n: usize = first
         .parse()
-        .map_err(|_| format!("face {f}: bad vertex count `{first}`"))?;
+        .map_err(|_| format!("face {f}: bad vertex count `{}`", excerpt(first)))?;
     if n < 3 {
         return Err(format!("face {f} has {n} vertices, at least 3 are needed"));
     }
@@ -161,13 +169,16 @@ fn parse_face(content: &str, f: usize, n_vertices: usize) -> std::result::Result
             .ok_or_else(|| format!("face {f} declares {n} vertices but lists {k}"))?;
         let index: u32 = tok
             .parse()
-            .map_err(|_| format!("face {f}: bad vertex index `{tok}`"))?;
+            .map_err(|_| format!("face {f}: bad vertex index `{}`", excerpt(tok)))?;
         if index as usize >= n_vertices {
             return Err(format!(
                 "face {f} refers to vertex {index}, but the file has only {n_vertices} vertices"
             ));
         }
         polygon.push(index);
+    }
+    if let Some(v) = repeated_vertex(&polygon) {
+        return Err(format!("face {f} {}", repeated_vertex_message(v)));
     }
     Ok(polygon)
 }

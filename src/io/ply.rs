@@ -1,101 +1,124 @@
-//! Stanford PLY, ASCII and binary, through the `ply-rs-bw` crate: `vertex` elements with `x y
-//! z` and `face` elements with a `vertex_indices` (or `vertex_index`) list.
+//! Stanford PLY, ASCII and binary: `vertex` elements with `x y z` and `face` elements with a
+//! `vertex_indices` (or `vertex_index`) list. Read by the header and data readers of this
+//! module's siblings (`ply_header`, `ply_data`), written by hand.
 
-use std::io::{BufRead, Cursor, Read};
 use std::path::Path;
 
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{DefaultElement, ElementDef, Encoding, Header, Property};
-
 use super::atomic::write_atomically;
-use super::{one_line, split_fan, RawMesh, SplitMesh};
+use super::ply_data::{read_ascii, read_binary, Value};
+use super::ply_header::{read_header, Element, Encoding, Header, Kind};
+use super::{repeated_vertex, repeated_vertex_message, split_fan, RawMesh, SplitMesh};
 use crate::{Error, Result};
 
 /// Parses a PLY file in any of its encodings (ASCII, binary little- or big-endian). The
 /// `vertex` element gives positions from its `x`, `y`, `z` properties (any numeric type;
 /// other properties ignored); the `face` element gives polygons from its `vertex_indices`
 /// or `vertex_index` list (any integer type, 0-based), split into fans. Other elements are
-/// read and ignored.
+/// read and ignored. An ASCII line holds one element, with exactly the numbers its
+/// properties take (a list: its count, then as many items).
 ///
 /// Errors name the line (header and ASCII data, [`Error::Parse`]) or the element (binary data,
-/// [`Error::Malformed`]): a malformed header, missing `x y z` or face list, a truncated file,
-/// a bad number, a NaN or infinite coordinate, a face with fewer than 3 vertices or an index
-/// out of range, content after the declared elements.
+/// [`Error::Malformed`]): a malformed header (an unknown line or type, a count that is not a
+/// whole number or does not fit in 64 bits), missing `x y z` or face list, a truncated file,
+/// a bad or out-of-range number, a line with more or fewer numbers than its element takes, a
+/// NaN or infinite coordinate, a face with fewer than 3 vertices, a repeated vertex or an
+/// index out of range, content after the declared elements.
 pub fn parse_ply(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
     parse_ply_split(bytes, path_label).map(|(mesh, _)| mesh)
 }
 
 /// [`parse_ply`], plus the diagonals that split its polygons (vertex pairs).
 pub(crate) fn parse_ply_split(bytes: &[u8], path_label: &str) -> Result<(RawMesh, Vec<[u32; 2]>)> {
-    let parse_err = |line: usize, reason: String| Error::Parse {
+    let parse_err = |(line, reason): (usize, String)| Error::Parse {
         path: path_label.to_string(),
         line,
         reason,
     };
-    let (header_end, header_lines) = find_header_end(bytes)
-        .ok_or_else(|| parse_err(1, "not a PLY file: no `ply` ... `end_header` header".into()))?;
-    let parser = Parser::<DefaultElement>::new();
-    let header = parser
-        .read_header(&mut Cursor::new(&bytes[..header_end]))
-        .map_err(|e| parse_err(header_lines, format!("bad header: {}", one_line(&e))))?;
-    let body = &bytes[header_end..];
-    let mut mesh = PlyMesh::default();
+    let malformed = |(element, reason): (String, String)| Error::Malformed {
+        path: path_label.to_string(),
+        element,
+        reason,
+    };
+    let header = read_header(bytes).map_err(parse_err)?;
+    let mut mesh = PlyMesh::new(&header).map_err(parse_err)?;
+    let body = &bytes[header.len..];
+    let mut take = |def: &Element, index: u64, values: &[Value]| mesh.add(def, index, values);
     match header.encoding {
-        Encoding::Ascii => read_ascii(&parser, &header, body, header_lines, &mut mesh)
-            .map_err(|(line, reason)| parse_err(line, reason))?,
-        encoding => read_binary(&parser, &header, encoding, body, &mut mesh).map_err(
-            |(element, reason)| Error::Malformed {
-                path: path_label.to_string(),
-                element,
-                reason,
-            },
-        )?,
-    }
-    mesh.finish(&header)
-        .map_err(|(element, reason)| Error::Malformed {
-            path: path_label.to_string(),
-            element,
-            reason,
-        })
-}
-
-/// The byte offset just after the `end_header` line and the number of header lines.
-fn find_header_end(bytes: &[u8]) -> Option<(usize, usize)> {
-    if !bytes.starts_with(b"ply") {
-        return None;
-    }
-    let mut offset = 0;
-    for (i, line) in bytes.split_inclusive(|&b| b == b'\n').enumerate() {
-        offset += line.len();
-        if line.trim_ascii() == b"end_header" {
-            return Some((offset, i + 1));
+        Encoding::Ascii => {
+            read_ascii(&header.elements, body, header.lines + 1, &mut take).map_err(parse_err)?
         }
+        encoding => read_binary(&header.elements, encoding, body, &mut take).map_err(malformed)?,
     }
-    None
+    mesh.finish().map_err(malformed)
 }
 
 /// Positions and polygons gathered element by element, with where each face came from.
-#[derive(Default)]
 struct PlyMesh {
+    /// The indices of `x`, `y`, `z` among the vertex element's properties.
+    xyz: [usize; 3],
+    /// The index of the face element's vertex list among its properties.
+    list: Option<usize>,
     positions: Vec<[f64; 3]>,
-    polygons: Vec<(String, Vec<i64>)>,
+    polygons: Vec<(u64, Vec<i64>)>,
 }
 
 impl PlyMesh {
+    /// Finds the properties the mesh needs; errors are (line, reason).
+    fn new(header: &Header) -> std::result::Result<PlyMesh, (usize, String)> {
+        let find = |name: &str| header.elements.iter().find(|e| e.name == name);
+        let Some(vertex) = find("vertex") else {
+            return Err((header.lines, "bad header: no `vertex` element".into()));
+        };
+        let mut xyz = [0; 3];
+        for (slot, name) in xyz.iter_mut().zip(["x", "y", "z"]) {
+            *slot = vertex
+                .properties
+                .iter()
+                .position(|p| p.name == name && matches!(p.kind, Kind::Scalar(_)))
+                .ok_or_else(|| {
+                    let reason = format!("bad header: element `vertex` has no number `{name}`");
+                    (vertex.line, reason)
+                })?;
+        }
+        let list = match find("face") {
+            None => None,
+            Some(face) => Some(
+                face.properties
+                    .iter()
+                    .position(|p| {
+                        ["vertex_indices", "vertex_index"].contains(&p.name.as_str())
+                            && matches!(p.kind, Kind::List(_, item) if item.is_integer())
+                    })
+                    .ok_or_else(|| {
+                        let reason = "bad header: element `face` has no integer list \
+                                      `vertex_indices`"
+                            .to_string();
+                        (face.line, reason)
+                    })?,
+            ),
+        };
+        Ok(PlyMesh {
+            xyz,
+            list,
+            positions: Vec::new(),
+            polygons: Vec::new(),
+        })
+    }
+
     /// Takes what the mesh needs from one element (`index` within its kind).
     fn add(
         &mut self,
-        def: &ElementDef,
-        element: &DefaultElement,
-        index: usize,
+        def: &Element,
+        index: u64,
+        values: &[Value],
     ) -> std::result::Result<(), String> {
         match def.name.as_str() {
             "vertex" => {
                 let mut p = [0.0; 3];
-                for (c, name) in p.iter_mut().zip(["x", "y", "z"]) {
-                    *c = element.get(name).and_then(scalar).ok_or_else(|| {
-                        format!("vertex {index} has no numeric `{name}` property")
-                    })?;
+                for ((c, &k), name) in p.iter_mut().zip(&self.xyz).zip(["x", "y", "z"]) {
+                    if let Value::Number(x) = values[k] {
+                        *c = x;
+                    }
                     if !c.is_finite() {
                         return Err(format!("vertex {index}: `{name}` is {c}, not finite"));
                     }
@@ -103,12 +126,10 @@ impl PlyMesh {
                 self.positions.push(p);
             }
             "face" => {
-                let list = ["vertex_indices", "vertex_index"]
-                    .iter()
-                    .find_map(|name| element.get(*name))
-                    .and_then(integer_list)
-                    .ok_or_else(|| format!("face {index} has no integer `vertex_indices` list"))?;
-                self.polygons.push((format!("face {index}"), list));
+                if let Some(Value::List(items)) = self.list.map(|k| &values[k]) {
+                    let list = items.iter().map(|&i| i as i64).collect();
+                    self.polygons.push((index, list));
+                }
             }
             _ => {}
         }
@@ -116,143 +137,33 @@ impl PlyMesh {
     }
 
     /// Checks the polygons against the vertex count and splits them into fans.
-    fn finish(self, header: &Header) -> std::result::Result<SplitMesh, (String, String)> {
-        if !header.elements.contains_key("vertex") {
-            return Err(("header".into(), "no `vertex` element".into()));
-        }
+    fn finish(self) -> std::result::Result<SplitMesh, (String, String)> {
         let n = self.positions.len();
         let (mut faces, mut diagonals) = (Vec::new(), Vec::new());
-        for (name, list) in &self.polygons {
+        let mut polygon = Vec::new();
+        for (index, list) in &self.polygons {
+            let name = || format!("face {index}");
             if list.len() < 3 {
                 return Err((
-                    name.clone(),
+                    name(),
                     format!("{} vertices, at least 3 are needed", list.len()),
                 ));
             }
-            if let Some(&i) = list.iter().find(|&&i| i < 0 || i as usize >= n) {
+            if let Some(&i) = list.iter().find(|&&i| i < 0 || i as u64 >= n as u64) {
                 return Err((
-                    name.clone(),
+                    name(),
                     format!("refers to vertex {i}, but the file has {n} vertices"),
                 ));
             }
-            let polygon: Vec<u32> = list.iter().map(|&i| i as u32).collect();
+            polygon.clear();
+            polygon.extend(list.iter().map(|&i| i as u32));
+            if let Some(v) = repeated_vertex(&polygon) {
+                return Err((name(), repeated_vertex_message(v)));
+            }
             split_fan(&polygon, &mut faces, &mut diagonals);
         }
         Ok(((self.positions, faces), diagonals))
     }
-}
-
-fn scalar(p: &Property) -> Option<f64> {
-    Some(match *p {
-        Property::Char(x) => f64::from(x),
-        Property::UChar(x) => f64::from(x),
-        Property::Short(x) => f64::from(x),
-        Property::UShort(x) => f64::from(x),
-        Property::Int(x) => f64::from(x),
-        Property::UInt(x) => f64::from(x),
-        Property::Float(x) => f64::from(x),
-        Property::Double(x) => x,
-        _ => return None,
-    })
-}
-
-fn integer_list(p: &Property) -> Option<Vec<i64>> {
-    fn widen<T: Copy + Into<i64>>(list: &[T]) -> Vec<i64> {
-        list.iter().map(|&x| x.into()).collect()
-    }
-    Some(match p {
-        Property::ListChar(l) => widen(l),
-        Property::ListUChar(l) => widen(l),
-        Property::ListShort(l) => widen(l),
-        Property::ListUShort(l) => widen(l),
-        Property::ListInt(l) => widen(l),
-        Property::ListUInt(l) => widen(l),
-        _ => return None,
-    })
-}
-
-/// One element per line; errors are (line, reason).
-fn read_ascii(
-    parser: &Parser<DefaultElement>,
-    header: &Header,
-    body: &[u8],
-    header_lines: usize,
-    mesh: &mut PlyMesh,
-) -> std::result::Result<(), (usize, String)> {
-    let mut lines = body.lines().enumerate();
-    let mut last = header_lines;
-    for def in header.elements.values() {
-        for index in 0..def.count {
-            let Some((i, line)) = lines.next() else {
-                return Err((
-                    last,
-                    format!(
-                        "the file ends before {} {index} (it declares {})",
-                        def.name, def.count
-                    ),
-                ));
-            };
-            last = header_lines + i + 1;
-            let line = line.map_err(|e| (last, one_line(&e)))?;
-            let element = parser
-                .read_ascii_element(&line, def)
-                .map_err(|e| (last, format!("{} {index}: {}", def.name, one_line(&e))))?;
-            mesh.add(def, &element, index).map_err(|r| (last, r))?;
-        }
-    }
-    if let Some((i, _)) = lines.find(|(_, l)| l.as_ref().map_or(true, |l| !l.trim().is_empty())) {
-        return Err((
-            header_lines + i + 1,
-            "content after the declared elements".into(),
-        ));
-    }
-    Ok(())
-}
-
-/// Elements one after another; errors are (element, reason).
-fn read_binary(
-    parser: &Parser<DefaultElement>,
-    header: &Header,
-    encoding: Encoding,
-    body: &[u8],
-    mesh: &mut PlyMesh,
-) -> std::result::Result<(), (String, String)> {
-    let mut cursor = Cursor::new(body);
-    for def in header.elements.values() {
-        for index in 0..def.count {
-            let name = || format!("{} {index}", def.name);
-            if def.properties.is_empty() {
-                // An element without properties takes no bytes.
-                break;
-            }
-            if cursor.position() as usize >= body.len() {
-                let reason = format!("the file ends before it (it declares {})", def.count);
-                return Err((name(), reason));
-            }
-            let element = match encoding {
-                Encoding::BinaryBigEndian => parser.read_big_endian_element(&mut cursor, def),
-                _ => parser.read_little_endian_element(&mut cursor, def),
-            }
-            .map_err(|e| {
-                (
-                    name(),
-                    format!(
-                        "the file ends inside it or it is malformed: {}",
-                        one_line(&e)
-                    ),
-                )
-            })?;
-            mesh.add(def, &element, index).map_err(|r| (name(), r))?;
-        }
-    }
-    let rest = cursor.bytes().count();
-    if rest > 0 {
-        return Err((
-            "end".into(),
-            format!("{rest} bytes after the declared elements"),
-        ));
-    }
-    Ok(())
 }
 
 /// Writes PLY, binary little-endian or ASCII, with `double` positions (shortest round-trip

@@ -4,7 +4,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use super::atomic::write_atomically;
-use super::{one_line, RawMesh};
+use super::{excerpt, one_line, RawMesh};
 use crate::{Error, Result};
 
 /// Bytes of the binary header and triangle count, and of one binary triangle record.
@@ -15,10 +15,13 @@ const BINARY_TRIANGLE: usize = 50;
 /// count in its header (whatever the header's first bytes say, since many binary exporters
 /// begin it with `solid`), else ASCII when it begins with `solid`. Every triangle gives three
 /// vertices, in order (vertex `3t + k` is corner `k` of triangle `t`); see [`super::weld`].
-/// An ASCII file may hold several solids, read one after another.
+/// An ASCII file may hold several solids, read one after another; nothing but another solid
+/// may follow an `endsolid`.
 ///
-/// Errors name the triangle at fault ([`Error::Malformed`]): a truncated or overlong binary
-/// file, a malformed ASCII facet, a NaN or infinite coordinate.
+/// Errors name the triangle at fault in a binary file ([`Error::Malformed`]: truncated or
+/// overlong, a NaN or infinite coordinate) and the line in an ASCII file ([`Error::Parse`]: a
+/// statement out of place, a bad number, a NaN or infinite coordinate, content after
+/// `endsolid`, a file that ends inside a solid), quoting at most a short excerpt of it.
 pub fn parse_stl(bytes: &[u8], path_label: &str) -> Result<RawMesh> {
     let triangles = match binary_count(bytes) {
         Some(Ok(_)) => read_binary(bytes, path_label)?,
@@ -95,34 +98,135 @@ fn read_binary(bytes: &[u8], path_label: &str) -> Result<Vec<stl_io::Triangle>> 
     read_triangles(&copy, path_label, 0)
 }
 
-/// Each solid of an ASCII file in turn; a first line `solid` without a name is accepted.
+/// The triangles of an ASCII file: one or more `solid` ... `endsolid` blocks of facets, read
+/// line by line so that every fault names its line. Keywords are read in any case.
 fn read_ascii(bytes: &[u8], path_label: &str) -> Result<Vec<stl_io::Triangle>> {
     let text = String::from_utf8_lossy(bytes);
-    let mut solids: Vec<String> = Vec::new();
-    for line in text.lines() {
-        let first = line.split_whitespace().next();
-        if first == Some("solid") {
-            solids.push(format!("solid {}\n", line.trim_start()[5..].trim()));
-        } else if let Some(solid) = solids.last_mut() {
-            solid.push_str(line);
-            solid.push('\n');
-        } else if first.is_some() {
-            return Err(malformed(
-                path_label,
-                "header",
-                "ASCII STL must begin with `solid`".to_string(),
-            ));
+    let mut reader = AsciiReader::default();
+    let mut last = 0;
+    for (i, line) in text.lines().enumerate() {
+        last = i + 1;
+        let tokens: Vec<&str> = line.split_ascii_whitespace().collect();
+        if tokens.is_empty() {
+            continue;
+        }
+        reader.line(&tokens).map_err(|reason| Error::Parse {
+            path: path_label.to_string(),
+            line: last,
+            reason: format!("{reason} (`{}`)", excerpt(line.trim())),
+        })?;
+    }
+    if let Some(expected) = reader.expected() {
+        return Err(Error::Parse {
+            path: path_label.to_string(),
+            line: last.max(1),
+            reason: format!("the file ends where {expected} is expected"),
+        });
+    }
+    Ok(reader.triangles)
+}
+
+/// Where an ASCII STL reader stands: the statement it expects next.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+enum Expect {
+    /// `solid` (the first line, or after `endsolid`).
+    #[default]
+    Solid,
+    /// `facet normal` or `endsolid`.
+    Facet,
+    OuterLoop,
+    /// The `k`th `vertex` line.
+    Vertex(usize),
+    EndLoop,
+    EndFacet,
+}
+
+#[derive(Default)]
+struct AsciiReader {
+    expect: Expect,
+    corners: [stl_io::Vertex; 3],
+    triangles: Vec<stl_io::Triangle>,
+}
+
+impl AsciiReader {
+    /// What the file must still hold, if it cannot end here.
+    fn expected(&self) -> Option<String> {
+        // A file read at all began with `solid`: at `Solid`, every solid has ended.
+        match self.expect {
+            Expect::Solid => None,
+            other => Some(self.describe(other)),
         }
     }
-    let mut triangles = Vec::new();
-    for solid in &solids {
-        triangles.extend(read_triangles(
-            solid.as_bytes(),
-            path_label,
-            triangles.len(),
-        )?);
+
+    fn describe(&self, expect: Expect) -> String {
+        let t = self.triangles.len();
+        match expect {
+            Expect::Solid => "`solid` (after `endsolid`, only another solid may follow)".into(),
+            Expect::Facet => format!("`facet normal` for triangle {t} or `endsolid`"),
+            Expect::OuterLoop => format!("`outer loop` of triangle {t}"),
+            Expect::Vertex(k) => format!("`vertex x y z` for corner {k} of triangle {t}"),
+            Expect::EndLoop => format!("`endloop` of triangle {t}"),
+            Expect::EndFacet => format!("`endfacet` of triangle {t}"),
+        }
     }
-    Ok(triangles)
+
+    /// Reads one non-blank line, split into tokens.
+    fn line(&mut self, tokens: &[&str]) -> std::result::Result<(), String> {
+        let is = |k: usize, word: &str| tokens.get(k).is_some_and(|t| t.eq_ignore_ascii_case(word));
+        let wrong = |this: &Self| Err(format!("expected {}", this.describe(this.expect)));
+        self.expect = match self.expect {
+            Expect::Solid if is(0, "solid") => Expect::Facet,
+            Expect::Facet if is(0, "endsolid") => Expect::Solid,
+            Expect::Facet if is(0, "facet") && is(1, "normal") && tokens.len() == 5 => {
+                for token in &tokens[2..] {
+                    self.number("normal", token)?;
+                }
+                Expect::OuterLoop
+            }
+            Expect::OuterLoop if is(0, "outer") && is(1, "loop") && tokens.len() == 2 => {
+                Expect::Vertex(0)
+            }
+            Expect::Vertex(k) if is(0, "vertex") && tokens.len() == 4 => {
+                let mut p = [0f32; 3];
+                for (c, token) in p.iter_mut().zip(&tokens[1..]) {
+                    *c = self.number(&format!("corner {k}"), token)?;
+                }
+                if p.iter().any(|c| !c.is_finite()) {
+                    return Err(format!(
+                        "triangle {}: corner {k} has a NaN or infinite coordinate (in single \
+                         precision)",
+                        self.triangles.len()
+                    ));
+                }
+                self.corners[k] = stl_io::Vertex::new(p);
+                if k < 2 {
+                    Expect::Vertex(k + 1)
+                } else {
+                    Expect::EndLoop
+                }
+            }
+            Expect::EndLoop if is(0, "endloop") && tokens.len() == 1 => Expect::EndFacet,
+            Expect::EndFacet if is(0, "endfacet") && tokens.len() == 1 => {
+                self.triangles.push(stl_io::Triangle {
+                    normal: stl_io::Normal::new([0.0; 3]),
+                    vertices: self.corners,
+                });
+                Expect::Facet
+            }
+            _ => return wrong(self),
+        };
+        Ok(())
+    }
+
+    fn number(&self, what: &str, token: &str) -> std::result::Result<f32, String> {
+        token.parse().map_err(|_| {
+            format!(
+                "triangle {}: {what}: `{}` is not a number",
+                self.triangles.len(),
+                excerpt(token)
+            )
+        })
+    }
 }
 
 /// The triangles of one binary file or one ASCII solid; `first` numbers them in messages.

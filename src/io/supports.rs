@@ -47,7 +47,7 @@ pub fn parse_supports(text: &str, path_label: &str) -> Result<Vec<u32>> {
         };
         err(
             e.line().max(1),
-            format!("{what}: {message} (column {})", e.column()),
+            format!("{what}: {} (column {})", short_quotes(message), e.column()),
         )
     };
     let value: serde_json::Value =
@@ -72,6 +72,23 @@ pub fn parse_supports(text: &str, path_label: &str) -> Result<Vec<u32>> {
             ),
         )),
     }
+}
+
+/// `message` with every quoted part (serde_json quotes the bad value in full, which may be
+/// megabytes) cut to an excerpt.
+fn short_quotes(message: &str) -> String {
+    let mut out = String::new();
+    for (k, part) in message.split('"').enumerate() {
+        if k > 0 {
+            out.push('"');
+        }
+        if k % 2 == 1 {
+            out.push_str(&super::excerpt(part));
+        } else {
+            out.push_str(part);
+        }
+    }
+    out
 }
 
 fn json_kind(value: &serde_json::Value) -> &'static str {

@@ -131,6 +131,16 @@ fn malformed_lines_report_their_line_number() {
         ),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2.5 3\n", 4, "`2.5`"),
         (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2\n",
+            4,
+            "face lists vertex 2 twice",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3 -3\n",
+            5,
+            "face lists vertex 2 twice",
+        ),
+        (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n",
             4,
             "relative vertex index -4",
@@ -218,6 +228,69 @@ fn write_failures_leave_nothing() {
     assert_eq!(fs::read_dir(&dir.0).unwrap().count(), 0);
 }
 
+/// Issue 48: a write replaced whatever its path named. Links are written through (the link
+/// kept, the file it names replaced); devices, FIFOs and folders are refused untouched.
+#[cfg(unix)]
+#[test]
+fn writes_go_through_links_and_never_replace_special_files() {
+    use std::os::unix::fs::{symlink, FileTypeExt};
+    let dir = TempDir::new("targets");
+    let triangle = ([[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0u32, 1, 2]]);
+    let write = |path: &std::path::Path| write_obj(path, &triangle.0, &triangle.1);
+    let real = dir.0.join("real.obj");
+    fs::write(&real, "old").unwrap();
+    symlink("real.obj", dir.0.join("link.obj")).unwrap();
+    symlink(dir.0.join("link.obj"), dir.0.join("chain.obj")).unwrap();
+    write(&dir.0.join("chain.obj")).unwrap();
+    assert!(fs::symlink_metadata(dir.0.join("link.obj"))
+        .unwrap()
+        .is_symlink());
+    assert!(fs::symlink_metadata(dir.0.join("chain.obj"))
+        .unwrap()
+        .is_symlink());
+    assert_eq!(read_obj(&real).unwrap().1, vec![[0, 1, 2]]);
+    // A dangling link gets its file.
+    symlink("made.obj", dir.0.join("dangling.obj")).unwrap();
+    write(&dir.0.join("dangling.obj")).unwrap();
+    assert!(dir.0.join("made.obj").is_file());
+    // A loop of links is an error, not a hang.
+    symlink("loop-b.obj", dir.0.join("loop-a.obj")).unwrap();
+    symlink("loop-a.obj", dir.0.join("loop-b.obj")).unwrap();
+    let err = write(&dir.0.join("loop-a.obj")).unwrap_err().to_string();
+    assert!(err.contains("symbolic links in a row"), "{err}");
+
+    let fifo = dir.0.join("pipe.obj");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.unwrap().success(), "mkfifo {}", fifo.display());
+    symlink("pipe.obj", dir.0.join("to-pipe.obj")).unwrap();
+    fs::create_dir(dir.0.join("folder.obj")).unwrap();
+    let before = fs::read_dir(&dir.0).unwrap().count();
+    let cases = [
+        (fifo.clone(), "is a FIFO (named pipe), not a regular file"),
+        (dir.0.join("to-pipe.obj"), "is a FIFO"),
+        (dir.0.join("folder.obj"), "is a folder"),
+        ("/dev/null".into(), "is a character device"),
+        ("/dev/full".into(), "is a character device"),
+    ];
+    for (path, needle) in cases {
+        if !path.starts_with(&dir.0) && !path.exists() {
+            continue;
+        }
+        let err = write(&path).unwrap_err();
+        assert!(
+            matches!(&err, Error::Io { path: p, .. } if *p == path.display().to_string()),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains(needle), "{err}");
+    }
+    assert!(fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    assert_eq!(fs::read_dir(&dir.0).unwrap().count(), before);
+}
+
 #[test]
 fn unreadable_files_are_io_errors() {
     let dir = TempDir::new("missing");
@@ -256,6 +329,18 @@ fn malformed_supports_report_line_and_reason() {
         ("{\n \"anchored\": [1, 2\n", 3, "invalid JSON"),
         ("", 1, "invalid JSON"),
     ];
+    // A long bad value is quoted by an excerpt, not in full.
+    let long = format!("[\"{}\"]", "x".repeat(100_000));
+    match parse_supports(&long, "s.json") {
+        Err(Error::Parse { reason, .. }) => {
+            assert!(reason.len() < 200, "{} bytes", reason.len());
+            assert!(
+                reason.contains(&format!("\"{}…\"", "x".repeat(40))),
+                "{reason}"
+            );
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
     for &(text, line, needle) in cases {
         match parse_supports(text, "s.json") {
             Err(Error::Parse {

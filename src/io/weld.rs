@@ -66,7 +66,7 @@ impl Welded {
 /// beyond the tolerance. Faces whose corners merge are dropped and listed.
 ///
 /// Errors: a negative or non-finite tolerance, a non-finite coordinate, a face index out of
-/// range ([`Error::InvalidArgument`]).
+/// range, faces that all collapse (nothing would be left) ([`Error::InvalidArgument`]).
 pub fn weld(positions: &[[f64; 3]], faces: &[[u32; 3]], relative_tolerance: f64) -> Result<Welded> {
     if !(relative_tolerance.is_finite() && relative_tolerance >= 0.0) {
         return Err(Error::InvalidArgument {
@@ -97,6 +97,17 @@ pub fn weld(positions: &[[f64; 3]], faces: &[[u32; 3]], relative_tolerance: f64)
         } else {
             new_faces.push([a, b, c]);
         }
+    }
+    if new_faces.is_empty() && !faces.is_empty() {
+        return Err(Error::InvalidArgument {
+            name: "weld tolerance",
+            reason: format!(
+                "welding within {tolerance:.4e} ({relative_tolerance:e} x the bounding-box \
+                 diagonal) merges two corners of every face ({} in all), so no face is left: \
+                 give a smaller weld tolerance",
+                faces.len()
+            ),
+        });
     }
     Ok(Welded {
         merged: positions.len() - n_welded,

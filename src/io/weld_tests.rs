@@ -161,3 +161,24 @@ fn faces_whose_corners_merge_are_dropped_and_listed() {
     assert_eq!(welded.collapsed_faces, vec![1]);
     assert_eq!(welded.positions[1], [1.0, 0.0, 0.0]);
 }
+
+/// Issue 48: welding that collapsed every face left an "empty mesh", which named the wrong
+/// cause.
+#[test]
+fn welding_every_face_away_names_the_tolerance() {
+    let positions = vec![
+        [0.0; 3],
+        [1e-12, 0.0, 0.0],
+        [0.0, 1e-12, 0.0],
+        [1e3, 1e3, 0.0],
+    ];
+    let err = weld(&positions, &[[0, 1, 2]], 1e-9).unwrap_err();
+    assert!(
+        matches!(&err, Error::InvalidArgument { name: "weld tolerance", reason }
+            if reason.contains("every face (1 in all)")),
+        "{err}"
+    );
+    // Exact welding keeps the face; no faces at all are left for the mesh to call empty.
+    assert_eq!(weld(&positions, &[[0, 1, 2]], 0.0).unwrap().faces.len(), 1);
+    assert!(weld(&positions, &[], 1e-9).unwrap().faces.is_empty());
+}

@@ -5,7 +5,7 @@
 //! triangle valid without spoiling its neighbours. Larger inverted triangles (a real fold or
 //! overhang) are left for [`crate::Mesh::new`] to reject.
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 use crate::{Error, Result};
 
@@ -103,31 +103,66 @@ pub fn repair_plan(
         return Ok(Vec::new());
     }
     let mut plan = Plan::new(positions, faces, anchored, relative_tolerance);
+    // Faces that may be bad, the lowest first: every face a repair changes is queued again,
+    // so the lowest bad face is found without scanning them all (a long polygon's fan has
+    // many slivers, and a scan per repair was quadratic).
+    let mut queue: BTreeSet<usize> = (0..faces.len())
+        .filter(|&t| plan.is_bad(positions, faces, t))
+        .collect();
     let mut repairs = Vec::new();
     // Each repair mends a face for good or moves on; the bound only guards against cycles.
-    for _ in 0..4 * faces.len().max(1) {
-        let bad = |t: &usize| plan.is_bad(positions, faces, *t) && !plan.given_up[*t];
-        let Some(t) = (0..faces.len()).find(bad) else {
+    let mut budget = 4 * faces.len().max(1);
+    while budget > 0 {
+        let Some(t) = queue.pop_first() else {
             break;
         };
-        match plan.flip(positions, faces, t) {
-            Some(r) => repairs.push(r),
-            None => match plan.nudge(positions, faces, t) {
-                Some(r) => repairs.push(r),
-                None => plan.given_up[t] = true,
-            },
+        if plan.given_up[t] || !plan.is_bad(positions, faces, t) {
+            continue;
         }
+        budget -= 1;
+        let changed = match plan.flip(positions, faces, t) {
+            Some(r) => {
+                let PlanRepair::Flip { faces: [t, u], .. } = r else {
+                    unreachable!("a flip")
+                };
+                repairs.push(r);
+                vec![t, u]
+            }
+            None => match plan.nudge(positions, faces, t) {
+                Some(r) => {
+                    let PlanRepair::Nudge { vertex, .. } = r else {
+                        unreachable!("a nudge")
+                    };
+                    repairs.push(r);
+                    plan.faces_at[vertex as usize].clone()
+                }
+                None => {
+                    plan.given_up[t] = true;
+                    Vec::new()
+                }
+            },
+        };
+        queue.extend(
+            changed
+                .into_iter()
+                .filter(|&u| plan.is_bad(positions, faces, u)),
+        );
     }
     Ok(repairs)
 }
 
-/// The state of a repair: orientation, threshold, supports and edge adjacency.
+/// The state of a repair: orientation, threshold, supports and adjacency (kept up to date
+/// through flips).
 struct Plan {
     /// +1 when most faces are counter-clockwise in plan, else -1.
     sign: f64,
     threshold: f64,
     anchored: Vec<bool>,
     given_up: Vec<bool>,
+    /// The faces at each edge (sorted vertex pair).
+    edges: HashMap<(u32, u32), Vec<usize>>,
+    /// The faces at each vertex.
+    faces_at: Vec<Vec<usize>>,
 }
 
 fn signed_area(positions: &[[f64; 3]], f: &[u32; 3]) -> f64 {
@@ -159,11 +194,41 @@ impl Plan {
         for &v in anchored.iter().filter(|&&v| (v as usize) < n) {
             flags[v as usize] = true;
         }
-        Plan {
+        let mut plan = Plan {
             sign,
             threshold: tol * median,
             anchored: flags,
             given_up: vec![false; faces.len()],
+            edges: HashMap::new(),
+            faces_at: vec![Vec::new(); n],
+        };
+        for (t, f) in faces.iter().enumerate() {
+            plan.attach(t, f);
+        }
+        plan
+    }
+
+    /// Records face `t` with vertices `f` in the adjacency.
+    fn attach(&mut self, t: usize, f: &[u32; 3]) {
+        for k in 0..3 {
+            let list = self.edges.entry(key(f[k], f[(k + 1) % 3])).or_default();
+            list.push(t);
+            list.sort_unstable();
+            self.faces_at[f[k] as usize].push(t);
+        }
+    }
+
+    /// Removes face `t` with vertices `f` from the adjacency.
+    fn detach(&mut self, t: usize, f: &[u32; 3]) {
+        for k in 0..3 {
+            let e = key(f[k], f[(k + 1) % 3]);
+            if let Some(list) = self.edges.get_mut(&e) {
+                list.retain(|&u| u != t);
+                if list.is_empty() {
+                    self.edges.remove(&e);
+                }
+            }
+            self.faces_at[f[k] as usize].retain(|&u| u != t);
         }
     }
 
@@ -183,12 +248,7 @@ impl Plan {
         faces: &mut [[u32; 3]],
         t: usize,
     ) -> Option<PlanRepair> {
-        let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-        for (u, f) in faces.iter().enumerate() {
-            for k in 0..3 {
-                edges.entry(key(f[k], f[(k + 1) % 3])).or_default().push(u);
-            }
-        }
+        let edges = &self.edges;
         let mut best: Option<(f64, usize, FlipFaces)> = None;
         for k in 0..3 {
             let f = faces[t];
@@ -218,8 +278,13 @@ impl Plan {
             }
         }
         let (_, u, ([new_t, new_u], [removed, added])) = best?;
+        let (old_t, old_u) = (faces[t], faces[u]);
+        self.detach(t, &old_t);
+        self.detach(u, &old_u);
         faces[t] = new_t;
         faces[u] = new_u;
+        self.attach(t, &new_t);
+        self.attach(u, &new_u);
         Some(PlanRepair::Flip {
             faces: [t, u],
             removed,
@@ -259,8 +324,8 @@ impl Plan {
                 continue;
             }
             // A valid face at v must stay valid; a bad one must not get worse.
-            let incident: Vec<usize> = (0..faces.len())
-                .filter(|&u| u != t && faces[u].contains(&v))
+            let incident: Vec<usize> = (self.faces_at[v as usize].iter().copied())
+                .filter(|&u| u != t)
                 .collect();
             let before: Vec<f64> = incident
                 .iter()

@@ -206,22 +206,25 @@ impl ShapeStep {
         k: usize,
         schedule: &Schedule,
     ) -> Result<Vec<f64>> {
-        let normal = self.normal_equations(q, p, z, None);
-        let r_inf = normal.r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let mu = (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * normal.scale;
-        let nu = schedule.pull * normal.scale;
-        let pull: Vec<(f64, f64)> = (normal.r.iter().zip(&self.vertices))
-            .map(|(ri, &v)| {
-                let lambda = if r_inf > 0.0 {
-                    r_inf / (ri.abs() + schedule.eta * r_inf)
-                } else {
-                    1.0
-                };
-                let v = v as usize;
-                (mu * lambda + nu, mu * lambda * z[v] + nu * z0[v])
-            })
-            .collect();
-        self.solve(normal, &pull, None, z)
+        self.relative(z, z0, |z, z0| {
+            let normal = self.normal_equations(q, p, z, None);
+            let r_inf = normal.r.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            let mu =
+                (schedule.mu0 * schedule.beta.powi(k as i32)).max(schedule.mu_min) * normal.scale;
+            let nu = schedule.pull * normal.scale;
+            let pull: Vec<(f64, f64)> = (normal.r.iter().zip(&self.vertices))
+                .map(|(ri, &v)| {
+                    let lambda = if r_inf > 0.0 {
+                        r_inf / (ri.abs() + schedule.eta * r_inf)
+                    } else {
+                        1.0
+                    };
+                    let v = v as usize;
+                    (mu * lambda + nu, mu * lambda * z[v] + nu * z0[v])
+                })
+                .collect();
+            self.solve(normal, &pull, None, z)
+        })
     }
 
     /// The heights minimising ‖K z − b‖² + ρ Σ_i a_i (z_i − z⁰_i)² + ρ γ Σ_e c_e (Δ_i − Δ_j)²
@@ -240,12 +243,49 @@ impl ShapeStep {
         fair: Option<(f64, &[f64])>,
         jacobian: Option<&LoadJacobian>,
     ) -> Result<Vec<f64>> {
-        let normal = self.normal_equations(q, p, z, jacobian);
-        let pull: Vec<(f64, f64)> = (area.iter().zip(&self.vertices))
-            .map(|(&a, &v)| (rho * a, rho * a * z0[v as usize]))
-            .collect();
-        let fair = fair.map(|(gamma, c)| (rho * gamma, c, z0));
-        self.solve(normal, &pull, fair, z)
+        self.relative(z, z0, |z, z0| {
+            let normal = self.normal_equations(q, p, z, jacobian);
+            let pull: Vec<(f64, f64)> = (area.iter().zip(&self.vertices))
+                .map(|(&a, &v)| (rho * a, rho * a * z0[v as usize]))
+                .collect();
+            let fair = fair.map(|(gamma, c)| (rho * gamma, c, z0));
+            self.solve(normal, &pull, fair, z)
+        })
+    }
+
+    /// `step` run on heights relative to the supports' mean height (that of the anchored
+    /// vertices next to free ones, or the free vertices' mean without any) where that lies far
+    /// from the heights (`crate::geometry::far_base`): the height systems only see differences
+    /// (K's rows sum to 0 with their anchored terms, and the pulls are towards heights shifted
+    /// alike), so their answer is the same up to the shift, but solved for heights near 0 it
+    /// keeps its digits where a whole model lifted by 10⁷ lost seven of them and stalled.
+    /// Anchored heights are copied unchanged.
+    fn relative(
+        &self,
+        z: &[f64],
+        z0: &[f64],
+        step: impl FnOnce(&[f64], &[f64]) -> Result<Vec<f64>>,
+    ) -> Result<Vec<f64>> {
+        let height = |v: &u32| z[*v as usize];
+        let free: Vec<f64> = self.vertices.iter().map(height).collect();
+        let mut supports: Vec<f64> = self.k.anchored.iter().map(|(_, _, c)| height(c)).collect();
+        let reference = if supports.is_empty() {
+            &free
+        } else {
+            &supports
+        };
+        let base = crate::geometry::far_base(reference, &[&free[..], &supports[..]].concat());
+        if base == 0.0 {
+            return step(z, z0);
+        }
+        supports.clear();
+        let shift = |h: &[f64]| h.iter().map(|h| h - base).collect::<Vec<f64>>();
+        let relative = step(&shift(z), &shift(z0))?;
+        let mut out = z.to_vec();
+        for &v in &self.vertices {
+            out[v as usize] = relative[v as usize] + base;
+        }
+        Ok(out)
     }
 
     /// K's values, b, the residual r = K z − b, KᵀK on the fixed pattern and Kᵀb; with the

@@ -102,19 +102,31 @@ const MIN_OFFSET_AREA: f64 = 1e-2;
 /// along area-weighted vertex normals, with walls along every boundary loop.
 ///
 /// Errors ([`Error::InvalidArgument`]): `positions` of another length than the mesh's
-/// vertices or not finite; a thickness that is not finite and > 0 (naming the face); a
+/// vertices or not finite; a thickness that is not finite and > 0 (naming the face), or below
+/// 1e-12 times the shell's size (the larger of its bounding-box diagonal and its largest
+/// coordinate: the two surfaces would not differ in double precision), naming the least
+/// thickness; a
 /// vertex whose faces' normals cancel, or whose offset direction points away from one of its
 /// faces (a fold no direction clears, where no thickness fits), naming it; a thickness so
 /// large that the layer between a face and its offset folds over (the offset face turns
 /// over or keeps less than 1 % of its area), which would make the solid intersect itself:
 /// the message names the face that allows the least thickness, its vertices and that
-/// thickness; then any other crossing of the solid with itself (parts of the shell far apart
+/// thickness; a thickness above 1e12 times the shell's size, naming the largest; then any
+/// other crossing of the solid with itself (parts of the shell far apart
 /// along the surface but near in space), naming the two parts that cross.
 pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Result<Solid> {
     check_positions(mesh, positions)?;
     let face_thickness = face_thickness(mesh, thickness)?;
-    let (normals, vertex_thickness) =
-        vertex_normals_and_thickness(mesh, positions, &face_thickness)?;
+    let size = shell_size(mesh, positions);
+    check_range(&face_thickness, size, Range::Below)?;
+    let thickest = face_thickness.iter().copied().fold(0.0, f64::max);
+    // Offsets per unit of the thickest face's thickness, so that no product overflows.
+    let (normals, relative) =
+        vertex_normals_and_thickness(mesh, positions, &face_thickness, thickest)?;
+    let unit_offset = |v: usize, side: f64| normals[v].map(|c| side * relative[v] / 2.0 * c);
+    check_no_flips(mesh, positions, &face_thickness, thickest, &unit_offset)?;
+    check_range(&face_thickness, size, Range::Above)?;
+    let vertex_thickness: Vec<f64> = relative.iter().map(|r| r * thickest).collect();
     let referenced: Vec<usize> = (0..mesh.n_vertices())
         .filter(|&v| mesh.referenced[v])
         .collect();
@@ -127,7 +139,6 @@ pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Re
         let (p, n) = (positions[v], normals[v]);
         [p[0] + h * n[0], p[1] + h * n[1], p[2] + h * n[2]]
     };
-    check_no_flips(mesh, positions, &face_thickness, &|v, side| offset(v, side))?;
     let n = referenced.len() as u32;
     let mut out_positions: Vec<[f64; 3]> = referenced.iter().map(|&v| offset(v, 1.0)).collect();
     out_positions.extend(referenced.iter().map(|&v| offset(v, -1.0)));
@@ -148,7 +159,6 @@ pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Re
         faces.push([b, a + n, b + n]);
     }
     if let Some(pair) = crossing::first_crossing(&out_positions, &faces) {
-        let thickest = face_thickness.iter().copied().fold(0.0, f64::max);
         return Err(crossing_error(mesh, &walls, pair, thickest));
     }
     Ok(Solid {
@@ -178,6 +188,64 @@ fn crossing_error(mesh: &Mesh, walls: &[[u32; 2]], (s, t): (usize, usize), thick
             part(t)
         ),
     }
+}
+
+/// The thickness range a solid can be made in, relative to the shell's size: below it, the
+/// upper and lower surfaces cannot be told apart in double precision; above it, the solid's
+/// coordinates lose the precision its crossing test needs.
+const THICKNESS_RANGE: (f64, f64) = (1e-12, 1e12);
+
+/// The side of [`THICKNESS_RANGE`] a check looks at.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Range {
+    Below,
+    Above,
+}
+
+/// The size the thickness is measured against: the larger of the bounding-box diagonal of the
+/// referenced vertices and their largest coordinate (whose precision the offsets share).
+fn shell_size(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
+    let (mut lo, mut hi, mut largest) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3], 0.0f64);
+    for v in (0..mesh.n_vertices()).filter(|&v| mesh.referenced[v]) {
+        for k in 0..3 {
+            let c = positions[v][k];
+            (lo[k], hi[k], largest) = (lo[k].min(c), hi[k].max(c), largest.max(c.abs()));
+        }
+    }
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    diagonal.max(largest)
+}
+
+/// Refuses the first face whose thickness lies on `side` of [`THICKNESS_RANGE`] × `size`,
+/// naming the limit.
+fn check_range(face_thickness: &[f64], size: f64, side: Range) -> Result<()> {
+    let (least, most) = (THICKNESS_RANGE.0 * size, THICKNESS_RANGE.1 * size);
+    let out = |t: f64| match side {
+        Range::Below => t < least,
+        Range::Above => t > most,
+    };
+    let Some(f) = face_thickness.iter().position(|&t| out(t)) else {
+        return Ok(());
+    };
+    let t = face_thickness[f];
+    let reason = match side {
+        Range::Below => format!(
+            "{t:.4e} at face {f} is too small for a solid: below {:e} of the shell's size \
+             ({size:.4e}), its upper and lower surfaces cannot be told apart in double \
+             precision; give at least {least:.4e}",
+            THICKNESS_RANGE.0
+        ),
+        Range::Above => format!(
+            "{t:.4e} at face {f} is too large for a solid: beyond {:e} times the shell's size \
+             ({size:.4e}), its coordinates lose the precision the check for self-intersection \
+             needs; give at most {most:.4e}",
+            THICKNESS_RANGE.1
+        ),
+    };
+    Err(Error::InvalidArgument {
+        name: "thickness",
+        reason,
+    })
 }
 
 fn check_positions(mesh: &Mesh, positions: &[[f64; 3]]) -> Result<()> {
@@ -229,11 +297,13 @@ fn face_thickness(mesh: &Mesh, thickness: &Thickness) -> Result<Vec<f64>> {
 }
 
 /// Unit offset direction and offset distance per vertex (zero for vertices no face refers
-/// to).
+/// to), the distance in units of `unit` (the thickest face's thickness, so that the weighted
+/// sums cannot overflow).
 fn vertex_normals_and_thickness(
     mesh: &Mesh,
     positions: &[[f64; 3]],
     face_thickness: &[f64],
+    unit: f64,
 ) -> Result<(Vec<[f64; 3]>, Vec<f64>)> {
     let nv = mesh.n_vertices();
     let face_normals: Vec<[f64; 3]> = mesh
@@ -247,7 +317,7 @@ fn vertex_normals_and_thickness(
         for &v in face {
             let v = v as usize;
             normals[v] = add(normals[v], face_normals[f]);
-            weighted[v] += a * face_thickness[f];
+            weighted[v] += a * (face_thickness[f] / unit);
             area[v] += a;
         }
     }
@@ -329,11 +399,16 @@ fn widen_sharp_normals(mesh: &Mesh, face_normals: &[[f64; 3]], normals: &mut [[f
 /// initial extent (the Jacobian of the sweep is linear across the face, so its corners
 /// decide). Of the faces that fold, names the one that allows the least thickness, with its
 /// vertices and that thickness.
+///
+/// `unit_offset(v, side)` is vertex `v`'s offset towards `side` (±1) per unit of `unit` (the
+/// thickest face's thickness): the sweep is followed in those units, so that neither a tiny
+/// thickness (lost in `p + offset - p`) nor a huge one (overflowing the products) spoils it.
 fn check_no_flips(
     mesh: &Mesh,
     positions: &[[f64; 3]],
     face_thickness: &[f64],
-    offset: &dyn Fn(usize, f64) -> [f64; 3],
+    unit: f64,
+    unit_offset: &dyn Fn(usize, f64) -> [f64; 3],
 ) -> Result<()> {
     // (thickness that fits, face, side) of the tightest face that folds.
     let mut tightest: Option<(f64, usize, &str)> = None;
@@ -341,9 +416,11 @@ fn check_no_flips(
         let p = face.map(|v| positions[v as usize]);
         let (e1, e2) = (sub(p[1], p[0]), sub(p[2], p[0]));
         for (side, name) in [(1.0, "upper"), (-1.0, "lower")] {
-            let d = [0, 1, 2].map(|k| sub(offset(face[k] as usize, side), p[k]));
+            let d = [0, 1, 2].map(|k| unit_offset(face[k] as usize, side));
             let (de1, de2) = (sub(d[1], d[0]), sub(d[2], d[0]));
-            let limits = d.map(|dk| sweep_limit([e1, e2], [de1, de2], dk.map(|c| side * c)));
+            let limits = d.map(|dk| {
+                sweep_limit([e1, e2], [de1, de2], dk.map(|c| side * c), unit).map(|u| u / unit)
+            });
             if let Some(k) = (0..3).find(|&k| limits[k] == Some(0.0)) {
                 return Err(Error::InvalidArgument {
                     name: "positions",
@@ -377,10 +454,10 @@ fn check_no_flips(
     })
 }
 
-/// The smallest `s` in [0, 1] at which the face with edges `e + s de` keeps less than
+/// The smallest `s` in [0, `most`] at which the face with edges `e + s de` keeps less than
 /// [`MIN_OFFSET_AREA`] of its initial extent along `n`: `q(s) = ((e1 + s de1) × (e2 + s de2))
 /// · n` is quadratic in `s`. `None` when it never does.
-fn sweep_limit(e: [[f64; 3]; 2], de: [[f64; 3]; 2], n: [f64; 3]) -> Option<f64> {
+fn sweep_limit(e: [[f64; 3]; 2], de: [[f64; 3]; 2], n: [f64; 3], most: f64) -> Option<f64> {
     let c0 = dot(cross(e[0], e[1]), n);
     if c0 <= 0.0 {
         return Some(0.0);
@@ -388,7 +465,8 @@ fn sweep_limit(e: [[f64; 3]; 2], de: [[f64; 3]; 2], n: [f64; 3]) -> Option<f64> 
     let c1 = dot(add(cross(e[0], de[1]), cross(de[0], e[1])), n);
     let c2 = dot(cross(de[0], de[1]), n);
     let a0 = c0 * (1.0 - MIN_OFFSET_AREA);
-    let roots: Vec<f64> = if c2.abs() <= 1e-12 * (c0.abs() + c1.abs()) {
+    // The quadratic term is negligible over [0, most] (compared without squaring `most`).
+    let roots: Vec<f64> = if c2.abs() * most <= 1e-12 * (c0.abs() / most + c1.abs()) {
         vec![-a0 / c1]
     } else {
         let disc = c1 * c1 - 4.0 * c2 * a0;
@@ -398,10 +476,10 @@ fn sweep_limit(e: [[f64; 3]; 2], de: [[f64; 3]; 2], n: [f64; 3]) -> Option<f64> 
         let r = disc.sqrt();
         vec![(-c1 - r) / (2.0 * c2), (-c1 + r) / (2.0 * c2)]
     };
-    // q(0) > 0, so the first root in [0, 1] is where the face first gets too thin.
+    // q(0) > 0, so the first root in [0, most] is where the face first gets too thin.
     roots
         .into_iter()
-        .filter(|s| s.is_finite() && (0.0..=1.0).contains(s))
+        .filter(|s| s.is_finite() && (0.0..=most).contains(s))
         .reduce(f64::min)
 }
 

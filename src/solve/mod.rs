@@ -199,8 +199,9 @@ pub struct FormFindResult {
     /// ε∞ after each stress step, plus certificates of height steps: the paper's loop adds a
     /// last entry when its last height step was certified with the previous forces; the
     /// nearest method adds one for every height step that reached equilibrium. The returned
-    /// `stress` is the state of one of these entries (the nearest method's: the nearest state
-    /// in equilibrium, not necessarily the last). A stress step that stopped short of its
+    /// `stress` is the state of one of these entries: the lowest-ε∞ one, also for a run stopped
+    /// by `max_iterations` or a cancelling callback, unless the loop converged (the nearest
+    /// method's answer is then the nearest state in equilibrium, not necessarily the last). A stress step that stopped short of its
     /// optimum and did worse than the forces at hand is not taken: its entry is theirs.
     pub history: Vec<f64>,
     /// Stress steps taken.
@@ -377,11 +378,11 @@ fn infeasibility_hint(mesh: &crate::mesh::Mesh, s: &StressSettings) -> String {
         parts.push(if free_edges {
             "q_min (a straight free edge cannot carry q_min > 0 without τ; nor can every edge \
              of a ring of quads all split along the same diagonal, as in a latitude-longitude \
-             dome, unless the diagonals are marked: Problem::with_polygon_diagonals)"
+             dome, unless the quads are read as polygons, whose diagonals q_min does not bind)"
         } else {
             "q_min (not every edge of a ring of quads all split along the same diagonal, as in \
-             a latitude-longitude dome, can carry q_min > 0 unless the diagonals are marked: \
-             Problem::with_polygon_diagonals)"
+             a latitude-longitude dome, can carry q_min > 0 unless the quads are read as \
+             polygons, whose diagonals q_min does not bind)"
         });
     }
     if s.q_max.is_some() {

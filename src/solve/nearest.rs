@@ -14,6 +14,7 @@
 //! the nearest stress step's state in equilibrium (ε∞ < tolerance, certified by recomputed
 //! residuals), taken once a further one is no nearer.
 
+use super::paper::{paper_within, HeightLimit};
 use super::{
     area_shares, blocking_vertices, finish, infeasibility_hint, FormFindResult, FormFindSettings,
     Progress, Run, Termination, FAR_FROM_BALANCE,
@@ -48,6 +49,8 @@ const RESIDUAL_FACTOR: f64 = 0.5;
 /// A state in equilibrium that is no nearer than the nearest one before it by this fraction
 /// of E ends the search.
 const SETTLED: f64 = 1e-3;
+/// What blocks a loop whose heights reached the limit, where q_max does not.
+const LIMIT_HINT: &str = "the shape cannot stand within the height limit (raise max_height_change)";
 /// Stalling is judged only once w has grown by this factor from its start: before, the pull
 /// to the input may hold ε∞ up on purpose (rounds that still lower L also count as progress).
 const STALL_AFTER_GROWTH: f64 = 1e3;
@@ -228,10 +231,14 @@ impl<'a, 'p> Nearest<'a, 'p> {
             let prior = self.held.clone();
             let answer = self.stress_step(Some(&prior))?;
             self.held = answer;
-            if let Some(t) = self.after_stress_step() {
+            // Recorded before anything ends the loop, so that a run stopped here (budget,
+            // callback) answers the best state of its whole history.
+            let ended = self.after_stress_step();
+            let settled = self.record();
+            if let Some(t) = ended {
                 return Ok(t);
             }
-            if self.record() {
+            if settled {
                 return Ok(Termination::Converged);
             }
             stage_rounds += 1;
@@ -264,8 +271,9 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// Where the nearest method found no state in equilibrium (height steps whose lagged loads
     /// do not settle, as on nearly vertical strips), the paper's loop from the best state
     /// reached, with the rest of the iteration budget: its proximal steps damp what the
-    /// nearest method's exact ones cannot. Its answer replaces the best state if it balances
-    /// better.
+    /// nearest method's exact ones cannot. Its height steps are held within the height limit
+    /// of the input (a loop that held some back and did not converge is `Blocked` there), and
+    /// its answer replaces the best state if it balances better.
     fn polish(&mut self) -> Result<Termination> {
         let remaining = self.settings.max_iterations.saturating_sub(self.iterations);
         if remaining == 0 || !self.best.eps.is_finite() {
@@ -280,18 +288,35 @@ impl<'a, 'p> Nearest<'a, 'p> {
             ..self.settings.clone()
         };
         let offset = self.iterations;
+        let mut limit = HeightLimit {
+            z0: &self.z0,
+            limit: self.limit,
+            held: Vec::new(),
+        };
         let r = match self.progress.as_mut() {
             Some(cb) => {
                 let mut shifted = |k: usize, eps: f64| cb(k + offset, eps);
-                super::paper::paper(&start, &settings, Some(&mut shifted))?
+                paper_within(&start, &settings, Some(&mut shifted), Some(&mut limit))?
             }
-            None => super::paper::paper(&start, &settings, None)?,
+            None => paper_within(&start, &settings, None, Some(&mut limit))?,
         };
         self.iterations += r.iterations;
         self.solvers.extend(&r.solvers);
         self.history.extend(&r.history);
         self.stress_seconds += r.stress_seconds;
         self.shape_seconds += r.shape_seconds;
+        // A loop that did not converge with heights held back at the limit was blocked there.
+        let mut held = limit.held;
+        held.sort_unstable();
+        let termination = match r.termination {
+            Termination::MaxIterations | Termination::Stalled { .. } if !held.is_empty() => {
+                Termination::Blocked {
+                    vertices: held,
+                    hint: LIMIT_HINT.into(),
+                }
+            }
+            t => t,
+        };
         if r.stress.eps_inf < self.best.eps {
             self.best = Best {
                 eps: r.stress.eps_inf,
@@ -300,7 +325,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 stress: r.stress,
             };
         }
-        Ok(r.termination)
+        Ok(termination)
     }
 
     /// Records a height step's state (the held forces certified at new heights) as a state in
@@ -677,7 +702,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let at_limit = self.at_limit();
         if !at_limit.is_empty() {
             let hint = if capped.is_empty() {
-                "the shape cannot stand within the height limit (raise max_height_change)".into()
+                LIMIT_HINT.into()
             } else {
                 format!("{q_max}, so standing needs heights beyond the limit (raise q_max)")
             };

@@ -15,12 +15,50 @@ use crate::stress::{
 use std::borrow::Cow;
 use std::time::Instant;
 
+/// A bound on every height's change from reference heights: the nearest method's
+/// `max_height_change`, which the paper's loop holds when it continues from the nearest
+/// method's best state (`Nearest::polish`).
+pub(super) struct HeightLimit<'a> {
+    /// The reference heights, per vertex.
+    pub(super) z0: &'a [f64],
+    /// The largest change allowed, physical.
+    pub(super) limit: f64,
+    /// The vertices a height step was brought back at so far.
+    pub(super) held: Vec<u32>,
+}
+
+/// Sets the heights of `positions` to `z`, each brought back within `limit` of its reference
+/// where one is given (and recorded there).
+fn set_heights(positions: &mut [[f64; 3]], z: Vec<f64>, mut limit: Option<&mut HeightLimit>) {
+    for (v, (p, z)) in positions.iter_mut().zip(z).enumerate() {
+        p[2] = match limit.as_deref_mut() {
+            Some(l) if (z - l.z0[v]).abs() > l.limit => {
+                if !l.held.contains(&(v as u32)) {
+                    l.held.push(v as u32);
+                }
+                l.z0[v] + l.limit.copysign(z - l.z0[v])
+            }
+            _ => z,
+        };
+    }
+}
+
 /// The paper's loop: stress step, then a height step pulled towards the current heights with
 /// inverse-residual weights and a geometric schedule, repeated until ε∞ < tolerance.
 pub(super) fn paper(
     problem: &Problem,
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
+) -> Result<FormFindResult> {
+    paper_within(problem, settings, progress, None)
+}
+
+/// The paper's loop with every height step brought back within `limit` (None: unbounded).
+pub(super) fn paper_within(
+    problem: &Problem,
+    settings: &FormFindSettings,
+    progress: Option<&mut Progress>,
+    mut limit: Option<&mut HeightLimit>,
 ) -> Result<FormFindResult> {
     let start = Instant::now();
     let mesh = &problem.mesh;
@@ -97,7 +135,7 @@ pub(super) fn paper(
         let s = last.as_ref().unwrap();
         let z: Vec<f64> = positions.iter().map(|p| p[2]).collect();
         match shape.step(&s.force_densities, &s.loads, &z, &z0, k, &settings.schedule) {
-            Ok(z_new) => positions.iter_mut().zip(z_new).for_each(|(p, z)| p[2] = z),
+            Ok(z_new) => set_heights(&mut positions, z_new, limit.as_deref_mut()),
             Err(e) => {
                 termination = super::numerical(e);
                 break;
@@ -110,7 +148,6 @@ pub(super) fn paper(
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
         let certified_eps = certified.eps_inf;
-        lowest.offer(&positions, &certified);
         last = Some(certified);
         if certified_eps < settings.tolerance {
             history.push(certified_eps);
@@ -136,9 +173,9 @@ pub(super) fn paper(
     ))
 }
 
-/// The lowest-ε∞ state reached (heights with the forces certified there), the answer of a loop
-/// that ends without converging: later steps of a stalled loop may have moved further from
-/// balance.
+/// The lowest-ε∞ state of the stress steps (heights with the forces certified there, the
+/// states the history lists), the answer of a loop that ends without converging: later steps
+/// of a stalled loop may have moved further from balance.
 #[derive(Default)]
 struct Lowest {
     state: Option<(Vec<[f64; 3]>, StressResult)>,

@@ -23,12 +23,13 @@ use Formulation::{EdgeBased, Reduced};
 pub(super) fn attempt_list(
     settings: &StressSettings,
     lifted_first: bool,
+    native: Formulation,
 ) -> Vec<(QpSolver, Formulation, bool, f64)> {
     use QpSolver::{Clarabel, Native};
     let (a, b) = (lifted_first, !lifted_first);
     let mut attempts: Vec<(QpSolver, Formulation, bool, f64)> = Vec::new();
     if settings.solver == Native {
-        attempts.push((Native, settings.formulation, false, 1.0));
+        attempts.push((Native, native, false, 1.0));
     }
     match settings.formulation {
         Reduced => attempts.extend_from_slice(&[
@@ -46,6 +47,27 @@ pub(super) fn attempt_list(
         ]),
     }
     attempts
+}
+
+/// A vertex with more edges than this is a hub (a fan's centre, a UV sphere's pole): see
+/// `native_formulation`.
+const HUB_EDGES: usize = 64;
+
+/// The formulation of the native attempt: the requested one, except that the reduced QP of a
+/// mesh with a hub is solved in the edge-based form, which has the same optimum (§9 of
+/// docs/method.md; with constant hole jumps only where there are no holes). A hub's thin
+/// fan of faces makes the Airy values' map to force densities ill-conditioned (its cotangents
+/// grow with the fan's size) and the bounds of the edges around it dependent when all are
+/// active: on a wheel of 1000 spokes the interior-point iterations stalled short of the
+/// tolerances, while in the edge-based form each bound is a force density of its own.
+fn native_formulation(mesh: &Mesh, settings: &StressSettings) -> Formulation {
+    let same_optimum = settings.holes == airy::HoleMode::Affine || mesh.holes().next().is_none();
+    let hub = (0..mesh.positions.len()).any(|v| mesh.edges_at(v).len() > HUB_EDGES);
+    if settings.formulation == Reduced && same_optimum && hub {
+        EdgeBased
+    } else {
+        settings.formulation
+    }
 }
 
 /// The index of a formulation's force model in `Attempts::models`.
@@ -73,7 +95,8 @@ pub(super) fn run_attempts(
     use QpSolver::{Clarabel, Native};
     let mesh = &problem.mesh;
     let plan = &step.plan;
-    let attempts = attempt_list(settings, prior.is_some_and(|p| p.lifted_first));
+    let native = native_formulation(mesh, settings);
+    let attempts = attempt_list(settings, prior.is_some_and(|p| p.lifted_first), native);
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / step.unit).collect());

@@ -7,6 +7,24 @@ use crate::geometry::{loads, Frame, Plan};
 use crate::mesh::Mesh;
 use crate::problem::Problem;
 
+/// Heights over `l0`, relative to the mean height of the anchored vertices (of all referenced
+/// ones without any) where that lies far from them (`crate::geometry::far_base`): the QP sees
+/// only their differences, which keep their digits where a model lifted by 10⁷ would lose
+/// seven of them to z / L₀ rounded at that size. Elsewhere the heights are taken as they are,
+/// so that ordinary models are solved with the same arithmetic wherever they stand.
+fn relative_heights(mesh: &Mesh, positions: &[[f64; 3]], l0: f64) -> Vec<f64> {
+    let heights = |keep: &dyn Fn(usize) -> bool| {
+        (0..positions.len())
+            .filter(|&v| mesh.referenced[v] && keep(v))
+            .map(|v| positions[v][2])
+            .collect::<Vec<f64>>()
+    };
+    let supports = heights(&|v| mesh.anchored[v]);
+    let all = heights(&|_| true);
+    let base = crate::geometry::far_base(if supports.is_empty() { &all } else { &supports }, &all);
+    positions.iter().map(|p| (p[2] - base) / l0).collect()
+}
+
 /// A stress step's data in frame units (z' = z/L₀, p' = p/p̄, forces / p̄, q' = q L₀/p̄), the
 /// same for all its attempts, with the physical loads and scales.
 pub(super) struct FramedStep {
@@ -18,6 +36,7 @@ pub(super) struct FramedStep {
     pub(super) p_bar: f64,
     /// The natural force density scale p̄ / L₀.
     pub(super) unit: f64,
+    /// Heights in frame units, relative to the supports' mean height (`relative_heights`).
     pub(super) z: Vec<f64>,
     pub(super) p: Vec<f64>,
     pub(super) normal: Vec<[f64; 2]>,
@@ -44,7 +63,7 @@ impl FramedStep {
         let (load, free, p_bar) = loads_at(problem, positions, settings);
         check_mean_load(&load, &free)?;
         let unit = p_bar / l0;
-        let z: Vec<f64> = positions.iter().map(|p| p[2] / l0).collect();
+        let z = relative_heights(mesh, positions, l0);
         let p: Vec<f64> = match load_offset {
             Some(offset) => (load.iter().zip(offset))
                 .map(|(x, o)| (x + o) / p_bar)
@@ -149,7 +168,7 @@ pub(super) fn edge_bounds(
 }
 
 /// Vertices whose equations count: referenced and not anchored.
-fn non_anchored(mesh: &Mesh) -> Vec<u32> {
+pub(crate) fn non_anchored(mesh: &Mesh) -> Vec<u32> {
     (0..mesh.positions.len() as u32)
         .filter(|&v| mesh.is_non_anchored(v as usize))
         .collect()

@@ -12,6 +12,7 @@ mod framed;
 mod gauge;
 pub mod holes;
 mod ipm;
+pub(crate) mod linear;
 mod physical;
 mod qp;
 pub mod settings;
@@ -24,6 +25,7 @@ use attempts::{run_attempts, slot, Attempt, Attempts};
 use cache::PlanKey;
 pub use cache::{Prior, StressCache};
 use clarabel::solver::SolverStatus;
+pub(crate) use framed::non_anchored;
 use framed::FramedStep;
 pub use framed::{MAX_MEAN_LOAD, MIN_MEAN_LOAD};
 pub(crate) use physical::equilibrium;
@@ -120,7 +122,8 @@ pub struct StressResult {
     /// previous step's active set alone (form finding reuses it between steps).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
-    /// every reduced attempt failed numerically.
+    /// every reduced attempt failed numerically, or when the native solver answered a mesh with
+    /// a vertex of more than 64 edges (same optimum; see `docs/method.md` §9).
     pub formulation: Formulation,
     /// The solver that produced the answer (clarabel after a fallback from the native one).
     pub solver: QpSolver,

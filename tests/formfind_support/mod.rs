@@ -67,7 +67,7 @@ impl Scratch {
             for entry in fs::read_dir(dir).unwrap() {
                 let p = entry.unwrap().path();
                 out.push(p.strip_prefix(base).unwrap().display().to_string());
-                if p.is_dir() {
+                if fs::symlink_metadata(&p).unwrap().is_dir() {
                     walk(&p, base, out);
                 }
             }
@@ -80,12 +80,21 @@ impl Scratch {
 }
 
 impl Scratch {
-    /// Every path below the scratch folder with the content of each file (None for folders).
+    /// Every path below the scratch folder with the content of each regular file, the target of
+    /// each symbolic link (`link:` and the path) and None for anything else (folders, FIFOs:
+    /// reading a FIFO would wait for a writer).
     pub fn snapshot(&self) -> Vec<(String, Option<Vec<u8>>)> {
         self.listing()
             .into_iter()
             .map(|name| {
-                let content = fs::read(self.path(&name)).ok();
+                let path = self.path(&name);
+                let content = match fs::symlink_metadata(&path) {
+                    Ok(m) if m.is_symlink() => fs::read_link(&path)
+                        .ok()
+                        .map(|t| format!("link:{}", t.display()).into_bytes()),
+                    Ok(m) if m.is_file() => fs::read(&path).ok(),
+                    _ => None,
+                };
                 (name, content)
             })
             .collect()
@@ -106,6 +115,7 @@ pub fn run(cwd: &Path, args: &[&str]) -> Output {
         .expect("formfind runs")
 }
 
+pub mod views;
 pub mod xml;
 
 #[path = "../common/models.rs"]

@@ -40,7 +40,7 @@ fn sub(a: V3, b: V3) -> V3 {
 }
 
 /// An orthographic view along a fixed direction, and a fixed light.
-struct Projection {
+pub(super) struct Projection {
     right: V3,
     up: V3,
     /// Unit vector from the scene towards the viewer.
@@ -50,7 +50,7 @@ struct Projection {
 }
 
 impl Projection {
-    fn new() -> Projection {
+    pub(super) fn new() -> Projection {
         let (a, e) = (AZIMUTH_DEG.to_radians(), ELEVATION_DEG.to_radians());
         let eye = [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()];
         let right = [-a.sin(), a.cos(), 0.0];
@@ -67,7 +67,7 @@ impl Projection {
     }
 
     /// Page coordinates (y up) of a point, in model units.
-    fn screen(&self, p: V3) -> [f64; 2] {
+    pub(super) fn screen(&self, p: V3) -> [f64; 2] {
         [dot(self.right, p), dot(self.up, p)]
     }
 
@@ -117,7 +117,7 @@ fn back_to_front(mesh: &Mesh, pos: &[V3], projection: &Projection) -> Vec<usize>
 /// its points (to a tenth of a pixel) and its colour; the group fills and outlines every face
 /// with that colour (`currentColor`), which closes the hairline gaps anti-aliasing leaves
 /// between neighbours.
-fn shaded_faces(
+pub(super) fn shaded_faces(
     mesh: &Mesh,
     pos: &[V3],
     projection: &Projection,

@@ -41,20 +41,25 @@ pub(super) struct Plan {
     n: usize,
     /// None: one thread, in supernode order.
     split: Option<Split>,
+    /// Columns from this one on have negative pivots (the split rows' unknowns, see `dense`).
+    negative_from: usize,
 }
 
 impl Plan {
     /// The plan of a factor large enough to be factored on two threads (`Split::for_factor`),
-    /// supernodal and without a permutation; None otherwise (faer factors it).
-    pub(super) fn new(symbolic: &SymbolicCholesky<usize>) -> Option<Plan> {
-        Plan::with_split(symbolic, Some(Split::for_factor(symbolic)?))
+    /// supernodal and without a permutation; None otherwise (faer factors it). Pivots of the
+    /// columns from `negative_from` on are negative.
+    pub(super) fn new(symbolic: &SymbolicCholesky<usize>, negative_from: usize) -> Option<Plan> {
+        Plan::with_split(symbolic, Some(Split::for_factor(symbolic)?), negative_from)
     }
 
-    /// The plan with this split of the tree (None: one thread, in supernode order); None if
-    /// `symbolic` is not supernodal or has a permutation.
+    /// The plan with this split of the tree (None: one thread, in supernode order), pivots
+    /// negative from column `negative_from` on; None if `symbolic` is not supernodal or has a
+    /// permutation.
     pub(super) fn with_split(
         symbolic: &SymbolicCholesky<usize>,
         split: Option<Split>,
+        negative_from: usize,
     ) -> Option<Plan> {
         let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
             return None;
@@ -89,6 +94,7 @@ impl Plan {
             updaters,
             n: symbolic.nrows(),
             split,
+            negative_from,
         })
     }
 
@@ -216,7 +222,9 @@ impl Plan {
         }
         let mut block = MatMut::from_column_major_slice_mut(ls, nrows, ncols);
         let (mut top, mut bottom) = block.rb_mut().split_at_row_mut(ncols);
-        work.signs.resize(ncols, 1);
+        work.signs.clear();
+        work.signs
+            .extend((start..stop).map(|j| if j < self.negative_from { 1 } else { -1 }));
         let stack = cholesky_in_place_scratch::<f64>(ncols, Par::Seq, Default::default());
         if work.buffer_len < stack.unaligned_bytes_required() {
             work.buffer = MemBuffer::new(stack);

@@ -26,6 +26,7 @@
 
 use super::sparse::Csr;
 
+mod dense;
 mod factorise;
 mod gmres;
 mod graph;
@@ -422,7 +423,7 @@ fn iterate(
 ) -> IpmOutput {
     let n = qp.c.len();
     // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
-    let Some(mut space) = FactorSpace::new(&normal.pattern.symbolic, normal.p_values.len()) else {
+    let Some(mut space) = FactorSpace::for_pattern(normal.pattern) else {
         return stopped(vec![0.0; n], 0, None);
     };
     if let Some(out) = warm.and_then(|w| warm_start(qp, normal, cons, w, tol, &mut space)) {
@@ -858,3 +859,5 @@ fn gondzio_correctors(
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_dense;

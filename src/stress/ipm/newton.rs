@@ -1,7 +1,8 @@
 //! The Newton system of the interior-point method in augmented form, solved with the
 //! regularised factor of the normal matrix and refined against the exact system.
 
-use super::pattern::Normal;
+use super::dense::Source;
+use super::pattern::{Normal, Pattern};
 use super::{factorise, fallback_is_costly, gmres, inf_norm, mul_t, supernodal};
 use crate::stress::sparse::Csr;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -58,6 +59,14 @@ pub(super) struct FactorSpace {
 }
 
 impl FactorSpace {
+    /// The space for factors of `pattern`'s matrix, whose split rows' unknowns (beyond n)
+    /// have negative pivots.
+    pub(super) fn for_pattern(pattern: &Pattern) -> Option<FactorSpace> {
+        let mut space = FactorSpace::new(&pattern.symbolic, pattern.row_idx.len())?;
+        space.signs[pattern.n..].fill(-1);
+        Some(space)
+    }
+
     pub(super) fn new(symbolic: &SymbolicCholesky<usize>, n_values: usize) -> Option<FactorSpace> {
         let par = Par::Seq;
         let stack = symbolic
@@ -82,7 +91,7 @@ impl<'a> Newton<'a> {
         space: &'a mut FactorSpace,
     ) -> Option<Newton<'a>> {
         let pattern = normal.pattern;
-        let n = pattern.n;
+        let (n, n_factor) = (pattern.n, pattern.n + pattern.dense.count());
         let delta_eq = if fallback_is_costly(n) {
             DELTA_EQ_LARGE
         } else {
@@ -109,6 +118,12 @@ impl<'a> Newton<'a> {
         for &k in &pattern.diag {
             values[k] += reg;
         }
+        // C's split rows: u = w c·x, with the diagonal −1/w (see `dense`).
+        for (&(source, r), &slot) in pattern.dense.rows.iter().zip(&pattern.dense.diag) {
+            if source == Source::Cons {
+                values[slot] = -1.0 / w_reg[r];
+            }
+        }
         // Pivots that rounding makes non-positive are replaced by a huge value: that
         // direction then stays put for this solve instead of being amplified.
         let factored = match &pattern.plan {
@@ -119,8 +134,8 @@ impl<'a> Newton<'a> {
             None => {
                 let matrix = SparseColMatRef::new(
                     SymbolicSparseColMatRef::new_checked(
-                        n,
-                        n,
+                        n_factor,
+                        n_factor,
                         &pattern.col_ptr,
                         None,
                         &pattern.row_idx,
@@ -163,6 +178,9 @@ impl<'a> Newton<'a> {
         let t: Vec<f64> = b2.iter().zip(&self.w_reg).map(|(b, w)| b * w).collect();
         let mut dx = mul_t(self.cons, &t, n);
         dx.iter_mut().zip(b1).for_each(|(x, b)| *x += b);
+        // The split rows' unknowns (see `dense`): their equations' right side is 0.
+        let n_factor = n + self.normal.pattern.dense.count();
+        dx.resize(n_factor, 0.0);
         let space = &mut *self.space;
         let symbolic = &self.normal.pattern.symbolic;
         // Our own loops over the supernodes (`supernodal`); faer's solve only for a factor
@@ -171,11 +189,12 @@ impl<'a> Newton<'a> {
         if !supernodal::solve_in_place(symbolic, &space.l_values, &mut dx, &mut space.work, split) {
             LdltRef::new(symbolic, &space.l_values).solve_in_place_with_conj(
                 Conj::No,
-                MatMut::from_column_major_slice_mut(&mut dx, n, 1),
+                MatMut::from_column_major_slice_mut(&mut dx, n_factor, 1),
                 Par::Seq,
                 MemStack::new(&mut space.buffer),
             );
         }
+        dx.truncate(n);
         let cdx = self.cons.mul(&dx);
         let w = (0..b2.len())
             .map(|i| self.w_reg[i] * (cdx[i] - b2[i]))

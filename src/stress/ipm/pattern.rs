@@ -2,6 +2,7 @@
 //! factorisation, the value slot of every product), built once per mesh connectivity and kept
 //! in a `PatternCache`, and its values for one QP.
 
+use super::dense::{fill_couplings, DenseQuad, DenseRows, Source};
 use super::factorise::Plan;
 use super::graph::{amd_labels, entries};
 use super::ordering::nested_dissection_labels;
@@ -33,6 +34,9 @@ pub(super) struct Pattern {
     pub(super) row_start: Vec<usize>,
     pub(super) row_slot: Vec<usize>,
     pub(super) diag: Vec<usize>,
+    /// The rows of P and C factored apart, as unknowns n, n + 1, … of the factored matrix
+    /// (`dense`); the pattern's rows and columns beyond n are theirs.
+    pub(super) dense: DenseRows,
     pub(super) symbolic: SymbolicCholesky<usize>,
     /// Large factors' solves on two threads (`supernodal::Split::for_solve`).
     pub(super) solve_split: Option<Split>,
@@ -85,16 +89,29 @@ impl PatternCache {
 /// The normal matrix: the values of P and of each constraint row's products, on a `Pattern`.
 pub(super) struct Normal<'p> {
     pub(super) pattern: &'p Pattern,
-    /// Values of P alone, in the pattern's slots.
+    /// Values of P alone, in the pattern's slots, and the couplings of the split rows (see
+    /// `dense`), which P x does not read.
     pub(super) p_values: Vec<f64>,
     /// c_ia c_ib for the slots `pattern.row_slot`.
     pub(super) row_prod: Vec<f64>,
+    /// P's split rows, which P x adds apart.
+    pub(super) dense_quad: DenseQuad,
 }
 
 /// Every pair of entries (a, v_a), (b, v_b) with b ≤ a of each row r of `m`, as
 /// (r, a, b, v_a, v_b), row by row: the order of `Pattern::quad_slot` and `row_slot`.
+#[cfg(test)]
 pub(super) fn products(m: &Csr) -> impl Iterator<Item = (usize, usize, usize, f64, f64)> + '_ {
-    (0..m.nrows()).flat_map(move |r| {
+    products_of(m, |_| true)
+}
+
+/// `products` of the rows r of `m` with `keep(r)` (the others are not paired at all: a split
+/// row's pairs are as many as its entries squared).
+pub(super) fn products_of<'a>(
+    m: &'a Csr,
+    keep: impl Fn(usize) -> bool + 'a,
+) -> impl Iterator<Item = (usize, usize, usize, f64, f64)> + 'a {
+    (0..m.nrows()).filter(move |&r| keep(r)).flat_map(move |r| {
         m.row(r).flat_map(move |(a, va)| {
             m.row(r)
                 .filter(move |&(b, _)| b <= a)
@@ -264,7 +281,12 @@ impl Pattern {
         positions: Option<&[[f64; 2]]>,
     ) -> Option<Pattern> {
         let n = cons.ncols;
-        let (col_ptr, row_idx) = product_pattern([quad, cons], n);
+        let mut dense = DenseRows::find(quad, cons);
+        let kept = [
+            dense.kept(quad, Source::Quad),
+            dense.kept(cons, Source::Cons),
+        ];
+        let (col_ptr, row_idx) = product_pattern([&kept[0], &kept[1]], n);
         // One symbolic analysis in the new labels: the ordering alone comes from AMD or the
         // dissection, so that the pattern is not analysed twice.
         let label = match positions {
@@ -277,16 +299,22 @@ impl Pattern {
             }
             _ => amd_labels(n, &col_ptr, &row_idx)?,
         };
-        let (col_ptr, row_idx) = relabelled_lower(n, &col_ptr, &row_idx, &label);
-        let (up_ptr, up_idx) = transpose(n, &col_ptr, &row_idx);
-        let symbolic = symbolic_cholesky(n, &up_ptr, &up_idx)?;
-        let quad_slot = product_slots(quad, &label, &col_ptr, &row_idx);
-        let row_slot = product_slots(cons, &label, &col_ptr, &row_idx);
+        let lower = relabelled_lower(n, &col_ptr, &row_idx, &label);
+        let (col_ptr, row_idx) = dense.augmented(lower, &label, quad, cons);
+        let n_factor = n + dense.count();
+        let (up_ptr, up_idx) = transpose(n_factor, &col_ptr, &row_idx);
+        let symbolic = symbolic_cholesky(n_factor, &up_ptr, &up_idx)?;
+        let quad_slot = product_slots(&kept[0], &label, &col_ptr, &row_idx);
+        let row_slot = product_slots(&kept[1], &label, &col_ptr, &row_idx);
         // A row's columns are distinct (`Csr::push_row` merges repeats): k entries, k(k+1)/2
         // products.
         let mut row_start = vec![0];
         for r in 0..cons.nrows() {
-            let k = cons.start[r + 1] - cons.start[r];
+            let k = if dense.is_split(Source::Cons, r) {
+                0
+            } else {
+                cons.start[r + 1] - cons.start[r]
+            };
             row_start.push(row_start[r] + k * (k + 1) / 2);
         }
         debug_assert_eq!(row_start[cons.nrows()], row_slot.len());
@@ -308,8 +336,9 @@ impl Pattern {
             row_start,
             row_slot,
             diag,
+            dense,
             solve_split: Split::for_solve(&symbolic),
-            plan: Plan::new(&symbolic),
+            plan: Plan::new(&symbolic, n),
             symbolic,
         })
     }
@@ -325,29 +354,40 @@ impl<'p> Normal<'p> {
         cons: &Csr,
     ) -> Normal<'p> {
         let mut p_values = vec![0.0; pattern.row_idx.len()];
-        for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(products(quad)) {
+        let kept = products_of(quad, |r| !pattern.dense.is_split(Source::Quad, r));
+        for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(kept) {
             p_values[slot] += quad_weight[r] * va * vb;
         }
+        fill_couplings(&pattern.dense, (quad, quad_weight), cons, &mut p_values);
         let mut row_prod = Vec::with_capacity(pattern.row_slot.len());
-        row_prod.extend(products(cons).map(|(.., va, vb)| va * vb));
+        row_prod.extend(
+            products_of(cons, |r| !pattern.dense.is_split(Source::Cons, r))
+                .map(|(.., va, vb)| va * vb),
+        );
         Normal {
             pattern,
             p_values,
             row_prod,
+            dense_quad: DenseQuad::new(&pattern.dense, &pattern.label, quad, quad_weight),
         }
     }
 
     /// y = |P| |x| (entrywise absolute values): the size of the terms summed in P x.
     pub(super) fn mul_p_abs(&self, x: &[f64]) -> Vec<f64> {
-        self.sum_p_terms(x, |p, x| (p * x).abs())
+        let mut y = self.sum_p_terms(x, |p, x| (p * x).abs());
+        self.dense_quad.add_to(x, &mut y, true);
+        y
     }
 
     /// y = P x from the stored lower triangle (x and y in the new labels).
     pub(super) fn mul_p(&self, x: &[f64]) -> Vec<f64> {
-        self.sum_p_terms(x, |p, x| p * x)
+        let mut y = self.sum_p_terms(x, |p, x| p * x);
+        self.dense_quad.add_to(x, &mut y, false);
+        y
     }
 
-    /// y_r = Σ_c term(P_rc, x_c) over the full symmetric P, from its lower triangle.
+    /// y_r = Σ_c term(P_rc, x_c) over the symmetric P held in the pattern (all but its split
+    /// rows), from its lower triangle.
     pub(super) fn sum_p_terms(&self, x: &[f64], term: impl Fn(f64, f64) -> f64) -> Vec<f64> {
         let mut y = vec![0.0; self.pattern.n];
         let Pattern {
@@ -357,6 +397,10 @@ impl<'p> Normal<'p> {
             let mut acc = 0.0;
             let range = col_ptr[c]..col_ptr[c + 1];
             for (&r, &v) in row_idx[range.clone()].iter().zip(&self.p_values[range]) {
+                // Rows beyond n: the split rows' couplings, not P's (the last in each column).
+                if r >= self.pattern.n {
+                    break;
+                }
                 y[r] += term(v, x[c]);
                 if r != c {
                     acc += term(v, x[r]);

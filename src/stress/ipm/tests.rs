@@ -731,22 +731,32 @@ fn dissection_order_solves_a_large_qp_as_amds_does() {
 }
 
 /// The two-thread factorisation (and the same code on one thread) gives faer's factor of a
-/// grid's normal matrix, to rounding: a dropped or misplaced update would change it by the
-/// size of the entries.
+/// grid's normal matrix with two dense rows factored apart (negative pivots), to rounding: a
+/// dropped or misplaced update or a wrong pivot sign would change it by the size of the
+/// entries.
 #[test]
 fn own_factorisation_equals_faers() {
-    let (quad, cons, _) = grid_qp(40);
+    let (mut quad, mut cons, _) = grid_qp(40);
     let n = quad.ncols;
+    // Dense rows of P and of C, factored apart with negative pivots (see `dense`).
+    quad.push_row((0..n).step_by(7).map(|i| (i, 0.5)).collect());
+    cons.push_row(
+        (0..n)
+            .step_by(5)
+            .map(|i| (i, 1.0 + (i % 3) as f64))
+            .collect(),
+    );
     let mut cache = PatternCache::default();
     let (pattern, _) = cache.pattern(&quad, &cons, 0, None).expect("normal matrix");
-    let normal = Normal::new(pattern, &quad, &vec![1.0; n], &cons);
+    assert_eq!(pattern.dense.count(), 2);
+    let normal = Normal::new(pattern, &quad, &vec![1.0; quad.nrows()], &cons);
     let symbolic = &normal.pattern.symbolic;
-    let mut space = FactorSpace::new(symbolic, normal.p_values.len()).expect("factor space");
+    let mut space = FactorSpace::for_pattern(pattern).expect("factor space");
     assert!(
         normal.pattern.plan.is_none(),
         "faer factors a matrix this small"
     );
-    let d: Vec<f64> = (0..n).map(|i| 0.5 + (i % 3) as f64).collect();
+    let d: Vec<f64> = (0..cons.nrows()).map(|i| 0.5 + (i % 3) as f64).collect();
     drop(Newton::new(&normal, &cons, d, 1e-12, &mut space).expect("a sound factor"));
     let theirs = space.l_values.clone();
     let scale = inf_norm(&theirs);
@@ -759,7 +769,7 @@ fn own_factorisation_equals_faers() {
     );
     for split in [Some(split), None] {
         let threads = if split.is_some() { 2 } else { 1 };
-        let plan = factorise::Plan::with_split(symbolic, split).expect("a supernodal plan");
+        let plan = factorise::Plan::with_split(symbolic, split, n).expect("a supernodal plan");
         let mut own = vec![f64::NAN; theirs.len()];
         let matrix = (
             &pattern.col_ptr[..],

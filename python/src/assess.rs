@@ -1,0 +1,297 @@
+//! Masonry assessment: the envelope (a thickness, or intrados and extrados surfaces), keyword
+//! settings → `AssessSettings` (checked as the C API's `vsr_assess_settings_set_*` check them,
+//! with the same messages), and `voussoir::assess` with the GIL released.
+
+use crate::errors::{from_error, invalid, not_finite};
+use crate::mesh::{shape_text, Mesh};
+use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, QBound, Thickness};
+
+const OBJECTIVES: [&str; 5] = [
+    "fit",
+    "min-thickness",
+    "min-thrust",
+    "max-thrust",
+    "max-load",
+];
+
+fn text(name: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
+    v.extract().map_err(|_| {
+        let shown = v.repr().map_or("?".into(), |r| r.to_string());
+        invalid(name, format_args!("{shown} is not a string"))
+    })
+}
+
+fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let x: f64 = v.extract().map_err(|_| invalid(name, "is not a number"))?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(not_finite(name, x))
+    }
+}
+
+/// A flat float64 array of any shape, its entries finite.
+fn floats(name: &str, a: &PyReadonlyArrayDyn<'_, f64>, what: &str) -> PyResult<Vec<f64>> {
+    let values: Vec<f64> = a.as_array().iter().copied().collect();
+    match values.iter().position(|x| !x.is_finite()) {
+        None => Ok(values),
+        Some(k) => Err(invalid(
+            name,
+            format_args!("{what} {k} is {}, not finite", values[k]),
+        )),
+    }
+}
+
+/// Settings from keyword arguments, on top of the Rust defaults.
+pub fn settings_from(kwargs: &Bound<'_, PyDict>) -> PyResult<AssessSettings> {
+    let mut s = AssessSettings::default();
+    let kind = match kwargs.get_item("q_min_kind")? {
+        None => "absolute".to_string(),
+        Some(v) => text("q_min_kind", &v)?,
+    };
+    if kind != "absolute" && kind != "relative" {
+        return Err(invalid(
+            "q_min_kind",
+            format_args!("'{kind}' is not one of 'absolute', 'relative'"),
+        ));
+    }
+    for (key, v) in kwargs.iter() {
+        let key: String = key.extract()?;
+        match key.as_str() {
+            "objective" => {
+                let name = text(&key, &v)?;
+                s.objective = name.parse().map_err(|_| {
+                    let allowed: Vec<String> =
+                        OBJECTIVES.iter().map(|o| format!("'{o}'")).collect();
+                    invalid(
+                        &key,
+                        format_args!("'{name}' is not one of {}", allowed.join(", ")),
+                    )
+                })?;
+            }
+            "fixed_supports" => {
+                s.fixed_supports = v
+                    .extract::<bool>()
+                    .map_err(|_| invalid(&key, "is not True or False"))?
+            }
+            "unit_weight" => s.unit_weight = finite(&key, &v)?,
+            "load_rule" => s.load_rule = crate::settings::named::<LoadRule>(&key, &v)?,
+            "load_pattern" => {
+                s.load_pattern = if v.is_none() {
+                    None
+                } else {
+                    let a: PyReadonlyArrayDyn<'_, f64> = v
+                        .extract()
+                        .map_err(|_| invalid(&key, "is not an array of float64"))?;
+                    if a.shape().len() != 1 {
+                        let shape = shape_text(a.shape());
+                        return Err(invalid(
+                            &key,
+                            format_args!("has shape {shape}, expected (n,)"),
+                        ));
+                    }
+                    Some(floats(&key, &a, "vertex")?)
+                };
+            }
+            "q_min" => {
+                let q = finite(&key, &v)?;
+                s.q_min = if kind == "relative" {
+                    QBound::Relative(q)
+                } else {
+                    QBound::Absolute(q)
+                };
+            }
+            "q_min_kind" => {}
+            "tolerance" => s.tolerance = finite(&key, &v)?,
+            "max_iterations" => {
+                let n: i64 = v
+                    .extract()
+                    .map_err(|_| invalid(&key, "is not an integer"))?;
+                s.max_iterations = usize::try_from(n).unwrap_or(0);
+            }
+            _ => return Err(invalid(&key, "is not an assessment setting")),
+        }
+    }
+    if kwargs.get_item("q_min")?.is_none() && kind == "relative" {
+        s.q_min = QBound::Relative(0.0);
+    }
+    s.validate().map_err(|e| match e {
+        voussoir::Error::InvalidArgument { name, reason } => invalid(name, reason),
+        e => invalid("settings", e),
+    })?;
+    Ok(s)
+}
+
+/// A surface given as (vertices (n, 3) float64, faces (m, 3) int64).
+type Surface<'py> = (PyReadonlyArrayDyn<'py, f64>, PyReadonlyArrayDyn<'py, i64>);
+
+/// Its vertices and faces, checked.
+type Rows = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
+fn surface(name: &str, (v, f): &Surface<'_>) -> PyResult<Rows> {
+    for (what, shape) in [("vertices", v.shape()), ("faces", f.shape())] {
+        if shape.len() != 2 || shape[1] != 3 {
+            return Err(invalid(
+                name,
+                format_args!("{what} have shape {}, expected (n, 3)", shape_text(shape)),
+            ));
+        }
+    }
+    let flat = floats(name, v, "coordinate")?;
+    let n = flat.len() / 3;
+    let ids: Vec<i64> = f.as_array().iter().copied().collect();
+    if let Some(k) = ids.iter().position(|&i| i < 0 || i as u64 >= n as u64) {
+        return Err(invalid(
+            name,
+            format_args!(
+                "face {} refers to vertex {}, beyond its {n} vertices",
+                k / 3,
+                ids[k]
+            ),
+        ));
+    }
+    let rows = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let faces = (ids.chunks_exact(3))
+        .map(|c| [c[0] as u32, c[1] as u32, c[2] as u32])
+        .collect();
+    Ok((rows, faces))
+}
+
+/// The envelope of `thickness` (1 or #F values) or of intrados and extrados surfaces.
+fn envelope(
+    mesh: &voussoir::Mesh,
+    thickness: Option<PyReadonlyArrayDyn<'_, f64>>,
+    intrados: Option<Surface<'_>>,
+    extrados: Option<Surface<'_>>,
+) -> PyResult<Envelope> {
+    match (thickness, intrados, extrados) {
+        (Some(t), None, None) => {
+            let values = floats("thickness", &t, "entry")?;
+            let t = match values.len() {
+                1 => Thickness::Uniform(values[0]),
+                n if n == mesh.n_faces() => Thickness::PerFace(values),
+                n => {
+                    return Err(invalid(
+                        "thickness",
+                        format_args!(
+                            "has {n} values: give one (uniform) or one per face ({})",
+                            mesh.n_faces()
+                        ),
+                    ))
+                }
+            };
+            Envelope::from_thickness(mesh, &t).map_err(|e| from_error("thickness", e))
+        }
+        (None, Some(lo), Some(hi)) => {
+            let (lo, hi) = (surface("intrados", &lo)?, surface("extrados", &hi)?);
+            Envelope::from_surfaces(mesh, (&lo.0, &lo.1), (&hi.0, &hi.1))
+                .map_err(|e| from_error("intrados", e))
+        }
+        _ => Err(invalid(
+            "thickness",
+            "give the masonry's envelope: thickness, or intrados and extrados (not both)",
+        )),
+    }
+}
+
+/// `assess(mesh, thickness, intrados, extrados, settings, progress)`: the result's fields.
+#[pyfunction]
+#[pyo3(signature = (mesh, thickness, intrados, extrados, settings, progress=None))]
+pub fn assess<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    thickness: Option<PyReadonlyArrayDyn<'py, f64>>,
+    intrados: Option<Surface<'py>>,
+    extrados: Option<Surface<'py>>,
+    settings: &Bound<'py, PyDict>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let s = settings_from(settings)?;
+    let m: &Mesh = mesh.get();
+    let env = envelope(&m.problem().mesh, thickness, intrados, extrados)?;
+    if let Some(p) = &progress {
+        if !p.is_none() && !p.is_callable() {
+            return Err(invalid("progress", "is not callable"));
+        }
+    }
+    let callback: Option<Py<PyAny>> = progress.filter(|p| !p.is_none()).map(Bound::unbind);
+    let mut raised: Option<PyErr> = None;
+    let result = py.detach(|| {
+        let mut hook = |k: usize, infeasibility: f64| {
+            Python::attach(|py| {
+                let step = || -> PyResult<bool> {
+                    py.check_signals()?;
+                    let Some(cb) = &callback else {
+                        return Ok(true);
+                    };
+                    let answer = cb.call1(py, (k, infeasibility))?;
+                    let answer = answer.bind(py);
+                    Ok(answer.is_none() || answer.is_truthy()?)
+                };
+                step().unwrap_or_else(|e| {
+                    raised = Some(e);
+                    false
+                })
+            })
+        };
+        voussoir::assess(m.problem(), &env, &s, Some(&mut hook))
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    let result = result.map_err(|e| from_error("mesh", e))?;
+    fields(py, &m.problem().mesh, &env, &result)
+}
+
+/// The fields of an assessment, with its envelope.
+fn fields<'py>(
+    py: Python<'py>,
+    mesh: &voussoir::Mesh,
+    env: &Envelope,
+    r: &AssessResult,
+) -> PyResult<Bound<'py, PyDict>> {
+    use crate::results::matrix;
+    let d = PyDict::new(py);
+    let (vertices, detail) = crate::results::termination(&r.termination);
+    let name = r.termination.name();
+    d.set_item("objective", r.objective.as_str())?;
+    d.set_item("feasible", r.feasible)?;
+    d.set_item("termination", name)?;
+    d.set_item("termination_message", r.termination.to_string())?;
+    d.set_item("termination_vertices", PyArray1::from_vec(py, vertices))?;
+    d.set_item("termination_detail", detail)?;
+    d.set_item("iterations", r.iterations)?;
+    d.set_item("positions", matrix(py, &r.positions))?;
+    let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
+    d.set_item("edges", matrix(py, &edges))?;
+    d.set_item(
+        "force_densities",
+        PyArray1::from_slice(py, &r.force_densities),
+    )?;
+    d.set_item("loads", PyArray1::from_slice(py, &r.loads))?;
+    d.set_item("residuals", PyArray1::from_slice(py, &r.residuals))?;
+    d.set_item("eps_inf", r.eps_inf)?;
+    d.set_item("horizontal_imbalance", r.horizontal_imbalance)?;
+    d.set_item("lower", PyArray1::from_slice(py, &r.lower))?;
+    d.set_item("upper", PyArray1::from_slice(py, &r.upper))?;
+    d.set_item("thickness_scale", r.thickness_scale)?;
+    d.set_item("safety_factor", r.safety_factor)?;
+    d.set_item("reactions", matrix(py, &r.reactions))?;
+    d.set_item("thrust_horizontal", r.thrust_horizontal)?;
+    d.set_item("load_factor", r.load_factor)?;
+    d.set_item("worst_bound", r.worst_bound.0)?;
+    d.set_item("worst_bound_vertex", r.worst_bound.1)?;
+    d.set_item("worst_residual_vertex", r.worst_residual_vertex)?;
+    d.set_item("seconds", r.seconds)?;
+    d.set_item("envelope_lower", PyArray1::from_slice(py, &env.lower))?;
+    d.set_item("envelope_upper", PyArray1::from_slice(py, &env.upper))?;
+    d.set_item("envelope_middle", PyArray1::from_slice(py, &env.middle))?;
+    d.set_item(
+        "face_thickness",
+        PyArray1::from_slice(py, &env.face_thickness),
+    )?;
+    Ok(d)
+}

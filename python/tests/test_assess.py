@@ -1,0 +1,260 @@
+"""Masonry assessment from Python: `voussoir.assess` equals the Rust API (the formfind example's
+`--assess`, whose OBJ and JSON keep every bit) bit for bit, its certificate holds when
+recomputed from the result's arrays, bad input raises VoussoirError naming the argument, and
+`python -m voussoir --assess` writes the same as formfind."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import voussoir
+
+
+def dome(rings: int = 3, segments: int = 12, angle: float = math.radians(60), dz: float = 0.0,
+         scale: float = 1.0):
+    """A spherical cap over the unit disk (the C ABI tests' dome): a centre vertex and
+    `rings` rings of `segments` vertices, odd rings turned by half a step; the outer ring is
+    the boundary."""
+    sphere = 1.0 / math.sin(angle)
+    height = lambda r: math.sqrt(sphere * sphere - r * r) - sphere * math.cos(angle)  # noqa: E731
+    points = [(0.0, 0.0, height(0.0))]
+    for k in range(1, rings + 1):
+        r = k / rings
+        for m in range(segments):
+            a = 2 * math.pi * (m + 0.5 * (k % 2)) / segments
+            points.append((r * math.cos(a), r * math.sin(a), height(r)))
+    ring = lambda k, m: 1 + (k - 1) * segments + m % segments  # noqa: E731
+    faces = [(0, ring(1, m), ring(1, m + 1)) for m in range(segments)]
+    for k in range(1, rings):
+        for m in range(segments):
+            a0, a1, b0, b1 = ring(k, m), ring(k, m + 1), ring(k + 1, m), ring(k + 1, m + 1)
+            faces += [(b0, b1, a0), (a0, b1, a1)] if k % 2 == 1 else [(a0, b0, a1), (a1, b0, b1)]
+    v = np.array(points) * [scale, scale, 1.0] + [0, 0, dz]
+    f = np.array(faces, dtype=np.int64)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    clockwise = area < 0
+    f[clockwise] = f[clockwise][:, [0, 2, 1]]
+    rim = list(range(1 + (rings - 1) * segments, 1 + rings * segments))
+    return v, f, rim
+
+
+def write_obj(path, vertices, faces):
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices.tolist()]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces.tolist()]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def read_obj_vertices(path):
+    rows = [line.split()[1:4] for line in path.read_text().splitlines() if line.startswith("v ")]
+    return np.array(rows, dtype=np.float64)
+
+
+def check_certificate(r: voussoir.AssessmentResult, anchored):
+    """Equilibrium, compression and bounds recomputed from the result's arrays."""
+    assert r.feasible
+    n = len(r.positions)
+    free = np.ones(n, bool)
+    free[anchored] = False
+    i, j = r.edges[:, 0].astype(int), r.edges[:, 1].astype(int)
+    q = r.force_densities
+    assert (q >= 0).all()
+    dz = r.positions[i, 2] - r.positions[j, 2]
+    vertical = -r.loads.copy()
+    np.add.at(vertical, i, q * dz)
+    np.add.at(vertical, j, -q * dz)
+    mean = r.loads[free].mean()
+    assert np.abs(vertical[free]).max() < 1e-6 * mean
+    d = r.positions[i, :2] - r.positions[j, :2]
+    horizontal = np.zeros((n, 2))
+    np.add.at(horizontal, i, q[:, None] * d)
+    np.add.at(horizontal, j, -q[:, None] * d)
+    assert np.abs(horizontal[free]).max() < 1e-9 * mean
+    z = r.positions[:, 2]
+    assert (z >= r.lower - 1e-9).all() and (z <= r.upper + 1e-9).all()
+
+
+@pytest.fixture
+def files(tmp_path):
+    v, f, rim = dome()
+    write_obj(tmp_path / "dome.obj", v, f)
+    (tmp_path / "dome.json").write_text(json.dumps({"anchored": rim}))
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    "objective, extra",
+    [("fit", []), ("min-thickness", []), ("max-load", ["--load-pattern", "pattern.json"])],
+)
+def test_assess_equals_the_rust_api(objective, extra, files, formfind):
+    pattern = np.zeros(37)
+    pattern[0] = 1.0
+    (files / "pattern.json").write_text(json.dumps({"loads": pattern.tolist()}))
+    args = [formfind, "dome.obj", "--supports", "dome.json", "--assess", objective,
+            "--thickness", "0.1", "--unit-weight", "2", "--out", "out.obj",
+            "--report", "report.json", *extra]
+    rust = subprocess.run(args, cwd=files, capture_output=True, text=True)
+    assert rust.returncode in (0, 3), rust.stderr
+    report = json.loads((files / "report.json").read_text())
+    a = report["assessment"]
+
+    mesh = voussoir.Mesh.from_file(files / "dome.obj", files / "dome.json")
+    load = pattern if objective == "max-load" else None
+    r = voussoir.assess(mesh, 0.1, objective=objective, unit_weight=2.0, load_pattern=load)
+
+    assert np.array_equal(r.positions, read_obj_vertices(files / "out.obj"))
+    assert np.array_equal(r.force_densities, np.array(report["force_densities"]))
+    assert np.array_equal(r.loads, np.array(report["loads"]))
+    assert np.array_equal(r.lower, np.array(a["bounds"]["lower"]))
+    assert np.array_equal(r.upper, np.array(a["bounds"]["upper"]))
+    assert np.array_equal(r.envelope_lower, np.array(a["envelope"]["lower"]))
+    for key in ("feasible", "termination", "iterations", "thickness_scale", "safety_factor",
+                "thrust_horizontal", "load_factor", "eps_inf", "thickness_min"):
+        assert getattr(r, key) == a[key], key
+    check_certificate(r, mesh.anchored)
+    if objective == "min-thickness":
+        assert 0 < r.thickness_scale < 1 and r.thickness_min == r.thickness_scale * 0.1
+    if objective == "max-load":
+        assert r.load_factor > 0
+
+
+def test_surfaces_and_per_face_thickness():
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    lo, lo_faces, _ = dome(6, 24, dz=-0.05, scale=1.05)
+    hi, hi_faces, _ = dome(6, 24, dz=0.05, scale=1.05)
+    r = voussoir.assess(mesh, intrados=(lo, lo_faces), extrados=(hi, hi_faces))
+    check_certificate(r, rim)
+    assert r.thickness_min is None
+    assert np.allclose(r.envelope_upper - r.envelope_lower, 0.1, atol=1e-12, rtol=0)
+    per_face = np.full(len(f), 0.1)
+    uniform = voussoir.assess(mesh, 0.1)
+    faces = voussoir.assess(mesh, per_face)
+    assert faces.thickness_min is None and uniform.thickness_min == 0.1
+    assert np.array_equal(uniform.positions, faces.positions)
+    assert uniform.positions.shape == (37, 3) and uniform.edges.dtype == np.uint32
+    assert uniform.reactions.shape == (37, 2) and uniform.face_thickness.shape == (len(f),)
+
+
+def test_fixed_supports_and_settings():
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    free = voussoir.assess(mesh, 0.1, objective="min-thrust")
+    fixed = voussoir.assess(mesh, 0.1, objective="min-thrust", fixed_supports=True)
+    assert np.array_equal(fixed.positions[rim, 2], v[rim, 2])
+    assert np.abs(free.positions[rim, 2] - v[rim, 2]).max() > 1e-3
+    most = voussoir.assess(mesh, 0.1, objective="max-thrust")
+    assert free.thrust_horizontal < most.thrust_horizontal
+    few = voussoir.assess(mesh, 0.1, objective="min-thrust", max_iterations=2, load_rule="voronoi")
+    assert few.iterations <= 2 + 30  # the limit, plus the polishing steps
+
+
+@pytest.mark.parametrize(
+    "kwargs, argument, detail",
+    [
+        ({"thickness": 0.0}, "thickness", "face 0"),
+        ({"thickness": -1.0}, "thickness", "face 0"),
+        ({"thickness": float("nan")}, "thickness", "not finite"),
+        ({"thickness": [0.1, 0.2]}, "thickness", "one per face"),
+        ({}, "thickness", "give the masonry's envelope"),
+        ({"thickness": 0.1, "objective": "max"}, "objective", "'fit'"),
+        ({"thickness": 0.1, "unit_weight": 0.0}, "unit_weight", "> 0"),
+        ({"thickness": 0.1, "tolerance": 2.0}, "tolerance", "(0, 1)"),
+        ({"thickness": 0.1, "max_iterations": 0}, "max_iterations", "at least 1"),
+        ({"thickness": 0.1, "load_rule": "area"}, "load_rule", "'plan_area'"),
+        ({"thickness": 0.1, "q_min": -1.0}, "q_min", ">= 0"),
+        ({"thickness": 0.1, "tau": "zero"}, "tau", "not an assessment setting"),
+        ({"thickness": 0.1, "objective": "max-load"}, "load_pattern", "needs a load pattern"),
+        ({"thickness": 0.1, "objective": "max-load", "load_pattern": [1.0, 2.0]},
+         "load_pattern", "has 2 entries"),
+        ({"thickness": 0.1, "progress": 3}, "progress", "not callable"),
+    ],
+)
+def test_bad_input_names_the_argument(kwargs, argument, detail):
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    with pytest.raises(voussoir.VoussoirError) as e:
+        voussoir.assess(mesh, **kwargs)
+    message = str(e.value)
+    assert f"argument `{argument}`" in message and detail in message, message
+    assert "\n" not in message
+
+
+def test_bad_surfaces_name_the_vertex():
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    lo, lo_faces, _ = dome(6, 24, dz=-0.05, scale=1.05)
+    hi, hi_faces, _ = dome(6, 24, dz=0.05, scale=1.05)
+    small, small_faces, _ = dome(6, 24, dz=0.05, scale=0.5)
+    cases = [
+        (dict(intrados=(hi, hi_faces), extrados=(lo, lo_faces)), "intrados", "at vertex 0"),
+        (dict(intrados=(lo, lo_faces), extrados=(small, small_faces)), "extrados",
+         "does not cover vertex"),
+        (dict(intrados=(lo, lo_faces)), "thickness", "give the masonry's envelope"),
+        (dict(thickness=0.1, intrados=(lo, lo_faces), extrados=(hi, hi_faces)), "thickness",
+         "not both"),
+        (dict(intrados=(lo[:, :2], lo_faces), extrados=(hi, hi_faces)), "intrados",
+         "expected (n, 3)"),
+        (dict(intrados=(lo, lo_faces + 1000), extrados=(hi, hi_faces)), "intrados",
+         "beyond its"),
+        (dict(intrados=lo, extrados=(hi, hi_faces)), "intrados", "pair"),
+    ]
+    for kwargs, argument, detail in cases:
+        with pytest.raises(voussoir.VoussoirError) as e:
+            voussoir.assess(mesh, **kwargs)
+        assert f"argument `{argument}`" in str(e.value) and detail in str(e.value), str(e.value)
+
+
+def test_progress_sees_each_step_and_can_stop():
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    steps = []
+
+    def stop_at_three(step, infeasibility):
+        steps.append((step, infeasibility))
+        return len(steps) < 3
+
+    r = voussoir.assess(mesh, 0.1, objective="min-thrust", progress=stop_at_three)
+    assert [s for s, _ in steps] == [1, 2, 3]
+    assert r.termination == "cancelled" and r.iterations == 3
+
+    def fail(step, infeasibility):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        voussoir.assess(mesh, 0.1, progress=fail)
+
+
+def test_the_command_line_assesses_as_formfind(files, formfind):
+    rust = subprocess.run(
+        [formfind, "dome.obj", "--supports", "dome.json", "--assess", "min-thickness",
+         "--thickness", "0.1", "--fixed-supports", "--out", "rust.obj", "--report", "rust.json"],
+        cwd=files, capture_output=True, text=True,
+    )
+    assert rust.returncode == 0, rust.stderr
+    python = subprocess.run(
+        [sys.executable, "-m", "voussoir", "dome.obj", "--supports", "dome.json",
+         "--assess", "min-thickness", "--thickness", "0.1", "--fixed-supports",
+         "--out", "py.obj", "--report", "py.json"],
+        cwd=files, capture_output=True, text=True,
+    )
+    assert python.returncode == 0, python.stderr
+    py, rust_obj = read_obj_vertices(files / "py.obj"), read_obj_vertices(files / "rust.obj")
+    assert np.array_equal(py, rust_obj)
+    a, b = (json.loads((files / f"{n}.json").read_text())["assessment"] for n in ("py", "rust"))
+    for key in ("objective", "feasible", "termination", "thickness_min", "thickness_scale",
+                "safety_factor", "thrust_horizontal", "load_factor", "eps_inf", "bounds"):
+        assert a[key] == b[key], key
+    bad = subprocess.run(
+        [sys.executable, "-m", "voussoir", "dome.obj", "--supports", "dome.json",
+         "--assess", "fit", "--thickness", "0", "--out", "bad.obj"],
+        cwd=files, capture_output=True, text=True,
+    )
+    assert bad.returncode == 2 and "--thickness" in bad.stderr
+    assert not (files / "bad.obj").exists()

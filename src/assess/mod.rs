@@ -1,0 +1,303 @@
+//! Masonry assessment (docs/method.md §16): a compression-only thrust surface in equilibrium
+//! with the masonry's weight that fits inside its envelope proves the vault safe (Heyman's
+//! safe theorem). [`assess`] finds one for an [`Objective`]: the one nearest the middle
+//! surface, the least thickness that still holds one, the least or greatest horizontal
+//! thrust, or the largest multiple of a live load.
+//!
+//! The plan is the mesh's; the unknowns are the thrust surface's heights (the supports' too,
+//! within the envelope, unless fixed), the stress (reduced coordinates: horizontal balance
+//! is exact) and the objective's scalar. Equilibrium is bilinear in stress and heights; a
+//! sequential QP with an exact ℓ1 penalty on the vertical residuals solves it, accepting
+//! only steps that lower its merit function. Every returned figure is recomputed from the
+//! returned heights and forces.
+
+mod envelope;
+mod model;
+mod qp;
+mod sqp;
+
+pub use envelope::Envelope;
+
+use crate::error::{Error, Result};
+use crate::geometry::loads::LoadRule;
+use crate::problem::Problem;
+use crate::solve::{Progress, Termination};
+use crate::stress::QBound;
+
+/// What [`assess`] optimises over the thrust surfaces that fit inside the envelope.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Objective {
+    /// Does one fit? The one nearest the middle surface (least area-weighted squared height
+    /// difference).
+    #[default]
+    Fit,
+    /// The least thickness: the smallest scale s of the envelope's half extents about the
+    /// middle surface that still contains a thrust surface (the loads stay those of the given
+    /// thickness: scaling all loads scales the stress, not the thrust surface).
+    MinThickness,
+    /// The least horizontal thrust Σ_supports |H_a| (the passive state).
+    MinThrust,
+    /// The greatest horizontal thrust (the active state).
+    MaxThrust,
+    /// The largest factor λ on [`AssessSettings::load_pattern`] added to the self-weight.
+    MaxLoad,
+}
+
+impl Objective {
+    /// The name used by the command line, Python and the JSON report.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Objective::Fit => "fit",
+            Objective::MinThickness => "min-thickness",
+            Objective::MinThrust => "min-thrust",
+            Objective::MaxThrust => "max-thrust",
+            Objective::MaxLoad => "max-load",
+        }
+    }
+}
+
+impl std::str::FromStr for Objective {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Objective> {
+        let all = [
+            Objective::Fit,
+            Objective::MinThickness,
+            Objective::MinThrust,
+            Objective::MaxThrust,
+            Objective::MaxLoad,
+        ];
+        all.into_iter()
+            .find(|o| o.as_str() == s)
+            .ok_or_else(|| Error::InvalidArgument {
+                name: "objective",
+                reason: format!(
+                    "'{s}' is not one of fit, min-thickness, min-thrust, max-thrust, max-load"
+                ),
+            })
+    }
+}
+
+/// Settings of [`assess`]. `Default` gives the documented defaults.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct AssessSettings {
+    /// What to optimise. Default [`Objective::Fit`].
+    pub objective: Objective,
+    /// Keep the supports at the mesh's heights instead of letting the thrust meet each
+    /// support anywhere within the envelope. Default false.
+    pub fixed_supports: bool,
+    /// Weight per unit volume of the masonry: a face weighs area × thickness × unit weight.
+    /// 0: no self-weight, the problem's extra loads alone (loads given per vertex). Default 1.
+    pub unit_weight: f64,
+    /// How a face's weight is shared among its corners (on the middle surface). Default
+    /// barycentric.
+    pub load_rule: LoadRule,
+    /// Downward load per vertex for [`Objective::MaxLoad`], multiplied by λ; ignored
+    /// otherwise. Default none.
+    pub load_pattern: Option<Vec<f64>>,
+    /// Lower bound on the force densities (compression only: 0). Default `Absolute(0)`.
+    pub q_min: QBound,
+    /// Largest ε∞ (relative to the mean load) of a certified surface. Default 1e-6.
+    pub tolerance: f64,
+    /// Sequential QP iterations at most. Default 200.
+    pub max_iterations: usize,
+}
+
+impl Default for AssessSettings {
+    fn default() -> Self {
+        AssessSettings {
+            objective: Objective::Fit,
+            fixed_supports: false,
+            unit_weight: 1.0,
+            load_rule: LoadRule::Barycentric,
+            load_pattern: None,
+            q_min: QBound::Absolute(0.0),
+            tolerance: 1e-6,
+            max_iterations: 200,
+        }
+    }
+}
+
+impl AssessSettings {
+    /// Checks every setting; errors name it.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name: &'static str, reason: String| Err(Error::InvalidArgument { name, reason });
+        if !(self.unit_weight.is_finite() && self.unit_weight >= 0.0) {
+            return bad(
+                "unit_weight",
+                format!("{} is not a finite number >= 0", self.unit_weight),
+            );
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return bad("tolerance", format!("{} is not in (0, 1)", self.tolerance));
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", "must be at least 1".into());
+        }
+        let q = match self.q_min {
+            QBound::Absolute(q) | QBound::Relative(q) => q,
+        };
+        if !(q.is_finite() && q >= 0.0) {
+            return bad("q_min", format!("{q} is not a finite number >= 0"));
+        }
+        if let Some(pattern) = &self.load_pattern {
+            if let Some(v) = pattern.iter().position(|p| !p.is_finite()) {
+                return bad(
+                    "load_pattern",
+                    format!("vertex {v} has {}, not a finite number", pattern[v]),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// These settings with `load_pattern` set to `pattern`.
+    #[must_use]
+    pub fn with_load_pattern(mut self, pattern: Vec<f64>) -> Self {
+        self.load_pattern = Some(pattern);
+        self
+    }
+}
+
+crate::setters::with_setters!(AssessSettings {
+    with_objective: objective: Objective,
+    with_fixed_supports: fixed_supports: bool,
+    with_unit_weight: unit_weight: f64,
+    with_load_rule: load_rule: LoadRule,
+    with_q_min: q_min: QBound,
+    with_tolerance: tolerance: f64,
+    with_max_iterations: max_iterations: usize,
+});
+
+/// The outcome of [`assess`], in physical units.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct AssessResult {
+    /// The analysis that was run.
+    pub objective: Objective,
+    /// True when `positions` with `force_densities` is a certified thrust surface: ε∞ <
+    /// tolerance, every q within its bounds (q ≥ 0), and every height within
+    /// `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal.
+    pub feasible: bool,
+    /// Converged; or how the search ended (the best state reached is returned).
+    pub termination: Termination,
+    /// Sequential QP iterations (the starting `fit` search's included).
+    pub iterations: usize,
+    /// The thrust surface: the mesh's plan with the found heights.
+    pub positions: Vec<[f64; 3]>,
+    /// Force density per mesh edge (compression positive).
+    pub force_densities: Vec<f64>,
+    /// Vertical load per vertex: self-weight plus extra loads plus λ × pattern.
+    pub loads: Vec<f64>,
+    /// Vertical residual per vertex (0 at supports).
+    pub residuals: Vec<f64>,
+    /// max |r| / mean load over the non-anchored vertices.
+    pub eps_inf: f64,
+    /// Largest horizontal imbalance at a non-anchored vertex over the mean load.
+    pub horizontal_imbalance: f64,
+    /// Lower bound per vertex: the envelope at the reported thickness (scaled by
+    /// `thickness_scale`).
+    pub lower: Vec<f64>,
+    /// Upper bound per vertex, likewise.
+    pub upper: Vec<f64>,
+    /// Scale of the envelope's half extents: 1, or the least scale found by
+    /// [`Objective::MinThickness`].
+    pub thickness_scale: f64,
+    /// 1 / `thickness_scale`: the geometric safety factor of a minimum-thickness analysis.
+    pub safety_factor: f64,
+    /// Horizontal reaction per vertex (non-zero at supports): the force the vault pushes
+    /// the support with.
+    pub reactions: Vec<[f64; 2]>,
+    /// Σ over supports of |reaction|.
+    pub thrust_horizontal: f64,
+    /// λ of [`Objective::MaxLoad`] (0 otherwise).
+    pub load_factor: f64,
+    /// The largest excess of a height over its bound (0 when inside) and its vertex.
+    pub worst_bound: (f64, Option<u32>),
+    /// The largest residual's vertex (None when there is no non-anchored vertex).
+    pub worst_residual_vertex: Option<u32>,
+    /// When an analysis other than the least thickness found no certified surface: the
+    /// least thickness scale at which one was found (above 1: the envelope is too thin), and
+    /// the vertex where that surface leaves the given envelope the most. None otherwise.
+    pub needed_scale: Option<(f64, Option<u32>)>,
+    /// Wall time, seconds.
+    pub seconds: f64,
+}
+
+/// Finds a certified thrust surface inside `envelope` for `settings.objective`.
+///
+/// `problem` gives the mesh (its plan is the form diagram; with fixed supports its anchored
+/// heights), the extra point loads and prescribed horizontal forces; its face densities are
+/// replaced by the envelope's thickness × `unit_weight` on the middle surface. Without a
+/// certified surface the result has `feasible == false` with the best state reached (least
+/// infeasibility) and where it fails.
+pub fn assess(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+    progress: Option<&mut Progress>,
+) -> Result<AssessResult> {
+    settings.validate()?;
+    let model = model::Model::new(problem, envelope, settings)?;
+    let (from, fit_iterations) = feasible_start(problem, envelope, settings)?;
+    let mut run = sqp::solve(&model, settings, progress, from)?;
+    run.iterations += fit_iterations;
+    let mut result = model.certify(run, settings);
+    let cancelled = result.termination == Termination::Cancelled;
+    if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {
+        result.needed_scale = needed_scale(problem, envelope, settings)?;
+    }
+    Ok(result)
+}
+
+/// For every analysis but `fit`: the `fit` search's answer, a surface inside the envelope
+/// (when one is found), to start from, so that the objective is pursued from equilibrium
+/// rather than traded against it; and the steps it took.
+fn feasible_start(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+) -> Result<(Option<model::State>, usize)> {
+    if settings.objective == Objective::Fit {
+        return Ok((None, 0));
+    }
+    let fit = AssessSettings {
+        objective: Objective::Fit,
+        load_pattern: None,
+        ..settings.clone()
+    };
+    let model = model::Model::new(problem, envelope, &fit)?;
+    let run = sqp::solve(&model, &fit, None, None)?;
+    Ok((Some(run.state), run.iterations))
+}
+
+/// The least thickness scale with a certified surface, and where that surface leaves the
+/// envelope at scale 1 the most.
+fn needed_scale(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+) -> Result<Option<(f64, Option<u32>)>> {
+    let thinnest = AssessSettings {
+        objective: Objective::MinThickness,
+        ..settings.clone()
+    };
+    let model = model::Model::new(problem, envelope, &thinnest)?;
+    let (from, _) = feasible_start(problem, envelope, &thinnest)?;
+    let run = sqp::solve(&model, &thinnest, None, from)?;
+    let found = model.certify(run, &thinnest);
+    if !found.feasible {
+        return Ok(None);
+    }
+    let outside = (0..found.positions.len())
+        .filter(|&v| problem.mesh.referenced[v])
+        .map(|v| {
+            let z = found.positions[v][2];
+            ((envelope.lower[v] - z).max(z - envelope.upper[v]), v as u32)
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .filter(|(excess, _)| *excess > 0.0)
+        .map(|(_, v)| v);
+    Ok(Some((found.thickness_scale, outside)))
+}

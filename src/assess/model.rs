@@ -1,0 +1,464 @@
+//! The assessment problem in frame units (docs/method.md §1: z′ = z/L₀, p′ = p/p̄,
+//! q′ = q L₀/p̄): fixed loads from the envelope, the bounds, the stress constraints, and the
+//! functions of a state (residuals, objective, reactions); and the certificate of a run.
+
+use super::envelope::Envelope;
+use super::{AssessResult, AssessSettings, Objective};
+use crate::error::{Error, Result};
+use crate::geometry::loads;
+use crate::problem::Problem;
+use crate::solve::Termination;
+use crate::stress::linear::LinearStress;
+use crate::stress::{equilibrium, StressSettings, TauMode};
+
+/// A point of the search, in frame units.
+#[derive(Debug, Clone)]
+pub(super) struct State {
+    /// Stress unknowns: q = S y.
+    pub y: Vec<f64>,
+    /// Force density per mesh edge (0 on edges without force).
+    pub q: Vec<f64>,
+    /// Height per vertex.
+    pub z: Vec<f64>,
+    /// The objective's scalar: the thickness scale s or the load factor λ (else unused).
+    pub t: f64,
+}
+
+pub(super) struct Model<'a> {
+    pub problem: &'a Problem,
+    pub objective: Objective,
+    pub stress: LinearStress,
+    pub p_bar: f64,
+    pub l0: f64,
+    /// Physical self-weight plus extra loads, and the live pattern, per vertex.
+    pub dead_physical: Vec<f64>,
+    pub live_physical: Vec<f64>,
+    /// Frame loads per vertex.
+    pub dead: Vec<f64>,
+    pub live: Vec<f64>,
+    /// Frame middle heights and half extents per vertex.
+    pub middle: Vec<f64>,
+    pub half: Vec<f64>,
+    /// Frame heights of the start (the middle surface; the mesh's at fixed supports).
+    pub z_start: Vec<f64>,
+    /// Per vertex: its height is an unknown.
+    pub variable: Vec<bool>,
+    /// Vertices with a vertical equation (referenced, not anchored).
+    pub residual: Vec<u32>,
+    /// Referenced anchored vertices.
+    pub supports: Vec<u32>,
+    /// Per edge with force and exactly one anchored end: (edge, anchored end, other end).
+    pub support_edges: Vec<(usize, u32, u32)>,
+    /// Plan area share per vertex whose height is an unknown (summing to 1).
+    pub area: Vec<f64>,
+    /// Σ of the frame dead loads: the unit of thrust.
+    pub total_load: f64,
+    /// Edge ids around each vertex.
+    pub incident: Vec<Vec<u32>>,
+}
+
+impl<'a> Model<'a> {
+    pub fn new(
+        problem: &'a Problem,
+        envelope: &Envelope,
+        settings: &AssessSettings,
+    ) -> Result<Model<'a>> {
+        let mesh = &problem.mesh;
+        let n = mesh.positions.len();
+        check_lengths(problem, envelope)?;
+        let middle_positions = envelope.middle_positions(mesh);
+        let density: Vec<f64> = (envelope.face_thickness.iter())
+            .map(|t| t * settings.unit_weight)
+            .collect();
+        let dead_physical = loads::vertex_loads(
+            mesh,
+            &middle_positions,
+            settings.load_rule,
+            &density,
+            &problem.extra_loads,
+        );
+        let live_physical = live_pattern(problem, settings)?;
+        let residual = crate::stress::non_anchored(mesh);
+        let p_bar = mean_load(&dead_physical, &residual)?;
+        let stress_settings = StressSettings {
+            q_min: settings.q_min,
+            tau: TauMode::Zero,
+            ..StressSettings::default()
+        };
+        let stress = LinearStress::new(problem, &middle_positions, &stress_settings, p_bar)?;
+        let l0 = stress.frame.scale;
+        let supports: Vec<u32> = (0..n as u32)
+            .filter(|&v| mesh.referenced[v as usize] && mesh.anchored[v as usize])
+            .collect();
+        let variable: Vec<bool> = (0..n)
+            .map(|v| mesh.referenced[v] && !(settings.fixed_supports && mesh.anchored[v]))
+            .collect();
+        let z_start: Vec<f64> = (0..n)
+            .map(|v| {
+                let z = if variable[v] {
+                    envelope.middle[v]
+                } else {
+                    mesh.positions[v][2]
+                };
+                z / l0
+            })
+            .collect();
+        let incident = (0..n)
+            .map(|v| {
+                let (a, b) = (mesh.vertex_edge_start[v], mesh.vertex_edge_start[v + 1]);
+                mesh.vertex_edges[a as usize..b as usize].to_vec()
+            })
+            .collect();
+        let model = Model {
+            problem,
+            objective: settings.objective,
+            p_bar,
+            l0,
+            dead: dead_physical.iter().map(|p| p / p_bar).collect(),
+            live: live_physical.iter().map(|p| p / p_bar).collect(),
+            dead_physical,
+            live_physical,
+            middle: envelope.middle.iter().map(|m| m / l0).collect(),
+            half: envelope.half_extent().iter().map(|h| h / l0).collect(),
+            z_start,
+            support_edges: support_edges(problem, &stress),
+            area: area_shares(problem, &stress, &variable),
+            total_load: 0.0,
+            variable,
+            residual,
+            supports,
+            incident,
+            stress,
+        };
+        model.check_fixed_supports(settings)?;
+        Ok(Model {
+            total_load: model.residual.iter().map(|&v| model.dead[v as usize]).sum(),
+            ..model
+        })
+    }
+
+    /// Fixed supports must lie inside the envelope (at any scale, for the least thickness).
+    fn check_fixed_supports(&self, settings: &AssessSettings) -> Result<()> {
+        if !settings.fixed_supports {
+            return Ok(());
+        }
+        for &a in &self.supports {
+            let a = a as usize;
+            let excess = (self.z_start[a] - self.middle[a]).abs() - self.half[a];
+            let slack = if self.objective == Objective::MinThickness {
+                f64::INFINITY
+            } else {
+                1e-12
+            };
+            if excess > slack || (self.half[a] == 0.0 && excess > 1e-12) {
+                return Err(Error::InvalidArgument {
+                    name: "fixed_supports",
+                    reason: format!(
+                        "support vertex {a} at height {} lies outside the envelope [{}, {}]",
+                        self.z_start[a] * self.l0,
+                        (self.middle[a] - self.half[a]) * self.l0,
+                        (self.middle[a] + self.half[a]) * self.l0
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The scale of the half extents at `state`.
+    pub fn scale(&self, state: &State) -> f64 {
+        if self.objective == Objective::MinThickness {
+            state.t
+        } else {
+            1.0
+        }
+    }
+
+    /// Frame load at vertex v.
+    pub fn load(&self, state: &State, v: usize) -> f64 {
+        if self.objective == Objective::MaxLoad {
+            self.dead[v] + state.t * self.live[v]
+        } else {
+            self.dead[v]
+        }
+    }
+
+    /// Vertical residual c_i = Σ q_e (z_i − z_j) − p_i per vertex of `residual`.
+    pub fn residuals(&self, state: &State) -> Vec<f64> {
+        let edges = &self.problem.mesh.edges;
+        (self.residual.iter())
+            .map(|&i| {
+                let i = i as usize;
+                let sum: f64 = (self.incident[i].iter())
+                    .map(|&e| {
+                        let j = other_end(edges[e as usize].v, i);
+                        state.q[e as usize] * (state.z[i] - state.z[j])
+                    })
+                    .sum();
+                sum - self.load(state, i)
+            })
+            .collect()
+    }
+
+    /// Horizontal reaction per vertex (frame; non-zero at supports).
+    pub fn reactions(&self, q: &[f64]) -> Vec<[f64; 2]> {
+        let u = &self.stress.plan.u;
+        let mut r = vec![[0.0; 2]; u.len()];
+        for &(e, a, j) in &self.support_edges {
+            let (a, j) = (a as usize, j as usize);
+            for d in 0..2 {
+                r[a][d] += q[e] * (u[a][d] - u[j][d]);
+            }
+        }
+        r
+    }
+
+    /// Σ |reaction| over the supports, over the total load.
+    pub fn thrust(&self, q: &[f64]) -> f64 {
+        let r = self.reactions(q);
+        let sum: f64 = (self.supports.iter())
+            .map(|&a| r[a as usize][0].hypot(r[a as usize][1]))
+            .sum();
+        sum / self.total_load
+    }
+
+    /// The objective f at `state` (lower is better).
+    pub fn objective_value(&self, state: &State) -> f64 {
+        match self.objective {
+            Objective::Fit => (0..state.z.len())
+                .filter(|&v| self.variable[v])
+                .map(|v| self.area[v] * (state.z[v] - self.middle[v]).powi(2))
+                .sum(),
+            Objective::MinThickness => state.t,
+            Objective::MinThrust => self.thrust(&state.q),
+            Objective::MaxThrust => -self.thrust(&state.q),
+            Objective::MaxLoad => -state.t,
+        }
+    }
+
+    /// The certificate of the run's state, in physical units.
+    pub fn certify(&self, run: Run, settings: &AssessSettings) -> AssessResult {
+        let mesh = &self.problem.mesh;
+        let state = &run.state;
+        let n = mesh.positions.len();
+        let positions: Vec<[f64; 3]> = (0..n)
+            .map(|v| {
+                let p = mesh.positions[v];
+                if mesh.referenced[v] {
+                    [p[0], p[1], state.z[v] * self.l0]
+                } else {
+                    p
+                }
+            })
+            .collect();
+        let unit = self.p_bar / self.l0;
+        let force_densities: Vec<f64> = state.q.iter().map(|q| q * unit).collect();
+        let lambda = if self.objective == Objective::MaxLoad {
+            state.t
+        } else {
+            0.0
+        };
+        let loads: Vec<f64> = (self.dead_physical.iter().zip(&self.live_physical))
+            .map(|(d, l)| d + lambda * l)
+            .collect();
+        let external: Vec<[f64; 2]> = (self.stress.external.iter())
+            .map(|f| [f[0] * self.p_bar, f[1] * self.p_bar])
+            .collect();
+        let (residuals, imbalance) =
+            equilibrium(mesh, &positions, &force_densities, &loads, &external);
+        let mean = self.p_bar;
+        let (worst_residual_vertex, max_r) = (self.residual.iter())
+            .map(|&v| (v, residuals[v as usize].abs()))
+            .fold((None, 0.0), |(bv, bm), (v, m)| {
+                if m > bm || bv.is_none() {
+                    (Some(v), m)
+                } else {
+                    (bv, bm)
+                }
+            });
+        let horizontal = (self.residual.iter())
+            .map(|&v| imbalance[v as usize][0].hypot(imbalance[v as usize][1]))
+            .fold(0.0, f64::max);
+        let s = self.scale(state);
+        let lower: Vec<f64> = (0..n)
+            .map(|v| (self.middle[v] - s * self.half[v]) * self.l0)
+            .collect();
+        let upper: Vec<f64> = (0..n)
+            .map(|v| (self.middle[v] + s * self.half[v]) * self.l0)
+            .collect();
+        let worst_bound = worst_bound(mesh, &positions, &lower, &upper);
+        let q_ok = (self.stress.bounds.iter().zip(&force_densities))
+            .all(|(b, q)| b.is_none_or(|(lo, hi)| *q >= lo * unit && *q <= hi * unit));
+        let eps_inf = max_r / mean;
+        let diag = 2.0 * self.l0;
+        let reactions: Vec<[f64; 2]> = (self.reactions(&state.q).iter())
+            .map(|r| [r[0] * self.p_bar, r[1] * self.p_bar])
+            .collect();
+        let thrust_horizontal = (self.supports.iter())
+            .map(|&a| reactions[a as usize][0].hypot(reactions[a as usize][1]))
+            .sum();
+        AssessResult {
+            objective: self.objective,
+            feasible: eps_inf < settings.tolerance && q_ok && worst_bound.0 <= 1e-9 * diag,
+            termination: run.termination,
+            iterations: run.iterations,
+            positions,
+            force_densities,
+            loads,
+            residuals,
+            eps_inf,
+            horizontal_imbalance: horizontal / mean,
+            lower,
+            upper,
+            thickness_scale: s,
+            safety_factor: 1.0 / s,
+            reactions,
+            thrust_horizontal,
+            load_factor: lambda,
+            worst_bound,
+            worst_residual_vertex,
+            needed_scale: None,
+            seconds: run.seconds,
+        }
+    }
+}
+
+pub(super) fn other_end(v: [u32; 2], i: usize) -> usize {
+    if v[0] as usize == i {
+        v[1] as usize
+    } else {
+        v[0] as usize
+    }
+}
+
+fn check_lengths(problem: &Problem, envelope: &Envelope) -> Result<()> {
+    let mesh = &problem.mesh;
+    let n = mesh.positions.len();
+    for (name, len, want) in [
+        ("envelope", envelope.lower.len(), n),
+        ("envelope", envelope.upper.len(), n),
+        ("envelope", envelope.middle.len(), n),
+        ("envelope", envelope.face_thickness.len(), mesh.faces.len()),
+    ] {
+        if len != want {
+            return Err(Error::InvalidArgument {
+                name,
+                reason: format!("was built for another mesh: {len} entries, expected {want}"),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn live_pattern(problem: &Problem, settings: &AssessSettings) -> Result<Vec<f64>> {
+    let n = problem.mesh.positions.len();
+    match (&settings.load_pattern, settings.objective) {
+        (Some(p), _) if p.len() != n => Err(Error::InvalidArgument {
+            name: "load_pattern",
+            reason: format!("has {} entries, expected one per vertex ({n})", p.len()),
+        }),
+        (Some(p), Objective::MaxLoad) => {
+            let free = crate::stress::non_anchored(&problem.mesh);
+            if free.iter().all(|&v| p[v as usize] == 0.0) {
+                return Err(Error::InvalidArgument {
+                    name: "load_pattern",
+                    reason: "is 0 on every non-anchored vertex: there is no load to multiply"
+                        .into(),
+                });
+            }
+            Ok(p.clone())
+        }
+        (None, Objective::MaxLoad) => Err(Error::InvalidArgument {
+            name: "load_pattern",
+            reason: "the max-load analysis needs a load pattern (one load per vertex)".into(),
+        }),
+        _ => Ok(vec![0.0; n]),
+    }
+}
+
+fn mean_load(load: &[f64], free: &[u32]) -> Result<f64> {
+    if free.is_empty() {
+        return Err(Error::InvalidArgument {
+            name: "supports",
+            reason: "every vertex is anchored: there is no vault to assess".into(),
+        });
+    }
+    let mean = free.iter().map(|&v| load[v as usize]).sum::<f64>() / free.len() as f64;
+    if !(mean.is_finite() && mean > 0.0) {
+        return Err(Error::InvalidArgument {
+            name: "loads",
+            reason: format!(
+                "the self-weight and extra loads on the non-anchored vertices average {mean:e}: \
+                 a masonry vault stands under a positive downward load"
+            ),
+        });
+    }
+    Ok(mean)
+}
+
+fn support_edges(problem: &Problem, stress: &LinearStress) -> Vec<(usize, u32, u32)> {
+    let mesh = &problem.mesh;
+    (mesh.edges.iter().enumerate())
+        .filter(|(e, _)| stress.bounds[*e].is_some())
+        .filter_map(|(e, edge)| {
+            let [a, b] = edge.v;
+            match (mesh.anchored[a as usize], mesh.anchored[b as usize]) {
+                (true, false) => Some((e, a, b)),
+                (false, true) => Some((e, b, a)),
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+/// A third of each face's plan area per corner, over the vertices whose height is an
+/// unknown, normalised to sum 1.
+fn area_shares(problem: &Problem, stress: &LinearStress, variable: &[bool]) -> Vec<f64> {
+    let mesh = &problem.mesh;
+    let mut a = vec![0.0; variable.len()];
+    for (t, f) in mesh.faces.iter().enumerate() {
+        for &v in f {
+            if variable[v as usize] {
+                a[v as usize] += stress.plan.area[t] / 3.0;
+            }
+        }
+    }
+    let total: f64 = a.iter().sum();
+    if total > 0.0 {
+        a.iter_mut().for_each(|x| *x /= total);
+    }
+    a
+}
+
+/// The largest excess of a height over its bound (0 when all are inside) and its vertex.
+fn worst_bound(
+    mesh: &crate::mesh::Mesh,
+    positions: &[[f64; 3]],
+    lower: &[f64],
+    upper: &[f64],
+) -> (f64, Option<u32>) {
+    (0..positions.len())
+        .filter(|&v| mesh.referenced[v])
+        .map(|v| {
+            let z = positions[v][2];
+            ((lower[v] - z).max(z - upper[v]), v as u32)
+        })
+        .fold(
+            (0.0, None),
+            |(bm, bv), (m, v)| {
+                if m > bm {
+                    (m, Some(v))
+                } else {
+                    (bm, bv)
+                }
+            },
+        )
+}
+
+/// What the search (`sqp::solve`) returns: the best state reached and how it ended.
+pub(super) struct Run {
+    pub state: State,
+    pub termination: Termination,
+    pub iterations: usize,
+    pub seconds: f64,
+}

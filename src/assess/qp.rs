@@ -1,0 +1,454 @@
+//! One step of the sequential QP (docs/method.md §16.3): the objective's model plus a
+//! proximal term, the vertical residuals linearised with elastic slacks e⁺, e⁻ priced at ν
+//! (the exact ℓ1 penalty), and every linear constraint exact: q = S y, horizontal balance,
+//! force-density bounds, the envelope and, for the least thrust, a second-order cone per
+//! support. Solved by clarabel.
+
+use super::model::{other_end, Model, State};
+use super::Objective;
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+/// Columns of the step's unknowns.
+pub(super) struct Layout {
+    n_y: usize,
+    /// Column of dq_e per edge with force.
+    q_col: Vec<Option<usize>>,
+    /// Column of dz_v per vertex whose height is an unknown.
+    z_col: Vec<Option<usize>>,
+    /// Column of the objective's scalar step.
+    t_col: Option<usize>,
+    /// First columns of e⁺ and e⁻ (one per residual vertex).
+    e_plus: usize,
+    e_minus: usize,
+    /// First column of the thrust bounds h_a (least thrust), one per support.
+    h_start: usize,
+    n: usize,
+}
+
+impl Layout {
+    pub fn new(model: &Model) -> Layout {
+        let n_y = model.stress.s().ncols;
+        let mut n = n_y;
+        let mut next = |take: bool| {
+            take.then(|| {
+                n += 1;
+                n - 1
+            })
+        };
+        let q_col: Vec<Option<usize>> = (model.stress.bounds.iter())
+            .map(|b| next(b.is_some()))
+            .collect();
+        let z_col: Vec<Option<usize>> = model.variable.iter().map(|&v| next(v)).collect();
+        let t_col = next(matches!(
+            model.objective,
+            Objective::MinThickness | Objective::MaxLoad
+        ));
+        let n_r = model.residual.len();
+        let e_plus = n;
+        let e_minus = n + n_r;
+        let h_start = n + 2 * n_r;
+        let n_h = if model.objective == Objective::MinThrust {
+            model.supports.len()
+        } else {
+            0
+        };
+        Layout {
+            n_y,
+            q_col,
+            z_col,
+            t_col,
+            e_plus,
+            e_minus,
+            h_start,
+            n: h_start + n_h,
+        }
+    }
+}
+
+/// A step's inputs: the proximal weight ρ, the penalty ν and, for a second-order correction,
+/// the bilinear term of the rejected trial step per residual row.
+pub(super) struct StepInput<'a> {
+    /// ρ on the force densities and on the heights (and the scalar).
+    pub rho: f64,
+    pub rho_z: f64,
+    pub nu: f64,
+    pub correction: Option<&'a [f64]>,
+}
+
+/// A step and its model's figures.
+pub(super) struct Step {
+    pub dy: Vec<f64>,
+    /// Per edge (0 where no force).
+    pub dq: Vec<f64>,
+    /// Per vertex (0 where the height is fixed).
+    pub dz: Vec<f64>,
+    pub dt: f64,
+    /// Σ (e⁺ + e⁻): the linearised ℓ1 infeasibility after the step.
+    pub slack: f64,
+    /// The objective's model at the step.
+    pub model_objective: f64,
+    /// Multipliers μ of the residual rows (|μ| ≤ ν).
+    pub multipliers: Vec<f64>,
+}
+
+#[derive(Default)]
+struct Triplets {
+    i: Vec<usize>,
+    j: Vec<usize>,
+    v: Vec<f64>,
+}
+
+impl Triplets {
+    fn push(&mut self, i: usize, j: usize, v: f64) {
+        if v != 0.0 {
+            self.i.push(i);
+            self.j.push(j);
+            self.v.push(v);
+        }
+    }
+}
+
+/// Rows A x + s = b in cone order: zero, non-negative, then second-order cones of size 3.
+struct Rows {
+    a: Triplets,
+    b: Vec<f64>,
+    n_zero: usize,
+    n_nonneg: usize,
+    n_soc: usize,
+}
+
+impl Rows {
+    fn next(&self) -> usize {
+        self.b.len()
+    }
+}
+
+pub(super) fn solve_step(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    input: &StepInput,
+) -> Option<Step> {
+    let (p, c) = objective(model, layout, state, input);
+    let mut rows = Rows {
+        a: Triplets::default(),
+        b: Vec::new(),
+        n_zero: 0,
+        n_nonneg: 0,
+        n_soc: 0,
+    };
+    force_rows(model, layout, state, &mut rows);
+    vertical_rows(model, layout, state, input.correction, &mut rows);
+    horizontal_rows(model, layout, state, &mut rows);
+    rows.n_zero = rows.next();
+    bound_rows(model, layout, state, &mut rows);
+    rows.n_nonneg = rows.next() - rows.n_zero;
+    thrust_cones(model, layout, state, &mut rows);
+    rows.n_soc = (rows.next() - rows.n_zero - rows.n_nonneg) / 3;
+    let first_residual_row = layout.q_col.iter().flatten().count();
+    let (x, z) = run_clarabel(layout.n, p, &c, rows)?;
+    let multipliers = z[first_residual_row..first_residual_row + model.residual.len()].to_vec();
+    let mut step = read_step(model, layout, state, &x);
+    step.multipliers = multipliers;
+    Some(step)
+}
+
+/// ½ dᵀ P d + cᵀ d: the proximal term ρ (Σ dz² + Σ l² dq² + dt²), the objective's model and
+/// the penalty ν Σ (e⁺ + e⁻).
+fn objective(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    input: &StepInput,
+) -> (Triplets, Vec<f64>) {
+    let mut p = Triplets::default();
+    let mut c = vec![0.0; layout.n];
+    let (rho, rho_z) = (input.rho, input.rho_z);
+    for (e, col) in layout.q_col.iter().enumerate() {
+        if let Some(col) = col {
+            let l = model.stress.plan.length[e];
+            p.push(*col, *col, 2.0 * rho * l * l);
+        }
+    }
+    for (v, col) in layout.z_col.iter().enumerate() {
+        if let Some(col) = col {
+            let mut diag = 2.0 * rho_z;
+            if model.objective == Objective::Fit {
+                diag += 2.0 * model.area[v];
+                c[*col] = 2.0 * model.area[v] * (state.z[v] - model.middle[v]);
+            }
+            p.push(*col, *col, diag);
+        }
+    }
+    if let Some(t) = layout.t_col {
+        p.push(t, t, 2.0 * rho_z);
+        c[t] = if model.objective == Objective::MinThickness {
+            1.0
+        } else {
+            -1.0
+        };
+    }
+    for k in 0..model.residual.len() {
+        c[layout.e_plus + k] = input.nu;
+        c[layout.e_minus + k] = input.nu;
+    }
+    match model.objective {
+        Objective::MinThrust => {
+            for k in 0..model.supports.len() {
+                c[layout.h_start + k] = 1.0 / model.total_load;
+            }
+        }
+        Objective::MaxThrust => {
+            for (col, g) in thrust_gradient(model, state) {
+                c[layout.q_col[col].expect("support edges carry force")] -= g;
+            }
+        }
+        _ => {}
+    }
+    (p, c)
+}
+
+/// ∂(thrust)/∂q_e per support edge e, thrust = Σ |H_a| / W; where H_a = 0 the direction of
+/// the edges' plan vectors stands in for the unit reaction.
+fn thrust_gradient(model: &Model, state: &State) -> Vec<(usize, f64)> {
+    let r = model.reactions(&state.q);
+    let u = &model.stress.plan.u;
+    let mut fallback = vec![[0.0; 2]; u.len()];
+    for &(_, a, j) in &model.support_edges {
+        let (a, j) = (a as usize, j as usize);
+        fallback[a] = [
+            fallback[a][0] + u[a][0] - u[j][0],
+            fallback[a][1] + u[a][1] - u[j][1],
+        ];
+    }
+    (model.support_edges.iter())
+        .map(|&(e, a, j)| {
+            let (a, j) = (a as usize, j as usize);
+            let dir = if r[a][0].hypot(r[a][1]) > 1e-12 {
+                r[a]
+            } else {
+                fallback[a]
+            };
+            let len = dir[0].hypot(dir[1]).max(f64::MIN_POSITIVE);
+            let g = (dir[0] * (u[a][0] - u[j][0]) + dir[1] * (u[a][1] - u[j][1])) / len;
+            (e, g / model.total_load)
+        })
+        .collect()
+}
+
+/// dq_e − S_e dy = S_e y − q_e for every edge with force.
+fn force_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    let s = model.stress.s();
+    for (e, col) in layout.q_col.iter().enumerate() {
+        let Some(col) = col else { continue };
+        let row = rows.next();
+        rows.a.push(row, *col, 1.0);
+        let mut sy = 0.0;
+        for (c, v) in s.row(e) {
+            rows.a.push(row, c, -v);
+            sy += v * state.y[c];
+        }
+        rows.b.push(sy - state.q[e]);
+    }
+}
+
+/// The linearised vertical residual with its elastic slacks:
+/// Σ (z_i − z_j) dq_e + Σ q_e (dz_i − dz_j) − ∂p_i/∂t dt − e⁺ + e⁻ = −c_i (− correction).
+fn vertical_rows(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    correction: Option<&[f64]>,
+    rows: &mut Rows,
+) {
+    let c = model.residuals(state);
+    let edges = &model.problem.mesh.edges;
+    for (k, &i) in model.residual.iter().enumerate() {
+        let i = i as usize;
+        let row = rows.next();
+        for &e in &model.incident[i] {
+            let e = e as usize;
+            let Some(qc) = layout.q_col[e] else { continue };
+            let j = other_end(edges[e].v, i);
+            rows.a.push(row, qc, state.z[i] - state.z[j]);
+            if let Some(zc) = layout.z_col[i] {
+                rows.a.push(row, zc, state.q[e]);
+            }
+            if let Some(zc) = layout.z_col[j] {
+                rows.a.push(row, zc, -state.q[e]);
+            }
+        }
+        if let (Some(t), Objective::MaxLoad) = (layout.t_col, model.objective) {
+            rows.a.push(row, t, -model.live[i]);
+        }
+        rows.a.push(row, layout.e_plus + k, -1.0);
+        rows.a.push(row, layout.e_minus + k, 1.0);
+        rows.b.push(-c[k] - correction.map_or(0.0, |x| x[k]));
+    }
+}
+
+/// Horizontal balance at the free boundary vertices: Σ (u_v − u_j) dq_e = −(its imbalance).
+fn horizontal_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    let edges = &model.problem.mesh.edges;
+    let u = &model.stress.plan.u;
+    for &v in &model.stress.balance {
+        let v = v as usize;
+        for (d, &external) in model.stress.external[v].iter().enumerate() {
+            let row = rows.next();
+            let mut imbalance = external;
+            for &e in &model.incident[v] {
+                let e = e as usize;
+                let Some(qc) = layout.q_col[e] else { continue };
+                let du = u[v][d] - u[other_end(edges[e].v, v)][d];
+                rows.a.push(row, qc, du);
+                imbalance += state.q[e] * du;
+            }
+            rows.b.push(-imbalance);
+        }
+    }
+}
+
+/// Force-density bounds, the envelope (scaled by s + ds for the least thickness), e± ≥ 0
+/// and s ≥ 0, as rows A d ≤ b.
+fn bound_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    for (e, bound) in model.stress.bounds.iter().enumerate() {
+        let (Some((lo, hi)), Some(col)) = (bound, layout.q_col[e]) else {
+            continue;
+        };
+        let row = rows.next();
+        rows.a.push(row, col, -1.0);
+        rows.b.push(state.q[e] - lo);
+        if hi.is_finite() {
+            let row = rows.next();
+            rows.a.push(row, col, 1.0);
+            rows.b.push(hi - state.q[e]);
+        }
+    }
+    let thickness = model.objective == Objective::MinThickness;
+    let s = model.scale(state);
+    let mesh = &model.problem.mesh;
+    for v in (0..state.z.len()).filter(|&v| mesh.referenced[v]) {
+        let zc = layout.z_col[v];
+        if zc.is_none() && !thickness {
+            continue;
+        }
+        let (m, h, z) = (model.middle[v], model.half[v], state.z[v]);
+        for (sign, b) in [(-1.0, z - m + s * h), (1.0, m + s * h - z)] {
+            let row = rows.next();
+            if let Some(zc) = zc {
+                rows.a.push(row, zc, sign);
+            }
+            if let (true, Some(t)) = (thickness, layout.t_col) {
+                rows.a.push(row, t, -h);
+            }
+            rows.b.push(b);
+        }
+    }
+    for k in 0..2 * model.residual.len() {
+        let row = rows.next();
+        rows.a.push(row, layout.e_plus + k, -1.0);
+        rows.b.push(0.0);
+    }
+    if let (true, Some(t)) = (thickness, layout.t_col) {
+        let row = rows.next();
+        rows.a.push(row, t, -1.0);
+        rows.b.push(state.t);
+    }
+}
+
+/// The least thrust: h_a ≥ |H_a + dH_a| per support, a second-order cone of size 3.
+fn thrust_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    if model.objective != Objective::MinThrust {
+        return;
+    }
+    let r = model.reactions(&state.q);
+    let u = &model.stress.plan.u;
+    let mut first_row = vec![usize::MAX; u.len()];
+    for (k, &a) in model.supports.iter().enumerate() {
+        let row = rows.next();
+        first_row[a as usize] = row;
+        rows.a.push(row, layout.h_start + k, -1.0);
+        rows.b.push(0.0);
+        rows.b.push(r[a as usize][0]);
+        rows.b.push(r[a as usize][1]);
+    }
+    for &(e, a, j) in &model.support_edges {
+        let (a, j) = (a as usize, j as usize);
+        let col = layout.q_col[e].expect("support edges carry force");
+        for (d, (ua, uj)) in u[a].iter().zip(&u[j]).enumerate() {
+            rows.a.push(first_row[a] + 1 + d, col, -(ua - uj));
+        }
+    }
+}
+
+fn run_clarabel(n: usize, p: Triplets, c: &[f64], rows: Rows) -> Option<(Vec<f64>, Vec<f64>)> {
+    let m = rows.b.len();
+    let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
+    let am = CscMatrix::new_from_triplets(m, n, rows.a.i, rows.a.j, rows.a.v);
+    let mut cones = vec![
+        SupportedConeT::ZeroConeT(rows.n_zero),
+        SupportedConeT::NonnegativeConeT(rows.n_nonneg),
+    ];
+    cones.extend((0..rows.n_soc).map(|_| SupportedConeT::SecondOrderConeT(3)));
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(200)
+        .tol_gap_abs(1e-10)
+        .tol_gap_rel(1e-10)
+        .tol_feas(1e-10)
+        .build()
+        .expect("static clarabel settings are valid");
+    let mut solver = DefaultSolver::new(&pm, c, &am, &rows.b, &cones, settings).ok()?;
+    solver.solve();
+    matches!(
+        solver.solution.status,
+        SolverStatus::Solved | SolverStatus::AlmostSolved
+    )
+    .then(|| (solver.solution.x.clone(), solver.solution.z.clone()))
+}
+
+fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
+    let dq: Vec<f64> = (layout.q_col.iter())
+        .map(|c| c.map_or(0.0, |c| x[c]))
+        .collect();
+    let dz: Vec<f64> = (layout.z_col.iter())
+        .map(|c| c.map_or(0.0, |c| x[c]))
+        .collect();
+    let dt = layout.t_col.map_or(0.0, |c| x[c]);
+    let n_r = model.residual.len();
+    let slack = (0..n_r)
+        .map(|k| x[layout.e_plus + k].max(0.0) + x[layout.e_minus + k].max(0.0))
+        .sum();
+    let model_objective = match model.objective {
+        Objective::Fit => (0..dz.len())
+            .filter(|&v| model.variable[v])
+            .map(|v| model.area[v] * (state.z[v] + dz[v] - model.middle[v]).powi(2))
+            .sum(),
+        Objective::MinThickness => state.t + dt,
+        Objective::MinThrust => {
+            (0..model.supports.len())
+                .map(|k| x[layout.h_start + k])
+                .sum::<f64>()
+                / model.total_load
+        }
+        Objective::MaxThrust => {
+            let g: f64 = (thrust_gradient(model, state).iter())
+                .map(|&(e, g)| g * dq[e])
+                .sum();
+            -(model.thrust(&state.q) + g)
+        }
+        Objective::MaxLoad => -(state.t + dt),
+    };
+    Step {
+        dy: x[..layout.n_y].to_vec(),
+        dq,
+        dz,
+        dt,
+        slack,
+        model_objective,
+        multipliers: Vec::new(),
+    }
+}

@@ -1,0 +1,397 @@
+//! The sequential QP of the assessment (docs/method.md §16.3): minimise the merit
+//! φ = f + ν Σ |c_i| (c the vertical residuals, exact ℓ1 penalty) by steps of `qp.rs`,
+//! damped by a proximal weight ρ (Levenberg–Marquardt): a step is accepted only when φ falls
+//! by at least a tenth of what its model predicts, else once retried with a second-order
+//! correction (the constraints are bilinear, so their second-order term is known exactly)
+//! and then ρ grows. ν grows while the linearised residuals cannot be met at its price and
+//! otherwise follows the step's multipliers (ten times the largest).
+
+use super::model::{other_end, Model, Run, State};
+use super::qp::{solve_step, Layout, Step, StepInput};
+use super::{AssessSettings, Objective};
+use crate::error::Result;
+use crate::solve::{Progress, Termination};
+use std::time::Instant;
+
+/// Accept a step when φ falls by this fraction of the predicted fall.
+const ACCEPT: f64 = 0.1;
+const RHO_START: f64 = 1e-2;
+const RHO_MIN: f64 = 1e-8;
+/// Only steps at most this damped say the objective has settled.
+const RHO_SETTLED: f64 = 1e-3;
+/// Beyond this ρ no step of the model lowers φ: the search is stationary.
+const RHO_MAX: f64 = 1e8;
+/// ν at most this factor above its start.
+const NU_RANGE: f64 = 1e8;
+/// Steps at most that bring the last state into equilibrium after the search.
+const POLISH_STEPS: usize = 30;
+/// The search holds the residuals to this fraction of the tolerance.
+const FEASIBILITY_MARGIN: f64 = 0.1;
+
+/// Runs the search from `from` (a state of a search on the same mesh and supports, its
+/// scalar reset), or from the middle surface with its best stress.
+pub(super) fn solve(
+    model: &Model,
+    settings: &AssessSettings,
+    mut progress: Option<&mut Progress>,
+    from: Option<State>,
+) -> Result<Run> {
+    let start = Instant::now();
+    let layout = Layout::new(model);
+    let mut search = Search::new(model, settings);
+    match from {
+        Some(state) => search.restart_from(state),
+        None => search.start_with_stress(&layout),
+    }
+    let mut termination = Termination::MaxIterations;
+    let mut iterations = 0;
+    while iterations < settings.max_iterations {
+        iterations += 1;
+        match search.iterate(&layout) {
+            Outcome::Continue => {}
+            Outcome::Stationary => {
+                termination = search.stationary_termination();
+                break;
+            }
+            Outcome::Converged => {
+                termination = Termination::Converged;
+                break;
+            }
+        }
+        if let Some(cb) = progress.as_deref_mut() {
+            if !cb(iterations, search.infeasibility()) {
+                termination = Termination::Cancelled;
+                break;
+            }
+        }
+    }
+    if termination != Termination::Cancelled {
+        iterations += search.polish(&layout);
+    }
+    let state = search.answer();
+    Ok(Run {
+        state,
+        termination,
+        iterations,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+enum Outcome {
+    Continue,
+    Stationary,
+    Converged,
+}
+
+struct Search<'m, 'a> {
+    model: &'m Model<'a>,
+    state: State,
+    /// max |c_i| at `state`.
+    residual: f64,
+    rho: f64,
+    nu: f64,
+    nu_max: f64,
+    feasible_below: f64,
+    /// The residual a certificate accepts (the tolerance, with a margin for recomputation).
+    certified_below: f64,
+    /// The best certified-feasible state (lowest objective) and the least infeasible one.
+    best_feasible: Option<(f64, State)>,
+    least_infeasible: (f64, State),
+    /// Objective values after the accepted steps.
+    history: Vec<f64>,
+    /// Once the objective has settled: ν stays high until the residuals meet the target.
+    polishing: bool,
+}
+
+impl<'m, 'a> Search<'m, 'a> {
+    fn new(model: &'m Model<'a>, settings: &AssessSettings) -> Self {
+        let n = model.z_start.len();
+        let state = State {
+            y: vec![0.0; model.stress.s().ncols],
+            q: vec![0.0; model.stress.bounds.len()],
+            z: model.z_start.clone(),
+            t: match model.objective {
+                Objective::MinThickness => 1.0,
+                _ => 0.0,
+            },
+        };
+        debug_assert_eq!(state.z.len(), n);
+        let nu = 10.0 / model.residual.len().max(1) as f64;
+        let residual = max_abs(&model.residuals(&state));
+        Search {
+            model,
+            least_infeasible: (residual, state.clone()),
+            state,
+            residual,
+            rho: RHO_START,
+            nu,
+            nu_max: nu * NU_RANGE,
+            feasible_below: FEASIBILITY_MARGIN * settings.tolerance,
+            certified_below: 0.5 * settings.tolerance,
+            best_feasible: None,
+            history: Vec::new(),
+            polishing: false,
+        }
+    }
+
+    /// The start: the stress that best balances the start heights (the step with the heights
+    /// held by a large proximal weight, the forces free and the residuals dear), taken
+    /// whatever the merit says: the search starts from there.
+    fn start_with_stress(&mut self, layout: &Layout) {
+        let input = StepInput {
+            rho: 1e-10,
+            rho_z: 1e8,
+            nu: 1e6,
+            correction: None,
+        };
+        if let Some(step) = solve_step(self.model, layout, &self.state, &input) {
+            self.state = self.apply(&step);
+            self.residual = max_abs(&self.model.residuals(&self.state));
+            self.record();
+        }
+    }
+
+    fn restart_from(&mut self, state: State) {
+        self.state = State {
+            t: self.state.t,
+            ..state
+        };
+        self.residual = max_abs(&self.model.residuals(&self.state));
+        self.least_infeasible = (self.residual, self.state.clone());
+        self.record();
+    }
+
+    /// Brings the last state into equilibrium at a dear penalty, at most `POLISH_STEPS`
+    /// steps: the best certified state then lies near where the search ended, not only
+    /// where it last happened to be feasible. Returns the steps taken.
+    fn polish(&mut self, layout: &Layout) -> usize {
+        self.polishing = true;
+        self.rho = RHO_START;
+        let mut steps = 0;
+        while self.residual > self.feasible_below && steps < POLISH_STEPS {
+            steps += 1;
+            self.nu = (self.nu * 1e3).min(self.nu_max);
+            if let Outcome::Stationary = self.iterate(layout) {
+                break;
+            }
+        }
+        steps
+    }
+
+    fn infeasibility(&self) -> f64 {
+        self.residual
+    }
+
+    /// φ = f + ν ‖c‖₁ at `state`.
+    fn merit(&self, state: &State) -> f64 {
+        let c = self.model.residuals(state);
+        self.model.objective_value(state) + self.nu * c.iter().map(|x| x.abs()).sum::<f64>()
+    }
+
+    /// One accepted step, or a larger ρ.
+    fn iterate(&mut self, layout: &Layout) -> Outcome {
+        let Some(step) = self.steered_step(layout) else {
+            return self.reject();
+        };
+        let phi = self.merit(&self.state);
+        let predicted = phi - (step.model_objective + self.nu * step.slack);
+        let trial = self.apply(&step);
+        let multipliers = step.multipliers.clone();
+        let accepted = self
+            .acceptable(phi, predicted, &trial)
+            .then_some(trial)
+            .or_else(|| {
+                let correction = bilinear_term(self.model, &step);
+                let input = StepInput {
+                    rho: self.rho,
+                    rho_z: self.rho,
+                    nu: self.nu,
+                    correction: Some(&correction),
+                };
+                let second = solve_step(self.model, layout, &self.state, &input)?;
+                let trial = self.apply(&second);
+                self.acceptable(phi, predicted, &trial).then_some(trial)
+            });
+        let Some(next) = accepted else {
+            return self.reject();
+        };
+        let before = self.model.objective_value(&self.state);
+        self.state = next;
+        self.update_penalty(&multipliers, step.slack);
+        self.residual = max_abs(&self.model.residuals(&self.state));
+        self.record();
+        // Steps the model predicts well need less damping.
+        let ratio = (phi - self.merit(&self.state)) / predicted;
+        self.rho = (self.rho / if ratio > 0.75 { 10.0 } else { 2.0 }).max(RHO_MIN);
+        let after = self.model.objective_value(&self.state);
+        if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
+            eprintln!(
+                "f {before:.6e} -> {after:.6e} res {:.2e} rho {:.1e} nu {:.1e} pred {predicted:.2e} t {:.5}",
+                self.residual, self.rho, self.nu, self.state.t
+            );
+        }
+        self.history.push(after);
+        let settled = self.rho <= RHO_SETTLED && self.settled();
+        match (settled, self.residual <= self.feasible_below) {
+            (true, true) => Outcome::Converged,
+            // The objective has settled short of equilibrium: polish with a dear penalty.
+            (true, false) => {
+                self.polishing = true;
+                Outcome::Continue
+            }
+            _ => Outcome::Continue,
+        }
+    }
+
+    /// ν at ten times the largest multiplier where the step met its linearised residuals
+    /// (so the penalty stays exact without drowning the objective), never below its start;
+    /// while polishing, a thousand times that.
+    fn update_penalty(&mut self, multipliers: &[f64], slack: f64) {
+        if slack <= 1e-12 * self.model.residual.len() as f64 {
+            let factor = if self.polishing { 1e4 } else { 10.0 };
+            let largest = max_abs(multipliers);
+            self.nu = (factor * largest).clamp(self.nu_max / NU_RANGE, self.nu_max);
+        }
+    }
+
+    /// The objective moved by less than a relative 1e-5 over the last five accepted steps
+    /// (or 1e-12 over the last one).
+    fn settled(&self) -> bool {
+        let h = &self.history;
+        let floor = self.objective_floor();
+        let last = *h.last().expect("called after a step");
+        let moved = |k: usize| (h[h.len() - 1 - k] - last).abs() / (last.abs() + floor);
+        (h.len() >= 2 && moved(1) <= 1e-12) || (h.len() >= 6 && moved(5) <= 1e-5)
+    }
+
+    fn reject(&mut self) -> Outcome {
+        self.rho *= 10.0;
+        if self.rho > RHO_MAX {
+            Outcome::Stationary
+        } else {
+            Outcome::Continue
+        }
+    }
+
+    /// The objective's natural size below which changes do not count.
+    fn objective_floor(&self) -> f64 {
+        match self.model.objective {
+            Objective::Fit => 1e-9,
+            _ => 1e-6,
+        }
+    }
+
+    /// The step at the current ρ, with ν raised while the linearised residuals are left
+    /// unmet at its price.
+    fn steered_step(&mut self, layout: &Layout) -> Option<Step> {
+        for _ in 0..2 {
+            let input = StepInput {
+                rho: self.rho,
+                rho_z: self.rho,
+                nu: self.nu,
+                correction: None,
+            };
+            let step = solve_step(self.model, layout, &self.state, &input)?;
+            let l1: f64 = self
+                .model
+                .residuals(&self.state)
+                .iter()
+                .map(|c| c.abs())
+                .sum();
+            let unmet = self.residual > self.feasible_below && step.slack > 0.1 * l1;
+            if unmet && self.nu < self.nu_max {
+                self.nu *= 10.0;
+                continue;
+            }
+            return Some(step);
+        }
+        let input = StepInput {
+            rho: self.rho,
+            rho_z: self.rho,
+            nu: self.nu,
+            correction: None,
+        };
+        solve_step(self.model, layout, &self.state, &input)
+    }
+
+    fn acceptable(&self, phi: f64, predicted: f64, trial: &State) -> bool {
+        let actual = phi - self.merit(trial);
+        predicted > 0.0 && actual >= ACCEPT * predicted
+    }
+
+    fn apply(&self, step: &Step) -> State {
+        let model = self.model;
+        let s = &self.state;
+        let y = (s.y.iter().zip(&step.dy)).map(|(a, b)| a + b).collect();
+        let q = (s.q.iter().zip(&step.dq).zip(&model.stress.bounds))
+            .map(|((q, dq), b)| b.map_or(0.0, |(lo, hi)| (q + dq).clamp(lo, hi)))
+            .collect();
+        let z = (s.z.iter().zip(&step.dz)).map(|(a, b)| a + b).collect();
+        let t = match model.objective {
+            Objective::MinThickness => (s.t + step.dt).max(0.0),
+            _ => s.t + step.dt,
+        };
+        State { y, q, z, t }
+    }
+
+    fn record(&mut self) {
+        let f = self.model.objective_value(&self.state);
+        if self.residual <= self.certified_below
+            && self.best_feasible.as_ref().is_none_or(|(b, _)| f <= *b)
+        {
+            self.best_feasible = Some((f, self.state.clone()));
+        }
+        if self.residual < self.least_infeasible.0 {
+            self.least_infeasible = (self.residual, self.state.clone());
+        }
+    }
+
+    fn stationary_termination(&self) -> Termination {
+        if self.best_feasible.is_some() {
+            Termination::Converged
+        } else {
+            Termination::Stalled {
+                vertices: self.worst_vertices(),
+            }
+        }
+    }
+
+    /// The ten non-anchored vertices with the largest residuals in the least infeasible state.
+    fn worst_vertices(&self) -> Vec<u32> {
+        let c = self.model.residuals(&self.least_infeasible.1);
+        let mut order: Vec<usize> = (0..c.len()).collect();
+        order.sort_by(|&a, &b| c[b].abs().total_cmp(&c[a].abs()));
+        order
+            .into_iter()
+            .take(10)
+            .map(|k| self.model.residual[k])
+            .collect()
+    }
+
+    fn answer(self) -> State {
+        match self.best_feasible {
+            Some((_, s)) => s,
+            None => self.least_infeasible.1,
+        }
+    }
+}
+
+/// The second-order term of the residuals along a step: Σ dq_e (dz_i − dz_j) per row.
+fn bilinear_term(model: &Model, step: &Step) -> Vec<f64> {
+    let edges = &model.problem.mesh.edges;
+    (model.residual.iter())
+        .map(|&i| {
+            let i = i as usize;
+            (model.incident[i].iter())
+                .map(|&e| {
+                    let j = other_end(edges[e as usize].v, i);
+                    step.dq[e as usize] * (step.dz[i] - step.dz[j])
+                })
+                .sum()
+        })
+        .collect()
+}
+
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}

@@ -1,0 +1,394 @@
+//! `VsrAssessment` (the outcome of `vsr_assess`) and its getters. Array getters copy out as
+//! `VsrResult`'s do: `(assessment, out, len, needed)`.
+
+use super::boundary::{boundary, copy_out, handle, out_ptr, CResult};
+use super::status::{VsrObjective, VsrStatus, VsrTermination};
+use crate::assess::AssessResult;
+use crate::mesh::Mesh;
+use std::ffi::c_char;
+
+/// The vertex id that stands for "no vertex" in `vsr_assessment_certificate`.
+pub const VSR_NO_VERTEX: u32 = u32::MAX;
+
+/// Opaque handle: the outcome of `vsr_assess`. It owns copies of everything it reports; free
+/// with `vsr_assessment_destroy`. Immutable: a `const VsrAssessment*` may be read from several
+/// threads at once.
+pub struct VsrAssessment {
+    result: AssessResult,
+    /// Edge vertex pairs, flattened (#E by 2).
+    edges: Vec<u32>,
+}
+
+impl VsrAssessment {
+    pub(crate) fn new(mesh: &Mesh, result: AssessResult) -> VsrAssessment {
+        VsrAssessment {
+            result,
+            edges: mesh.edges.iter().flat_map(|e| e.v).collect(),
+        }
+    }
+}
+
+/// Frees an assessment. NULL is a no-op.
+///
+/// # Safety
+/// `assessment` must be NULL or a handle from `vsr_assess` not yet destroyed, used by no other
+/// thread.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_destroy(assessment: *mut VsrAssessment) {
+    boundary!(keep_error, (), {
+        if !assessment.is_null() {
+            // SAFETY: from Box::into_raw in vsr_assess, destroyed once (caller's contract).
+            drop(unsafe { Box::from_raw(assessment) });
+        }
+    })
+}
+
+/// Borrows the assessment, checks every out-pointer, then writes `pick(result)` into them.
+unsafe fn scalars<T: Copy, const N: usize>(
+    assessment: *const VsrAssessment,
+    outs: [(&str, *mut T); N],
+    pick: impl FnOnce(&AssessResult) -> [T; N],
+) -> CResult {
+    // SAFETY: caller's contract.
+    let a = unsafe { handle("assessment", assessment)? };
+    for (name, p) in outs {
+        out_ptr(name, p)?;
+    }
+    for ((_, p), v) in outs.into_iter().zip(pick(&a.result)) {
+        // SAFETY: non-NULL and writable by the caller's contract.
+        unsafe { p.write(v) };
+    }
+    Ok(())
+}
+
+/// Borrows the assessment and copies `pick(assessment)` out.
+unsafe fn copy<T: Copy>(
+    assessment: *const VsrAssessment,
+    out: *mut T,
+    len: usize,
+    needed: *mut usize,
+    pick: impl FnOnce(&VsrAssessment) -> Vec<T>,
+) -> CResult {
+    // SAFETY: caller's contract.
+    let a = unsafe { handle("assessment", assessment)? };
+    // SAFETY: caller's contract.
+    unsafe { copy_out(&pick(a), out, len, needed) }
+}
+
+/// The analysis that was run (a `VsrObjective`). Written only on success.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_objective(
+    assessment: *const VsrAssessment,
+    out: *mut VsrObjective,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(assessment, [("out", out)], |r| {
+                [VsrObjective::of(r.objective)]
+            })
+        }
+    })
+}
+
+/// How the search ended: `feasible` 1 when the positions with the force densities are a
+/// certified thrust surface (ε∞ below the tolerance, every force density within its bounds,
+/// every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
+/// least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
+/// when the objective's optimum was reached (else why the search stopped: max iterations,
+/// stalled, cancelled, ...); the steps taken; the wall-clock seconds. Every pointer
+/// required; written only on success.
+///
+/// # Safety
+/// `assessment`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_outcome(
+    assessment: *const VsrAssessment,
+    feasible: *mut u32,
+    termination: *mut VsrTermination,
+    iterations: *mut usize,
+    seconds: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let a = unsafe { handle("assessment", assessment)? };
+        let r = &a.result;
+        let (f, t, i, s) = (
+            out_ptr("feasible", feasible)?,
+            out_ptr("termination", termination)?,
+            out_ptr("iterations", iterations)?,
+            out_ptr("seconds", seconds)?,
+        );
+        // SAFETY: non-NULL and writable (caller's contract).
+        unsafe {
+            f.write(u32::from(r.feasible));
+            t.write(VsrTermination::of(&r.termination));
+            i.write(r.iterations);
+            s.write(r.seconds);
+        }
+        Ok(())
+    })
+}
+
+/// The analysis' figures: `thickness_scale` s, the scale of the envelope's half extents
+/// (the least one for min-thickness, else 1); `safety_factor` 1 / s; `thrust_horizontal`,
+/// Σ over supports of the horizontal reaction's magnitude (force); `load_factor` λ of
+/// max-load (else 0). Every pointer required; written only on success.
+///
+/// # Safety
+/// `assessment`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_figures(
+    assessment: *const VsrAssessment,
+    thickness_scale: *mut f64,
+    safety_factor: *mut f64,
+    thrust_horizontal: *mut f64,
+    load_factor: *mut f64,
+) -> VsrStatus {
+    boundary!({
+        let outs = [
+            ("thickness_scale", thickness_scale),
+            ("safety_factor", safety_factor),
+            ("thrust_horizontal", thrust_horizontal),
+            ("load_factor", load_factor),
+        ];
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars(assessment, outs, |r| {
+                [
+                    r.thickness_scale,
+                    r.safety_factor,
+                    r.thrust_horizontal,
+                    r.load_factor,
+                ]
+            })
+        }
+    })
+}
+
+/// The certificate's figures: `eps_inf`, max |vertical residual| / mean load over the
+/// non-anchored vertices; `horizontal_imbalance`, the largest horizontal imbalance at a
+/// non-anchored vertex over the mean load; `worst_bound`, the largest excess of a height over
+/// its bounds (0 when all are inside) and `worst_bound_vertex` its vertex; and
+/// `worst_residual_vertex`, the vertex of the largest residual (`VSR_NO_VERTEX` where there
+/// is none). Every pointer required; written only on success.
+///
+/// # Safety
+/// `assessment`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_certificate(
+    assessment: *const VsrAssessment,
+    eps_inf: *mut f64,
+    horizontal_imbalance: *mut f64,
+    worst_bound: *mut f64,
+    worst_bound_vertex: *mut u32,
+    worst_residual_vertex: *mut u32,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let a = unsafe { handle("assessment", assessment)? };
+        let r = &a.result;
+        let (e, h, w) = (
+            out_ptr("eps_inf", eps_inf)?,
+            out_ptr("horizontal_imbalance", horizontal_imbalance)?,
+            out_ptr("worst_bound", worst_bound)?,
+        );
+        let (wb, wr) = (
+            out_ptr("worst_bound_vertex", worst_bound_vertex)?,
+            out_ptr("worst_residual_vertex", worst_residual_vertex)?,
+        );
+        // SAFETY: non-NULL and writable (caller's contract).
+        unsafe {
+            e.write(r.eps_inf);
+            h.write(r.horizontal_imbalance);
+            w.write(r.worst_bound.0);
+            wb.write(r.worst_bound.1.unwrap_or(VSR_NO_VERTEX));
+            wr.write(r.worst_residual_vertex.unwrap_or(VSR_NO_VERTEX));
+        }
+        Ok(())
+    })
+}
+
+/// A one-line description of the termination, as a NUL-terminated UTF-8 string copied into
+/// `out` (`len` bytes; `needed` counts the terminating NUL); for `VSR_TERMINATION_STALLED` it
+/// lists the vertices with the largest residuals.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable bytes; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_termination_message(
+    assessment: *const VsrAssessment,
+    out: *mut c_char,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            copy(assessment, out, len, needed, |a| {
+                let text = a.result.termination.to_string();
+                let mut bytes: Vec<c_char> = (text.bytes())
+                    .filter(|&b| b != 0)
+                    .map(|b| b as c_char)
+                    .collect();
+                bytes.push(0);
+                bytes
+            })
+        }
+    })
+}
+
+/// The thrust surface, #V by 3 doubles: the mesh's plan with the heights found.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_positions(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy(assessment, out, len, needed, |a| {
+                a.result.positions.iter().flatten().copied().collect()
+            })
+        }
+    })
+}
+
+/// Force density per edge (rows of `vsr_assessment_edges`), #E doubles (force per length,
+/// compression positive).
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_force_densities(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy(assessment, out, len, needed, |a| {
+                a.result.force_densities.clone()
+            })
+        }
+    })
+}
+
+/// Vertical load per vertex, #V doubles (downward positive): the self-weight, the mesh's
+/// extra loads and λ × the load pattern.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_loads(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.loads.clone()) } })
+}
+
+/// Vertical residual per vertex, #V doubles (0 at supports).
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_residuals(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.residuals.clone()) } })
+}
+
+/// Lower bound per vertex at the reported thickness (the envelope's intrados, scaled by the
+/// thickness scale about the middle surface), #V doubles.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_lower(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.lower.clone()) } })
+}
+
+/// Upper bound per vertex at the reported thickness, #V doubles.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_upper(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.upper.clone()) } })
+}
+
+/// Horizontal reaction per vertex, #V by 2 doubles (non-zero at supports): the force the
+/// vault pushes the support with.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_reactions(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy(assessment, out, len, needed, |a| {
+                a.result.reactions.iter().flatten().copied().collect()
+            })
+        }
+    })
+}
+
+/// Edges, #E by 2 `uint32_t` vertex ids (smaller first), row-major, sorted: the rows of
+/// `vsr_assessment_force_densities` (the mesh's edges, as `vsr_mesh_edges`).
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_edges(
+    assessment: *const VsrAssessment,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.edges.clone()) } })
+}

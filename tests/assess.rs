@@ -1,0 +1,426 @@
+//! The assessment (docs/method.md §16) against independent mathematics: certificates
+//! recomputed from the outputs, closed forms on a fan, known self-supporting shapes, unit
+//! invariance and bad input.
+
+mod common;
+
+use voussoir::generate::{self, KnownPlan};
+use voussoir::{
+    assess, AssessResult, AssessSettings, Envelope, Error, Mesh, Objective, Problem, Termination,
+    Thickness,
+};
+
+/// A fan: a free centre at height `rise` over n rim supports on the circle of radius `r`.
+fn fan(n: usize, r: f64, rise: f64) -> Mesh {
+    let mut positions = vec![[0.0, 0.0, rise]];
+    for k in 0..n {
+        let a = 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+        positions.push([r * a.cos(), r * a.sin(), 0.0]);
+    }
+    let faces: Vec<[u32; 3]> = (0..n as u32)
+        .map(|k| [0, k + 1, (k + 1) % n as u32 + 1])
+        .collect();
+    let rim: Vec<u32> = (1..=n as u32).collect();
+    Mesh::new(positions, faces, &rim).unwrap()
+}
+
+/// The mesh's own surface shifted down by `below` and up by `above`: an envelope whose
+/// bounds are exactly z − below and z + above at every vertex.
+fn shifted_envelope(mesh: &Mesh, below: f64, above: f64) -> Envelope {
+    let shift = |d: f64| -> Vec<[f64; 3]> {
+        (mesh.positions.iter())
+            .map(|p| [p[0], p[1], p[2] + d])
+            .collect()
+    };
+    let (lo, hi) = (shift(-below), shift(above));
+    Envelope::from_surfaces(mesh, (&lo, &mesh.faces), (&hi, &mesh.faces)).unwrap()
+}
+
+fn run(mesh: Mesh, envelope: &Envelope, settings: AssessSettings) -> AssessResult {
+    assess(&Problem::new(mesh), envelope, &settings, None).unwrap()
+}
+
+/// Recomputes the certificate from the outputs alone: residuals from positions, force
+/// densities and loads over the mesh's edges; q ≥ 0; heights within the reported bounds,
+/// which are the envelope's scaled about its middle by the reported scale.
+fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, tolerance: f64) {
+    assert!(r.feasible, "not certified: {:?}", r.termination);
+    let n = mesh.positions.len();
+    let mut residual = vec![0.0; n];
+    for (e, edge) in mesh.edges.iter().enumerate() {
+        let [i, j] = edge.v.map(|v| v as usize);
+        let q = r.force_densities[e];
+        assert!(q >= 0.0, "edge {e} in tension: q = {q}");
+        let dz = r.positions[i][2] - r.positions[j][2];
+        residual[i] += q * dz;
+        residual[j] -= q * dz;
+    }
+    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored[v]).collect();
+    let mean = free.iter().map(|&v| r.loads[v]).sum::<f64>() / free.len() as f64;
+    let eps = free
+        .iter()
+        .map(|&v| (residual[v] - r.loads[v]).abs() / mean)
+        .fold(0.0, f64::max);
+    assert!(eps < tolerance, "recomputed eps_inf {eps:e}");
+    assert!(
+        (eps - r.eps_inf).abs() <= 1e-9,
+        "{eps:e} vs {:e}",
+        r.eps_inf
+    );
+    let diag = plan_diagonal(mesh);
+    for v in 0..n {
+        let (m, h) = (
+            envelope.middle[v],
+            0.5 * (envelope.upper[v] - envelope.lower[v]),
+        );
+        let (lo, hi) = (m - r.thickness_scale * h, m + r.thickness_scale * h);
+        assert!((lo - r.lower[v]).abs() <= 1e-12 * (1.0 + lo.abs()));
+        assert!((hi - r.upper[v]).abs() <= 1e-12 * (1.0 + hi.abs()));
+        let z = r.positions[v][2];
+        assert!(
+            z >= lo - 1e-9 * diag && z <= hi + 1e-9 * diag,
+            "vertex {v} at {z} outside [{lo}, {hi}]"
+        );
+        assert_eq!(&r.positions[v][..2], &mesh.positions[v][..2], "plan moved");
+    }
+}
+
+fn plan_diagonal(mesh: &Mesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &mesh.positions {
+        for d in 0..2 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+/// On a fan every compressive stress balances the centre, so the extreme thrusts are closed
+/// forms: with load p on the centre and the rise ζ from the supports to the centre,
+/// Σ q (z_c − z_a) = p and thrust = r Σ q = p r / ζ; the least thrust takes the largest rise
+/// the envelope allows, the greatest the smallest.
+#[test]
+fn fan_thrusts_are_the_closed_forms() {
+    let (n, r, rise, below, above) = (12, 2.0, 1.0, 0.15, 0.1);
+    for fixed in [false, true] {
+        let mesh = fan(n, r, rise);
+        let envelope = shifted_envelope(&mesh, below, above);
+        let (largest, smallest) = if fixed {
+            (rise + above, rise - below)
+        } else {
+            (rise + above + below, rise - below - above)
+        };
+        for (objective, zeta) in [
+            (Objective::MinThrust, largest),
+            (Objective::MaxThrust, smallest),
+        ] {
+            let settings = AssessSettings::default()
+                .with_objective(objective)
+                .with_fixed_supports(fixed);
+            let result = run(mesh.clone(), &envelope, settings);
+            check_certificate(&mesh, &envelope, &result, 1e-6);
+            let expected = result.loads[0] * r / zeta;
+            let got = result.thrust_horizontal;
+            assert!(
+                (got - expected).abs() <= 1e-4 * expected,
+                "{objective:?} fixed={fixed}: thrust {got} expected {expected}"
+            );
+            assert_eq!(result.termination, Termination::Converged);
+        }
+    }
+}
+
+/// A shape that stands as it is, with any thickness: the nearest thrust surface is the
+/// shape itself.
+#[test]
+fn a_self_supporting_middle_surface_is_its_own_nearest_thrust_surface() {
+    let truth =
+        generate::self_supporting(KnownPlan::Disk, 300, &voussoir::FormFindSettings::default())
+            .unwrap();
+    let envelope = Envelope::from_thickness(&truth, &Thickness::Uniform(0.05)).unwrap();
+    let result = run(truth.clone(), &envelope, AssessSettings::default());
+    check_certificate(&truth, &envelope, &result, 1e-6);
+    let moved = (truth.positions.iter().zip(&result.positions))
+        .map(|(a, b)| (a[2] - b[2]).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-4, "moved {moved}");
+}
+
+/// A hemispherical dome: every analysis returns a certified thrust surface, the least
+/// thickness fits inside the given one, and the passive thrust is below the active one.
+#[test]
+fn hemisphere_analyses_are_certified_and_ordered() {
+    let (p, t) = generate::polar_disk(8);
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt(),
+        |_, outer| outer,
+    )
+    .unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1)).unwrap();
+    let mut thrust = Vec::new();
+    for objective in [
+        Objective::Fit,
+        Objective::MinThickness,
+        Objective::MinThrust,
+        Objective::MaxThrust,
+    ] {
+        let settings = AssessSettings::default().with_objective(objective);
+        let result = run(mesh.clone(), &envelope, settings);
+        check_certificate(&mesh, &envelope, &result, 1e-6);
+        if objective == Objective::MinThickness {
+            assert!(result.thickness_scale > 0.05 && result.thickness_scale < 1.0);
+            assert!((result.safety_factor * result.thickness_scale - 1.0).abs() < 1e-12);
+        } else {
+            assert_eq!(result.thickness_scale, 1.0);
+        }
+        thrust.push(result.thrust_horizontal);
+    }
+    assert!(thrust[2] < thrust[0] && thrust[0] < thrust[3], "{thrust:?}");
+}
+
+/// The unit weight scales the loads and the forces, not the thrust surface.
+#[test]
+fn unit_weight_scales_forces_not_the_surface() {
+    let mesh = generate::cap_dome(0.8, 120).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.08)).unwrap();
+    let base = run(mesh.clone(), &envelope, AssessSettings::default());
+    let heavy = run(
+        mesh.clone(),
+        &envelope,
+        AssessSettings::default().with_unit_weight(25.0),
+    );
+    for (a, b) in base.positions.iter().zip(&heavy.positions) {
+        assert!((a[2] - b[2]).abs() < 1e-6, "{} vs {}", a[2], b[2]);
+    }
+    let ratio = heavy.thrust_horizontal / base.thrust_horizontal;
+    assert!((ratio - 25.0).abs() < 25.0 * 1e-5, "thrust ratio {ratio}");
+}
+
+/// The largest load factor: a certified surface under self-weight plus λ × the pattern.
+#[test]
+fn max_load_is_certified_with_its_factor() {
+    let mesh = generate::cap_dome(0.9, 120).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.15)).unwrap();
+    let n = mesh.positions.len();
+    // A point load on the free vertex nearest (0.4, 0).
+    let target = (0..n)
+        .filter(|&v| !mesh.anchored[v])
+        .min_by(|&a, &b| {
+            let d = |v: usize| (mesh.positions[v][0] - 0.4).hypot(mesh.positions[v][1]);
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let mut pattern = vec![0.0; n];
+    pattern[target] = 0.05;
+    let settings = AssessSettings::default()
+        .with_objective(Objective::MaxLoad)
+        .with_load_pattern(pattern.clone());
+    let result = run(mesh.clone(), &envelope, settings);
+    check_certificate(&mesh, &envelope, &result, 1e-6);
+    assert!(result.load_factor > 0.0, "λ = {}", result.load_factor);
+    let dead = run(mesh.clone(), &envelope, AssessSettings::default()).loads;
+    for v in 0..n {
+        let expected = dead[v] + result.load_factor * pattern[v];
+        assert!((result.loads[v] - expected).abs() <= 1e-12 * expected.abs().max(1.0));
+    }
+}
+
+fn message(e: Error) -> String {
+    e.to_string()
+}
+
+#[test]
+fn bad_envelopes_and_settings_are_named() {
+    let mesh = generate::cap_dome(0.8, 60).unwrap();
+    for t in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let e = Envelope::from_thickness(&mesh, &Thickness::Uniform(t)).unwrap_err();
+        assert!(message(e).contains("thickness"), "{t}");
+    }
+    let wrong = Thickness::PerFace(vec![0.1; mesh.faces.len() - 1]);
+    assert!(message(Envelope::from_thickness(&mesh, &wrong).unwrap_err()).contains("per face"));
+    // Intrados above extrados at every vertex.
+    let up: Vec<[f64; 3]> = (mesh.positions.iter())
+        .map(|p| [p[0], p[1], p[2] + 1.0])
+        .collect();
+    let e = Envelope::from_surfaces(&mesh, (&up, &mesh.faces), (&mesh.positions, &mesh.faces));
+    let text = message(e.unwrap_err());
+    assert!(
+        text.contains("intrados") && text.contains("vertex"),
+        "{text}"
+    );
+    // An extrados over half the plan does not cover the other half.
+    let half: Vec<[u32; 3]> = (mesh.faces.iter())
+        .filter(|f| f.iter().all(|&v| mesh.positions[v as usize][0] < 0.0))
+        .copied()
+        .collect();
+    let e = Envelope::from_surfaces(&mesh, (&mesh.positions, &mesh.faces), (&up, &half));
+    let text = message(e.unwrap_err());
+    assert!(
+        text.contains("extrados") && text.contains("does not cover vertex"),
+        "{text}"
+    );
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1)).unwrap();
+    let problem = Problem::new(mesh.clone());
+    let cases = [
+        (
+            AssessSettings::default().with_objective(Objective::MaxLoad),
+            "load_pattern",
+        ),
+        (
+            AssessSettings::default()
+                .with_objective(Objective::MaxLoad)
+                .with_load_pattern(vec![1.0; 3]),
+            "load_pattern",
+        ),
+        (
+            AssessSettings::default().with_unit_weight(-1.0),
+            "unit_weight",
+        ),
+        (
+            AssessSettings::default().with_tolerance(f64::NAN),
+            "tolerance",
+        ),
+        (
+            AssessSettings::default().with_max_iterations(0),
+            "max_iterations",
+        ),
+    ];
+    for (settings, name) in cases {
+        let text = message(assess(&problem, &envelope, &settings, None).unwrap_err());
+        assert!(text.contains(name), "{name}: {text}");
+    }
+}
+
+/// A fixed support outside the envelope is named; at the least thickness it only bounds the
+/// scale.
+#[test]
+fn fixed_supports_outside_the_envelope_are_named() {
+    let mut mesh = fan(8, 1.0, 0.5);
+    let envelope = shifted_envelope(&mesh, 0.05, 0.05);
+    mesh.positions[3][2] = 0.2;
+    let settings = AssessSettings::default().with_fixed_supports(true);
+    let text = message(assess(&Problem::new(mesh), &envelope, &settings, None).unwrap_err());
+    assert!(text.contains("support vertex 3"), "{text}");
+}
+
+/// Cancelling from the progress callback ends the search with the best state so far.
+#[test]
+fn cancelling_returns_a_state_with_its_termination() {
+    let mesh = generate::cap_dome(0.8, 120).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1)).unwrap();
+    let settings = AssessSettings::default().with_objective(Objective::MinThickness);
+    let mut calls = 0;
+    let mut cancel = |_: usize, _: f64| {
+        calls += 1;
+        calls < 3
+    };
+    let problem = Problem::new(mesh);
+    let result = assess(&problem, &envelope, &settings, Some(&mut cancel)).unwrap();
+    assert_eq!(result.termination, Termination::Cancelled);
+    assert_eq!(calls, 3);
+    assert_eq!(result.positions.len(), problem.mesh.positions.len());
+}
+
+/// A hemisphere far too thin: no surface fits, and the answer says how much thicker and
+/// where the thinnest certified surface leaves the envelope.
+#[test]
+fn a_vault_too_thin_says_how_much_thicker() {
+    let (p, t) = generate::polar_disk(6);
+    let mesh = generate::lift(
+        &p,
+        &t,
+        |u| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt(),
+        |_, outer| outer,
+    )
+    .unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.005)).unwrap();
+    let settings = AssessSettings::default().with_max_iterations(60);
+    let result = run(mesh.clone(), &envelope, settings);
+    assert!(!result.feasible);
+    let (scale, at) = result.needed_scale.expect("a least thickness");
+    assert!(scale > 1.0, "scale {scale}");
+    let v = at.expect("where the thinnest surface leaves the envelope") as usize;
+    assert!(!mesh.anchored[v] || mesh.on_boundary[v]);
+}
+
+/// Bounds and loads given per vertex (compas_tno's zlb, zub and pz): the fan's closed form.
+#[test]
+fn bounds_and_loads_given_per_vertex() {
+    let (n, r, rise) = (10, 1.5, 0.8);
+    let mesh = fan(n, r, rise);
+    let lower: Vec<f64> = mesh.positions.iter().map(|p| p[2] - 0.1).collect();
+    let upper: Vec<f64> = mesh.positions.iter().map(|p| p[2] + 0.2).collect();
+    let envelope =
+        Envelope::from_bounds(&mesh, lower.clone(), upper, &Thickness::Uniform(1.0)).unwrap();
+    let mut loads = vec![0.0; n + 1];
+    loads[0] = 3.0;
+    let problem = Problem::new(mesh.clone()).with_extra_loads(loads).unwrap();
+    let settings = AssessSettings::default()
+        .with_objective(Objective::MinThrust)
+        .with_unit_weight(0.0);
+    let result = assess(&problem, &envelope, &settings, None).unwrap();
+    check_certificate(&mesh, &envelope, &result, 1e-6);
+    assert_eq!(result.loads[0], 3.0);
+    let expected = 3.0 * r / (rise + 0.2 + 0.1);
+    assert!((result.thrust_horizontal - expected).abs() <= 1e-4 * expected);
+    let mut swapped = lower.clone();
+    swapped[4] += 1.0;
+    let text = message(
+        Envelope::from_bounds(&mesh, swapped, lower, &Thickness::Uniform(1.0)).unwrap_err(),
+    );
+    assert!(text.contains("vertex 4"), "{text}");
+}
+
+/// A semicircular barrel with free long sides: its free edges balance horizontally with no
+/// tie (τ = 0), and the least thickness is certified and below the given one.
+#[test]
+fn a_barrel_with_free_sides_is_certified() {
+    let (nx, ny) = (16, 4);
+    let points: Vec<[f64; 2]> = (0..=ny)
+        .flat_map(|j| {
+            (0..=nx).map(move |i| {
+                [
+                    -1.0 + 2.0 * i as f64 / nx as f64,
+                    0.5 * j as f64 / ny as f64,
+                ]
+            })
+        })
+        .collect();
+    let faces = grid_faces(nx, ny);
+    let height = |u: [f64; 2]| (1.0 - u[0] * u[0]).max(0.0).sqrt();
+    let mesh = generate::lift(&points, &faces, height, |u, _| u[0].abs() > 1.0 - 1e-9).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.2)).unwrap();
+    for objective in [Objective::Fit, Objective::MinThickness] {
+        let settings = AssessSettings::default().with_objective(objective);
+        let result = run(mesh.clone(), &envelope, settings);
+        check_certificate(&mesh, &envelope, &result, 1e-6);
+        assert!(
+            result.horizontal_imbalance < 1e-8,
+            "{}",
+            result.horizontal_imbalance
+        );
+        if objective == Objective::MinThickness {
+            // An arch's least thickness is a tenth of its radius or so (Milankovitch: 0.1075
+            // with radial joints; read vertically the springing allows less).
+            let t_min = 0.2 * result.thickness_scale;
+            assert!(t_min > 0.05 && t_min < 0.12, "t_min {t_min}");
+        }
+    }
+}
+
+/// Triangles of the grid of (nx + 1) × (ny + 1) points, row by row in x.
+fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut faces = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            faces.push([a, b, c]);
+            faces.push([a, c, d]);
+        }
+    }
+    faces
+}

@@ -1,0 +1,101 @@
+//! `max_height_change` is a guarantee of the nearest method: no vertex of the answer moves
+//! more than that many plan diagonals, whichever path produced it (the nearest loop, or the
+//! paper's loop that continues from its best state when it finds no balanced one).
+
+use voussoir::{form_find, FormFindSettings, Mesh, Problem, Termination};
+
+/// A 15 × 15 grid vault with a steep outer wall (issue 48): interior heights 1 to 1.3 plus
+/// `noise` × seeded noise, the anchored outer ring at height 0 at the plan position of the
+/// first interior ring moved outwards by 0.01.
+fn walled_vault(seed: u64, noise: f64) -> Mesh {
+    let k = 15;
+    let h = 1.0 / (k - 1) as f64;
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut positions = Vec::new();
+    let mut anchored = Vec::new();
+    for i in 0..k {
+        for j in 0..k {
+            let (x, y) = (i.clamp(1, k - 2) as f64 * h, j.clamp(1, k - 2) as f64 * h);
+            let side = |a: usize| {
+                if a == 0 {
+                    -0.01
+                } else if a == k - 1 {
+                    0.01
+                } else {
+                    0.0
+                }
+            };
+            if i == 0 || j == 0 || i == k - 1 || j == k - 1 {
+                anchored.push(positions.len() as u32);
+                positions.push([x + side(i), y + side(j), 0.0]);
+            } else {
+                let (u, w) = ((x - h) / (1.0 - 2.0 * h), (y - h) / (1.0 - 2.0 * h));
+                let bump = (std::f64::consts::PI * u).sin() * (std::f64::consts::PI * w).sin();
+                positions.push([x, y, 1.0 + 0.3 * bump + noise * next()]);
+            }
+        }
+    }
+    let at = |i: usize, j: usize| (i * k + j) as u32;
+    let mut faces = Vec::new();
+    for i in 0..k - 1 {
+        for j in 0..k - 1 {
+            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Mesh::new(positions, faces, &anchored).expect("walled vault")
+}
+
+/// The largest height change over the plan bounding-box diagonal, measured here.
+fn largest_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &mesh.positions {
+        for d in 0..2 {
+            (lo[d], hi[d]) = (lo[d].min(p[d]), hi[d].max(p[d]));
+        }
+    }
+    let diagonal = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    (mesh.positions.iter().zip(positions))
+        .map(|(a, b)| (a[2] - b[2]).abs() / diagonal)
+        .fold(0.0, f64::max)
+}
+
+/// Where the limit binds hard (the answer moved 9 diagonals before the paper's loop held it),
+/// every answer stays within it: with the default budget (the nearest loop, then the paper's
+/// loop from its best state) and with a short one, for several seeds and limits.
+#[test]
+fn no_answer_moves_beyond_the_height_limit() {
+    let mut bound_hard = 0;
+    for seed in 0..3 {
+        let problem = Problem::new(walled_vault(seed, 0.02 * seed as f64));
+        for limit in [1.0, 0.5, 0.2] {
+            for max_iterations in [100, 30] {
+                let settings = FormFindSettings::default()
+                    .with_max_height_change(limit)
+                    .with_max_iterations(max_iterations);
+                let r = form_find(&problem, &settings, None).unwrap();
+                let moved = largest_change(&problem.mesh, &r.positions);
+                let case = format!("seed {seed}, limit {limit}, {max_iterations} steps");
+                assert!(
+                    moved <= limit * (1.0 + 1e-9),
+                    "{case}: moved {moved} diagonals ({:?})",
+                    r.termination
+                );
+                assert!((r.max_change - moved).abs() <= 1e-12, "{case}");
+                let blocked = matches!(r.termination, Termination::Blocked { .. });
+                bound_hard += (blocked || moved >= 0.999 * limit) as usize;
+                eprintln!(
+                    "DBG {case}: {moved} {:?} eps {:e} it {}",
+                    r.termination, r.stress.eps_inf, r.iterations
+                );
+            }
+        }
+    }
+    assert!(bound_hard >= 6, "the limit bound in {bound_hard} runs only");
+}
