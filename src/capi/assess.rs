@@ -411,7 +411,8 @@ pub unsafe extern "C" fn vsr_assess_settings_set_fixed_supports(
 }
 
 /// Sets the weight per unit volume of the masonry: a face weighs its area on the middle
-/// surface × its thickness × `unit_weight`. Finite and > 0. Default 1.
+/// surface × its thickness × `unit_weight`. Finite and >= 0 (0: the mesh's extra loads
+/// alone). Default 1.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
