@@ -2,7 +2,7 @@
 //! settings → `AssessSettings` (checked as the C API's `vsr_assess_settings_set_*` check them,
 //! with the same messages), and `voussoir::assess` with the GIL released.
 
-use crate::errors::{from_error, invalid, not_finite};
+use crate::errors::{from_error, invalid};
 use crate::mesh::{shape_text, Mesh};
 use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -29,7 +29,7 @@ fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(not_finite(name, x))
+        Err(invalid(name, format_args!("{x} is not finite")))
     }
 }
 
