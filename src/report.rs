@@ -1,13 +1,20 @@
 //! The JSON report of a run, one schema for every command line (the formfind example and
 //! `python -m voussoir`): every number computed, in the input's units, with the settings
 //! used and how the input was read. Settings and enumerations carry the names of
-//! `src/names.rs`, the names of Python's keyword settings.
+//! `src/names.rs`, the names of Python's keyword settings. An assessment's report
+//! ([`AssessmentReport`]) has the same layout and names, its figures under `assessment`.
 
 use serde::Serialize;
 
 use crate::io::{Model, UpAxis, WeldSummary};
 use crate::mesh::repair::PlanRepair;
 use crate::{FormFindResult, FormFindSettings, QpSolver, StressResult, StressStatus};
+
+mod assessment;
+pub use assessment::{
+    AssessmentFigures, AssessmentReport, AssessmentSettings, Bounds, EnvelopeHeights, Excess,
+    NeededScale,
+};
 
 /// What a run computed: the stress of the shape as it stands, or form finding.
 #[derive(Debug, Clone, Copy)]
@@ -43,6 +50,25 @@ pub struct MeshCounts {
     pub edges: usize,
     /// Holes.
     pub holes: usize,
+}
+
+impl MeshCounts {
+    /// The counts of `mesh`.
+    pub(crate) fn of(mesh: &crate::Mesh) -> MeshCounts {
+        MeshCounts {
+            vertices: mesh.n_vertices(),
+            faces: mesh.n_faces(),
+            edges: mesh.n_edges(),
+            holes: mesh.holes().count(),
+        }
+    }
+}
+
+/// The anchored vertices of `mesh`.
+fn anchored(mesh: &crate::Mesh) -> Vec<u32> {
+    (0..mesh.n_vertices() as u32)
+        .filter(|&v| mesh.anchored[v as usize])
+        .collect()
 }
 
 /// How the input was read and solved: the read options and what they did, then every solver
@@ -222,15 +248,8 @@ impl Report {
                 shape: timings[1],
                 total: timings[2],
             },
-            mesh: MeshCounts {
-                vertices: mesh.n_vertices(),
-                faces: mesh.n_faces(),
-                edges: mesh.n_edges(),
-                holes: mesh.holes().count(),
-            },
-            anchored: (0..mesh.n_vertices() as u32)
-                .filter(|&v| mesh.anchored[v as usize])
-                .collect(),
+            mesh: MeshCounts::of(mesh),
+            anchored: anchored(mesh),
             plan_repairs: model.repairs.clone(),
             unreferenced: mesh.unreferenced.clone(),
             units: "input units: lengths as in the mesh file, loads = density x area, force \
@@ -249,18 +268,21 @@ impl Report {
 
 /// (name, sentence, vertices, detail) of a run's ending.
 fn termination(run: Run<'_>) -> (&'static str, String, Vec<u32>, Option<String>) {
+    match run {
+        Run::Analysis(s) => (
+            "stress_only",
+            format!("stress analysis: {}", s.status),
+            vec![],
+            None,
+        ),
+        Run::FormFinding(f) => termination_fields(&f.termination),
+    }
+}
+
+/// (name, sentence, vertices, detail) of a termination: the vertices a `stalled` or `blocked`
+/// one lists, the constraint to relax, the failure or what blocks.
+fn termination_fields(t: &crate::Termination) -> (&'static str, String, Vec<u32>, Option<String>) {
     use crate::Termination::*;
-    let t = match run {
-        Run::Analysis(s) => {
-            return (
-                "stress_only",
-                format!("stress analysis: {}", s.status),
-                vec![],
-                None,
-            )
-        }
-        Run::FormFinding(f) => &f.termination,
-    };
     let (vertices, detail) = match t {
         Stalled { vertices } => (vertices.clone(), None),
         Blocked { vertices, hint } => (vertices.clone(), Some(hint.clone())),

@@ -286,33 +286,6 @@ def _surface(path: Path) -> Tuple[np.ndarray, np.ndarray]:
     return vertices, faces.astype(np.int64)
 
 
-def assessment_report(r: voussoir.AssessmentResult, thickness: Optional[float],
-                      pattern: Optional[np.ndarray]) -> Dict[str, Any]:
-    """The report's "assessment", as formfind writes it."""
-    detail = r.termination_detail
-    if r.termination == "stalled":
-        detail = {"vertices": r.termination_vertices.tolist()}
-    elif detail is not None:
-        detail = {"what": detail}
-    nonzero = np.flatnonzero(np.abs(r.reactions).sum(axis=1))
-    return {
-        "objective": r.objective, "feasible": r.feasible, "termination": r.termination,
-        "termination_detail": detail, "iterations": r.iterations, "seconds": r.seconds,
-        "thickness": thickness, "thickness_min": r.thickness_min,
-        "thickness_scale": r.thickness_scale, "safety_factor": r.safety_factor,
-        "thrust_horizontal": r.thrust_horizontal, "load_factor": r.load_factor,
-        "eps_inf": r.eps_inf, "horizontal_imbalance": r.horizontal_imbalance,
-        "worst_bound": {"excess": r.worst_bound, "vertex": r.worst_bound_vertex},
-        "worst_residual_vertex": r.worst_residual_vertex,
-        "bounds": {"lower": r.lower.tolist(), "upper": r.upper.tolist()},
-        "envelope": {"lower": r.envelope_lower.tolist(), "upper": r.envelope_upper.tolist(),
-                     "middle": r.envelope_middle.tolist(),
-                     "face_thickness": r.face_thickness.tolist()},
-        "reactions": [[int(v), *r.reactions[v].tolist()] for v in nonzero],
-        "load_pattern": None if pattern is None else pattern.tolist(),
-    }
-
-
 def run_assess(a: argparse.Namespace) -> int:
     """`--assess`: the thrust surface as OUT, the report with its "assessment"."""
     name = a.mesh.stem
@@ -331,25 +304,22 @@ def run_assess(a: argparse.Namespace) -> int:
         settings["max_iterations"] = a.max_iter
     if a.qmin is not None:
         settings["q_min"], settings["q_min_kind"] = _bound("--qmin", a.qmin)
+    # The input files the report's settings name, as given.
+    files = tuple(None if p is None else os.fspath(p)
+                  for p in (a.intrados, a.extrados, a.load_pattern))
     try:
         mesh = read_model(a, 1.0)
-        pattern = None if a.load_pattern is None else _load_pattern(a.load_pattern, mesh)
-        if thickness is not None:
-            r = voussoir.assess(mesh, thickness, load_pattern=pattern, **settings)
-        else:
-            r = voussoir.assess(mesh, intrados=_surface(a.intrados),
-                                extrados=_surface(a.extrados), load_pattern=pattern, **settings)
+        if a.load_pattern is not None:
+            settings["load_pattern"] = _load_pattern(a.load_pattern, mesh)
+        envelope = ((np.array([thickness]), None, None) if thickness is not None
+                    else (None, _surface(a.intrados), _surface(a.extrados)))
+        # The natives, asked for the library's report (the formfind example's schema).
+        fields = _native.assess(mesh._native, *envelope, settings, None, files)
     except voussoir.VoussoirError as e:
         raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
-    report = {
-        "assessment": assessment_report(r, thickness, pattern),
-        "edges": r.edges.tolist(), "force_densities": r.force_densities.tolist(),
-        "loads": r.loads.tolist(), "residuals": r.residuals.tolist(),
-        "anchored": mesh.anchored.tolist(), "plan_repairs": mesh.plan_repairs,
-        "settings": {**settings, "mesh": os.fspath(a.mesh)},
-        "voussoir_version": voussoir.__version__,
-    }
-    text = json.dumps(report, indent=1) + "\n"
+    least = None if thickness is None else fields["thickness_scale"] * thickness
+    r = voussoir.AssessmentResult._from_native(fields, least)
+    text = fields["report"]
     try:
         _write_all([(out, lambda p: mesh.write(p, r.positions)),
                     (report_path, lambda p: Path(p).write_text(text))])

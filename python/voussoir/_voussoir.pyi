@@ -81,5 +81,6 @@ def assess(
     extrados: Optional[Tuple[np.ndarray, np.ndarray]],
     settings: Dict[str, Any],
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
+    report: Optional[Tuple[Optional[str], Optional[str], Optional[str]]] = ...,
 ) -> Dict[str, Any]: ...
 def write_mesh(mesh: Mesh, positions: np.ndarray, path: str) -> None: ...
