@@ -372,7 +372,7 @@ def assess(
             the supports) or "max-load" (the largest factor on `load_pattern`).
         fixed_supports: keep the supports at the mesh's heights (by default the thrust meets
             each support anywhere within the envelope).
-        unit_weight: weight per unit volume (> 0).
+        unit_weight: weight per unit volume (>= 0; 0: the mesh's extra loads alone).
         load_pattern: (n,) downward load per vertex that "max-load" multiplies.
         progress: called as ``progress(step, infeasibility)`` after every step (1-based;
             infeasibility: the largest vertical residual over the mean load). Returning False
