@@ -35,7 +35,10 @@ mod solve;
 mod stress;
 mod validate;
 
-pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
+pub use assess::{
+    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, FamilyThickness,
+    Objective,
+};
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;

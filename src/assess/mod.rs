@@ -12,11 +12,13 @@
 //! returned heights and forces.
 
 mod envelope;
+mod family;
 mod model;
 mod qp;
 mod sqp;
 
 pub use envelope::Envelope;
+pub use family::{min_thickness_of_family, FamilyThickness};
 
 use crate::error::{Error, Result};
 use crate::geometry::loads::LoadRule;
