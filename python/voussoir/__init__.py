@@ -95,6 +95,9 @@ class Mesh:
             free boundary vertices; default 0.
         prescribed_tau: (n,) inward normal push per free boundary vertex, used with
             ``tau="prescribed"``; finite and >= 0; default 0.
+        polygon_diagonals: (k, 2) integer vertex ids of the edges that split the model's
+            polygons into triangles (interior edges): q_min does not bind them. `from_file`
+            marks those of a file's polygons.
         A single number given for `face_density`, `extra_loads` or `prescribed_tau` stands
             for every face or vertex.
 
@@ -115,6 +118,7 @@ class Mesh:
         extra_loads: Any = None,
         horizontal_forces: Any = None,
         prescribed_tau: Any = None,
+        polygon_diagonals: Any = None,
     ) -> None:
         self._native = _native.Mesh(
             _floats("vertices", _required("vertices", vertices)),
@@ -124,6 +128,7 @@ class Mesh:
             _floats("extra_loads", extra_loads),
             _floats("horizontal_forces", horizontal_forces),
             _floats("prescribed_tau", prescribed_tau),
+            None if polygon_diagonals is None else _ids("polygon_diagonals", polygon_diagonals),
         )
 
     @classmethod
@@ -218,6 +223,12 @@ class Mesh:
     def welded_ids(self) -> np.ndarray:
         """(n_file,) uint32: the mesh vertex of each vertex of the file read."""
         return self._native.welded_ids
+
+    @property
+    def polygon_diagonals(self) -> np.ndarray:
+        """(k, 2) uint32 marked polygon diagonals (q_min does not bind them), smaller id
+        first, in edge order."""
+        return self._native.polygon_diagonals
 
     @property
     def plan_repairs(self) -> List[str]:
