@@ -583,6 +583,14 @@ typedef struct VsrSettings VsrSettings;
  */
 typedef int (*VsrProgressFn)(void *user, size_t iteration, double eps_inf);
 
+/**
+ * The envelope of thickness `thickness`: the function writes `n_vertices` intrados heights
+ * to `lower` and as many extrados heights to `upper` (one per mesh vertex, in the mesh's
+ * order) and returns 0; any other value stops the search. It runs on the calling thread and
+ * must not unwind (throw a C++ exception or longjmp) out of the call.
+ */
+typedef int (*VsrEnvelopeAtFn)(void *user, double thickness, double *lower, double *upper, size_t n_vertices);
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1900,6 +1908,31 @@ VsrStatus vsr_assessment_reactions(const struct VsrAssessment *assessment, doubl
  * writable.
  */
 VsrStatus vsr_assessment_edges(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The least thickness t of a family of envelopes whose bounds are functions of t (Heyman's
+ * dome between the spheres R ± t/2 read vertically, compas_tno's `zlb`/`zub`): `envelope_at`
+ * gives the bounds at t; the self-weight is the middle surface's area × t × the settings'
+ * unit weight. Rounds of the least-thickness analysis move t towards the thickness whose
+ * least scale is 1, starting at `thickness` (docs/method.md §16.5); the settings' objective
+ * is ignored.
+ *
+ * `out` receives the least-thickness analysis at the least certified thickness (its surface
+ * lies inside that envelope; free with `vsr_assessment_destroy`), `thickness_out` that
+ * thickness and `converged_out` 1 when the last round's scale lay in
+ * [1 − `scale_tolerance`, 1] (a local least thickness of a nested family), else 0. All three
+ * are untouched on failure.
+ *
+ * Errors: NULL arguments or function (`VSR_STATUS_NULL_POINTER`); `thickness` or
+ * `scale_tolerance` not a finite number > 0, bounds that are not finite or with lower above
+ * upper (naming the vertex), `envelope_at` returning non-zero, no round with a certified
+ * surface (`VSR_STATUS_INVALID_ARGUMENT`); `VSR_STATUS_NUMERICAL` when a QP fails.
+ *
+ * # Safety
+ * `mesh`, `settings`: valid handles; `out`, `thickness_out`, `converged_out` writable;
+ * `envelope_at` and `user` valid for the duration of the call.
+ */
+VsrStatus vsr_min_thickness_of_family(const struct VsrMesh *mesh, VsrEnvelopeAtFn envelope_at, void *user, double thickness, double scale_tolerance, const struct VsrAssessSettings *settings, struct VsrAssessment **out, double *thickness_out, int *converged_out);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -774,3 +774,127 @@ fn the_progress_callback_sees_each_step_and_can_cancel() {
         vsr_mesh_destroy(mesh);
     }
 }
+
+/// The family of the family tests: a middle surface tilted away from the dome by 0.15 t x,
+/// so that it does not stand at every thickness.
+fn tilted_bounds(d: &Dome, t: f64) -> (Vec<f64>, Vec<f64>) {
+    (d.positions.chunks_exact(3))
+        .map(|p| (p[2] - 0.5 * t, p[2] + t * (0.5 + 0.3 * p[0])))
+        .unzip()
+}
+
+unsafe extern "C" fn tilted_family(
+    user: *mut c_void,
+    t: f64,
+    lower: *mut f64,
+    upper: *mut f64,
+    n: usize,
+) -> c_int {
+    // SAFETY: `user` is the test's Dome; lower and upper hold n values.
+    let d = unsafe { &*(user as *const Dome) };
+    let (lo, hi) = tilted_bounds(d, t);
+    assert_eq!(n, lo.len());
+    unsafe {
+        std::ptr::copy_nonoverlapping(lo.as_ptr(), lower, n);
+        std::ptr::copy_nonoverlapping(hi.as_ptr(), upper, n);
+    }
+    0
+}
+
+unsafe extern "C" fn refusing_family(
+    _: *mut c_void,
+    _: f64,
+    _: *mut f64,
+    _: *mut f64,
+    _: usize,
+) -> c_int {
+    7
+}
+
+#[test]
+fn the_least_thickness_of_a_family_is_the_rust_api_s() {
+    let d = Dome::new(3, 12);
+    let mesh = d.create();
+    let s = assess_settings();
+    let user = &d as *const Dome as *mut c_void;
+    let (mut a, mut t, mut converged) = (null_mut(), f64::NAN, 9);
+    assert_ok(unsafe {
+        vsr_min_thickness_of_family(
+            mesh,
+            Some(tilted_family),
+            user,
+            0.1,
+            1e-3,
+            s,
+            &mut a,
+            &mut t,
+            &mut converged,
+        )
+    });
+    let rust_mesh = rust_mesh(&d);
+    let member = |t: f64| {
+        let (lo, hi) = tilted_bounds(&d, t);
+        Envelope::from_bounds(&rust_mesh, lo, hi, &Thickness::Uniform(t))
+    };
+    let problem = Problem::new(rust_mesh.clone());
+    let want =
+        voussoir::min_thickness_of_family(&problem, member, 0.1, 1e-3, &AssessSettings::default())
+            .unwrap();
+    assert_eq!(t.to_bits(), want.thickness.to_bits());
+    assert_eq!(converged, c_int::from(want.converged));
+    assert!(t > 0.0 && want.result.feasible);
+    assert_same(a, &want.result);
+    check_certificate(a, &d.anchored);
+    unsafe { vsr_assessment_destroy(a) };
+
+    type Family = VsrEnvelopeAtFn;
+    let cases: [(Family, f64, f64, S, &str); 4] = [
+        (None, 0.1, 1e-3, S::NullPointer, "envelope_at"),
+        (
+            Some(refusing_family),
+            0.1,
+            1e-3,
+            S::InvalidArgument,
+            "envelope_at",
+        ),
+        (
+            Some(tilted_family),
+            -1.0,
+            1e-3,
+            S::InvalidArgument,
+            "thickness",
+        ),
+        (
+            Some(tilted_family),
+            0.1,
+            0.0,
+            S::InvalidArgument,
+            "scale_tolerance",
+        ),
+    ];
+    for (family, t0, tol, status, name) in cases {
+        let (mut a, mut t, mut converged) = (sentinel(), 42.0, 42);
+        let got = unsafe {
+            vsr_min_thickness_of_family(
+                mesh,
+                family,
+                user,
+                t0,
+                tol,
+                s,
+                &mut a,
+                &mut t,
+                &mut converged,
+            )
+        };
+        assert_failed(got, status, name);
+        assert!(
+            a == sentinel() && t == 42.0 && converged == 42,
+            "outputs written"
+        );
+    }
+    unsafe {
+        vsr_assess_settings_destroy(s);
+        vsr_mesh_destroy(mesh);
+    }
+}

@@ -23,9 +23,11 @@ mod status;
 // Masonry assessment, after the rest: new functions come last in the header.
 mod assess;
 mod assessment;
+mod family;
 
 pub use assess::*;
 pub use assessment::*;
+pub use family::*;
 pub use files::*;
 pub use mesh::*;
 pub use result::*;
