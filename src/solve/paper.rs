@@ -78,6 +78,7 @@ pub(super) fn paper_within(
     let mut cache = StressCache::for_form_finding();
     let mut stress_steps = 0;
     let mut solvers = Vec::new();
+    let mut qp_iterations = Vec::new();
     let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
@@ -91,6 +92,7 @@ pub(super) fn paper_within(
         cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         solvers.push(stress.solver);
+        qp_iterations.push(stress.iterations);
         let stress = keep_better(
             stress,
             last.take(),
@@ -163,6 +165,7 @@ pub(super) fn paper_within(
             termination,
             iterations: stress_steps,
             solvers,
+            qp_iterations,
             positions,
             stress,
             history,

@@ -161,7 +161,7 @@ fn polish_at(
         z,
     };
     let guess = active_guess(s, z);
-    let (polished, _) = polish(
+    let polished = polish(
         &qp,
         &normal,
         cons,
@@ -170,7 +170,7 @@ fn polish_at(
         tol,
         &mut space,
     )?;
-    Ok(label.iter().map(|&l| polished[l]).collect())
+    Ok(label.iter().map(|&l| polished.x[l]).collect())
 }
 
 /// min (x0 − 2)² + (x1 + 10⁻⁶)² subject to x1 ≥ 0: the bound is active at the optimum
