@@ -196,66 +196,6 @@ const SHARED: [&str; 9] = [
     "vault_pq",
 ];
 
-/// The non-anchored vertex nearest the centre of the plan's bounding box.
-fn central_vertex(mesh: &Mesh) -> usize {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for (p, _) in mesh
-        .positions
-        .iter()
-        .zip(&mesh.referenced)
-        .filter(|(_, r)| **r)
-    {
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
-    let c = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
-    let d = |v: usize| (mesh.positions[v][0] - c[0]).hypot(mesh.positions[v][1] - c[1]);
-    (0..mesh.positions.len())
-        .filter(|&v| mesh.is_non_anchored(v))
-        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
-        .expect("a non-anchored vertex")
-}
-
-/// Warm re-solves (`form_find_from`) of each model's nearest form finding after two edits:
-/// the central non-anchored vertex raised by 1% of the plan diagonal, and that vertex made
-/// a support; each against a cold form finding of the edited problem.
-fn re_solves(large: bool) {
-    println!("\nWarm re-solves after an edit (nearest method; \"/ cold\": over one cold stress step of the input)\n");
-    println!("| model | edit | cold form finding steps, s | re-solve steps | QP its | s | / cold | end | RMS change cold, re-solve |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    let settings = FormFindSettings::default();
-    for (name, problem) in model_list(large) {
-        let (cold_step, _) = cold_step(&problem);
-        let before = form_find(&problem, &settings, None).expect("form finding");
-        let v = central_vertex(&problem.mesh);
-        let mut moved = problem.clone();
-        moved.mesh.positions[v][2] += 0.01 * plan_diagonal(&problem.mesh);
-        let mut supported = problem.clone();
-        supported.mesh.anchored[v] = true;
-        for (edit, edited) in [("vertex moved 1%", moved), ("support added", supported)] {
-            let t = Instant::now();
-            let cold = form_find(&edited, &settings, None).expect("form finding");
-            let cold_secs = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let warm =
-                voussoir::form_find_from(&edited, &settings, &before, None).expect("re-solve");
-            let secs = t.elapsed().as_secs_f64();
-            println!(
-                "| {name} | {edit} | {}, {cold_secs:.2} | {} | {} | {secs:.3} | {:.1} | {} | {:.5}, {:.5} |",
-                cold.iterations,
-                warm.iterations,
-                warm.qp_iterations.iter().sum::<u32>(),
-                secs / cold_step,
-                outcome(&warm),
-                cold.rms_change,
-                warm.rms_change,
-            );
-        }
-    }
-}
-
 fn models(large: bool) {
     println!("\nForm finding, default settings (distances over the plan diagonal; \"/ cold\": the form finding's time over one cold stress step of the input)\n");
     println!("| model | V | cold step s (QP its) | method | end | steps | QP its | from last answer | solvers | s | / cold | Hausdorff | L2 | RMS change | max change |");
@@ -304,6 +244,5 @@ fn main() {
     }
     if !only_known {
         models(has("--large"));
-        re_solves(has("--large"));
     }
 }

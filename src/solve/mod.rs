@@ -180,8 +180,6 @@ pub struct FormFindResult {
     pub rms_change: f64,
     /// The largest height change at any vertex, over the plan bounding-box diagonal.
     pub max_change: f64,
-    /// What a warm re-solve starts from (`form_find_from`); None for the paper's loop.
-    pub(crate) resume: Option<Box<nearest::Resume>>,
     /// Seconds summed over iterations.
     pub stress_seconds: f64,
     pub shape_seconds: f64,
@@ -200,35 +198,7 @@ pub fn form_find(
 ) -> Result<FormFindResult> {
     settings.validate()?;
     match settings.method {
-        FormMethod::Nearest => nearest::nearest(problem, settings, progress, None),
-        FormMethod::Paper => paper::paper(problem, settings, progress),
-    }
-}
-
-/// [`form_find`] after an edit, starting from `previous`, the result of a form finding of
-/// the problem before the edit: the nearest method starts from its heights and forces (the
-/// forces certified with the edited problem's loads) and from the multipliers and penalty
-/// weight its loop ended with, instead of analysing the input and starting the
-/// continuation over. The answer is held to the same tolerance and certified the same way
-/// (residuals recomputed from the returned forces and heights). It is near the edited input
-/// but need not be as near as [`form_find`]'s: the loop may settle on another equilibrium
-/// (on generated vaults of 400 vertices after moving one vertex by 1% of the plan diagonal,
-/// the RMS change came out 8% larger and 13% smaller than a cold form finding's).
-///
-/// Between the two calls the input heights, the plan positions, the supports, the face
-/// densities, the extra loads, the horizontal forces and the settings may change; the faces
-/// must stay (a `previous` with another number of vertices or edges, a paper-method result,
-/// or settings with ODT sweeps start cold, as [`form_find`] does). With
-/// [`FormMethod::Paper`] this is [`form_find`].
-pub fn form_find_from(
-    problem: &Problem,
-    settings: &FormFindSettings,
-    previous: &FormFindResult,
-    progress: Option<&mut Progress>,
-) -> Result<FormFindResult> {
-    settings.validate()?;
-    match settings.method {
-        FormMethod::Nearest => nearest::nearest(problem, settings, progress, Some(previous)),
+        FormMethod::Nearest => nearest::nearest(problem, settings, progress),
         FormMethod::Paper => paper::paper(problem, settings, progress),
     }
 }
@@ -260,7 +230,6 @@ struct Run {
     iterations: usize,
     solvers: Vec<QpSolver>,
     qp_iterations: Vec<u32>,
-    resume: Option<Box<nearest::Resume>>,
     positions: Vec<[f64; 3]>,
     stress: StressResult,
     history: Vec<f64>,
@@ -277,7 +246,6 @@ fn finish(problem: &Problem, run: Run, start: Instant) -> FormFindResult {
         iterations: run.iterations,
         solvers: run.solvers,
         qp_iterations: run.qp_iterations,
-        resume: run.resume,
         positions: run.positions,
         stress: run.stress,
         history: run.history,

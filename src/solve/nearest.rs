@@ -58,21 +58,14 @@ const INEXACT_GAP_MAX: f64 = 1e-4;
 /// to the input may hold ε∞ up on purpose (rounds that still lower L also count as progress).
 const STALL_AFTER_GROWTH: f64 = 1e3;
 
-/// The nearest method from the input, or, with `previous` (see `super::form_find_from`),
-/// from its answer and multipliers where they fit this problem.
 pub(super) fn nearest(
     problem: &Problem,
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
-    previous: Option<&FormFindResult>,
 ) -> Result<FormFindResult> {
     let start = Instant::now();
     let mut state = Nearest::new(problem, settings, progress)?;
-    let resumable = previous.filter(|p| state.can_resume(p));
-    let mut ended = match resumable {
-        Some(p) => state.resume(p)?,
-        None => state.run()?,
-    };
+    let mut ended = state.run()?;
     if state.feasible.is_none()
         && matches!(
             ended,
@@ -91,19 +84,9 @@ pub(super) fn nearest(
     let Best {
         positions, stress, ..
     } = best;
-    let mut lambda = vec![0.0; problem.mesh.positions.len()];
-    for (&v, l) in state.shape.vertices().iter().zip(&state.lambda) {
-        lambda[v as usize] = *l;
-    }
-    let resume = Resume {
-        lambda,
-        w: state.w,
-        w_start: state.w_start,
-    };
     Ok(finish(
         problem,
         Run {
-            resume: (state.w > 0.0).then(|| Box::new(resume)),
             termination,
             iterations: state.iterations,
             solvers: state.solvers,
@@ -147,8 +130,6 @@ struct Nearest<'a, 'p> {
     /// The forces in use, certified at `positions`.
     held: StressResult,
     w: f64,
-    /// w at the start of the continuation (stalling is judged once w has grown from it).
-    w_start: f64,
     /// The lowest-E state in equilibrium (ε∞ < tolerance) reached.
     feasible: Option<Best>,
     /// Whether the held forces come from a QP solved to its full tolerances (not loosened by
@@ -207,7 +188,6 @@ impl<'a, 'p> Nearest<'a, 'p> {
             cache: StressCache::for_form_finding(),
             held: placeholder(),
             w: 0.0,
-            w_start: 0.0,
             feasible: None,
             exact: true,
             lambda: vec![0.0; n_rows],
@@ -246,52 +226,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             Ok(w) => w,
             Err(e) => return Ok(super::numerical(e)),
         };
-        self.w_start = self.w;
-        self.rounds()
-    }
-
-    /// Whether `previous` can start this loop: a nearest-method answer with multipliers, on
-    /// a mesh of as many vertices and edges, without ODT.
-    fn can_resume(&self, previous: &FormFindResult) -> bool {
-        let mesh = &self.problem.mesh;
-        let n = mesh.positions.len();
-        previous
-            .resume
-            .as_ref()
-            .is_some_and(|r| r.lambda.len() == n && r.w > 0.0 && r.w_start > 0.0)
-            && previous.positions.len() == n
-            && previous.stress.force_densities.len() == mesh.edges.len()
-            && self.settings.odt_iterations == 0
-    }
-
-    /// The loop from a previous answer (`can_resume`): its heights with its forces,
-    /// certified with this problem's loads, its multipliers, and the weight w its
-    /// continuation started with (with the last, larger w the loop stays at the previous
-    /// answer, which can be several times less near the edited input); then the same rounds
-    /// as `run`. Its forces are not this problem's QP answer, so the start is not a state in
-    /// equilibrium until a stress step certifies one.
-    fn resume(&mut self, previous: &FormFindResult) -> Result<Termination> {
-        let r = previous.resume.as_ref().expect("checked by can_resume");
-        for (p, q) in self.positions.iter_mut().zip(&previous.positions) {
-            p[2] = q[2];
-        }
-        let settings = self.step_settings();
-        self.held = (previous.stress).at_heights(self.problem, &self.positions, &settings);
-        self.exact = false;
-        // Per row of this problem: a vertex anchored before the edit has no multiplier yet.
-        self.lambda = (self.shape.vertices().iter())
-            .map(|&v| r.lambda[v as usize])
-            .collect();
-        (self.w, self.w_start) = (r.w_start, r.w_start);
-        self.shift_loads();
-        self.history.push(self.held.eps_inf);
-        self.record();
-        self.rounds()
-    }
-
-    /// Rounds of a height and a stress step, with multiplier updates, until the loop ends.
-    fn rounds(&mut self) -> Result<Termination> {
-        let w_start = self.w_start;
+        let w_start = self.w;
         let mut last_norm = residual_term(&self.held, self.shape.vertices()).sqrt();
         let (mut stage_rounds, mut stall_best, mut stall_at) = (0, self.best.eps, 0);
         loop {
@@ -842,16 +777,6 @@ impl<'a, 'p> Nearest<'a, 'p> {
 fn inexact_gap(held: &StressResult) -> Option<f64> {
     let gap = held.eps_inf.powi(2).min(INEXACT_GAP_MAX);
     gap.is_finite().then_some(gap)
-}
-
-/// What a nearest-method result keeps for a warm re-solve (`super::form_find_from`): the
-/// multiplier of each non-anchored vertex's equilibrium row (per vertex, 0 elsewhere, so that
-/// supports may be added or removed between the calls) and the weights w (last and first).
-#[derive(Debug, Clone)]
-pub(crate) struct Resume {
-    lambda: Vec<f64>,
-    w: f64,
-    w_start: f64,
 }
 
 /// Mean load over the rows (1 when zero, as the stress step's scale).

@@ -163,7 +163,6 @@ pub(super) fn paper_within(
             iterations: solvers.len(),
             solvers,
             qp_iterations,
-            resume: None,
             positions,
             stress,
             history,
