@@ -3,13 +3,20 @@
 //!     cargo bench --bench assess                   # hemispheres by mesh size, shared models
 //!     cargo bench --bench assess -- --hemisphere   # hemispheres only
 //!     cargo bench --bench assess -- --models       # shared models only
+//!     cargo bench --bench assess -- --heyman       # least thickness on Heyman's terms
 //!
 //! Hemispheres: radius 1 on `generate::polar_disk` meshes, rim anchored, thickness 0.1 along
 //! the normal (docs/method.md §16.1), every analysis; t_min/R = s × 0.1. Shared models: each
 //! with a uniform normal thickness of 2 % of its plan diagonal, fit and least thickness.
+//! Heyman: the least thickness of a hemispherical dome and of a semicircular barrel (an arch
+//! strip with free sides) over the family of shells R ± t/2 read vertically
+//! (`min_thickness_of_family`), against Heyman's t/R ≈ 0.042 and Milankovitch's 0.1075.
 
 use std::path::PathBuf;
-use voussoir::{assess, generate, AssessSettings, Envelope, Mesh, Objective, Problem, Thickness};
+use voussoir::{
+    assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
+    Thickness,
+};
 
 fn hemisphere(rings: usize) -> Mesh {
     let (p, t) = generate::polar_disk(rings);
@@ -94,9 +101,89 @@ fn models() {
     }
 }
 
+/// The shell between radii R ± t/2 (R = 1) read on the vertical at plan radius r; below the
+/// intrados' footprint the springing plane z = 0 bounds it.
+fn shell_bounds(r: f64, t: f64) -> (f64, f64) {
+    let at = |radius: f64| (radius * radius - r * r).max(0.0).sqrt();
+    (at(1.0 - 0.5 * t), at(1.0 + 0.5 * t))
+}
+
+fn shell_family(
+    mesh: &Mesh,
+    radius: impl Fn([f64; 3]) -> f64,
+    t: f64,
+) -> voussoir::Result<Envelope> {
+    let (lower, upper) = mesh
+        .positions
+        .iter()
+        .map(|&p| shell_bounds(radius(p), t))
+        .unzip();
+    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
+}
+
+fn barrel(nx: usize, ny: usize) -> Mesh {
+    let points: Vec<[f64; 2]> = (0..=ny)
+        .flat_map(|j| {
+            (0..=nx).map(move |i| {
+                [
+                    -1.0 + 2.0 * i as f64 / nx as f64,
+                    0.1 * j as f64 / ny as f64,
+                ]
+            })
+        })
+        .collect();
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let faces: Vec<[u32; 3]> = (0..ny)
+        .flat_map(|j| {
+            (0..nx).flat_map(move |i| {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                [[a, b, c], [a, c, d]]
+            })
+        })
+        .collect();
+    let height = |u: [f64; 2]| (1.0 - u[0] * u[0]).max(0.0).sqrt();
+    generate::lift(&points, &faces, height, |u, _| u[0].abs() > 1.0 - 1e-9).unwrap()
+}
+
+fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classical: f64) {
+    let problem = Problem::new(mesh.clone());
+    let settings = AssessSettings::default();
+    let family = |t: f64| shell_family(mesh, &radius, t);
+    match min_thickness_of_family(&problem, family, 0.1, 1e-3, &settings) {
+        Ok(f) => println!(
+            "| {name} | {} | {:.4} | {classical} | {:+.1}% | {} | {} | {:.1e} | {:.1} |",
+            mesh.positions.len(),
+            f.thickness,
+            100.0 * (f.thickness / classical - 1.0),
+            f.rounds,
+            f.converged,
+            f.result.eps_inf,
+            f.result.seconds
+        ),
+        Err(e) => println!("| {name} | {} | error: {e} |", mesh.positions.len()),
+    }
+}
+
+fn heyman() {
+    println!("\nLeast thickness over the shells R ± t/2 (R = 1) read vertically\n");
+    println!("| model | V | t_min / R | classical | diff | rounds | converged | eps_inf | last round s |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for rings in [6, 10, 14] {
+        let name = format!("hemisphere {rings} rings");
+        heyman_row(&name, &hemisphere(rings), |p| p[0].hypot(p[1]), 0.042);
+    }
+    for nx in [16, 32, 64] {
+        let name = format!("semicircular barrel, {nx} segments");
+        heyman_row(&name, &barrel(nx, 2), |p| p[0].abs(), 0.1075);
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let has = |f: &str| args.iter().any(|a| a == f);
+    if has("--heyman") {
+        return heyman();
+    }
     if !has("--models") {
         hemispheres();
     }

@@ -129,6 +129,7 @@ std::vector<HostileCase> hostile_cases() {
     std::vector<double> huge = p;
     for (double &c : huge) c *= 1e200;
     const std::vector<double> nan4(4, kNaN), nan5(5, kNaN), ones3(3, 1.0), neg5(5, -1.0);
+    const std::vector<uint32_t> boundary_pair = {0, 1}, far_pair = {0, 9};
     const std::vector<double> zeros4(4, 0.0);
     std::vector<HostileCase> cases = {
         mesh_case("mesh_empty", {}, t, a),
@@ -195,6 +196,18 @@ std::vector<HostileCase> hostile_cases() {
             [=](VsrMesh *m) { return vsr_mesh_set_prescribed_tau(m, neg5.data(), 5); },
             [=](voussoir::Mesh &m) { m.prescribed_tau(neg5); },
             [=](voussoir::Mesh &m) { return m.try_prescribed_tau(neg5.data(), 5); }),
+        mesh_setter_case(
+            "polygon_diagonals_boundary_edge",
+            [=](VsrMesh *m) { return vsr_mesh_set_polygon_diagonals(m, boundary_pair.data(), 1); },
+            [=](voussoir::Mesh &m) { m.set_polygon_diagonals(boundary_pair); },
+            [=](voussoir::Mesh &m) {
+                return m.try_set_polygon_diagonals(boundary_pair.data(), 1);
+            }),
+        mesh_setter_case(
+            "polygon_diagonals_out_of_range",
+            [=](VsrMesh *m) { return vsr_mesh_set_polygon_diagonals(m, far_pair.data(), 1); },
+            [=](voussoir::Mesh &m) { m.set_polygon_diagonals(far_pair); },
+            [=](voussoir::Mesh &m) { return m.try_set_polygon_diagonals(far_pair.data(), 1); }),
         mesh_setter_case(
             "analyse_zero_loads",
             [=](VsrMesh *m) {
@@ -550,6 +563,15 @@ TEST(CppApi, MeshGettersAndSetters) {
     mesh.horizontal_forces(std::vector<double>(10, 0.0));
     const std::vector<double> after = voussoir::analyse(mesh).loads();
     EXPECT_DOUBLE_EQ(after[4], 2 * before[4] + 0.5);
+    // Polygon diagonals: marked as given (either order), read back smaller id first in edge
+    // order, replaced by the next call.
+    EXPECT_TRUE(mesh.polygon_diagonals().empty());
+    mesh.set_polygon_diagonals({4, 2, 0, 4});
+    EXPECT_EQ(mesh.polygon_diagonals(), (std::vector<uint32_t>{0, 4, 2, 4}));
+    mesh.set_polygon_diagonals({3, 4});
+    EXPECT_EQ(mesh.polygon_diagonals(), (std::vector<uint32_t>{3, 4}));
+    mesh.set_polygon_diagonals({});
+    EXPECT_TRUE(mesh.polygon_diagonals().empty());
 }
 
 TEST(CppApi, EverySettingReachesItsCSetter) {

@@ -237,6 +237,9 @@ enum VsrStressStatus
    * native solver beyond 20k unknowns) 10 iterations went by without progress.
    */
   VSR_STRESS_STATUS_MAX_ITERATIONS = 3,
+  /**
+   * A solver failed numerically; `vsr_result_termination_message` says where.
+   */
   VSR_STRESS_STATUS_NUMERICAL_ERROR = 4,
 };
 #ifndef __cplusplus
@@ -824,6 +827,37 @@ VsrStatus vsr_mesh_counts(const struct VsrMesh *mesh, size_t *n_vertices, size_t
 VsrStatus vsr_mesh_edges(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
 
 /**
+ * Marks the edges that split the polygons of the model into triangles, as `vsr_mesh_read`
+ * marks those of a file's polygons: q_min does not bind them (only q >= 0), since a force
+ * network on a polygon mesh needs no force along them. Without them a mesh of quads split
+ * along one diagonal per ring (a latitude-longitude dome) may admit no stress with every
+ * q >= q_min > 0. Replaces the diagonals marked before (`n_diagonals` = 0 clears them).
+ *
+ * `diagonals`: #D by 2 `uint32_t` vertex ids, row-major, each pair an interior edge of the
+ * mesh (either order); NULL only when `n_diagonals` is 0. Copied.
+ *
+ * Errors: NULL `mesh`, or `diagonals` with a non-zero count (`VSR_STATUS_NULL_POINTER`);
+ * `n_diagonals * 2` overflowing (`VSR_STATUS_LENGTH_OVERFLOW`); a vertex id `>= #V`
+ * (`VSR_STATUS_INDEX_OUT_OF_RANGE`); a pair that is no interior edge
+ * (`VSR_STATUS_INVALID_ARGUMENT`). The message names the pair; on failure the mesh keeps
+ * the diagonals it had.
+ *
+ * # Safety
+ * `mesh`: a valid handle with exclusive access; `diagonals`: `2 n_diagonals` readable ids.
+ */
+VsrStatus vsr_mesh_set_polygon_diagonals(struct VsrMesh *mesh, const uint32_t *diagonals, size_t n_diagonals);
+
+/**
+ * Copies the marked polygon diagonals (`vsr_mesh_set_polygon_diagonals`, or those of the
+ * polygons of a file `vsr_mesh_read` read): #D by 2 `uint32_t` vertex ids, row-major,
+ * smaller id first, in edge order. Copy-out as described in the header's introduction.
+ *
+ * # Safety
+ * `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+ */
+VsrStatus vsr_mesh_polygon_diagonals(const struct VsrMesh *mesh, uint32_t *out, size_t len, size_t *needed);
+
+/**
  * Frees a result. NULL is a no-op.
  *
  * # Safety
@@ -1102,10 +1136,12 @@ VsrStatus vsr_result_stalled_vertices(const struct VsrResult *result, uint32_t *
 VsrStatus vsr_result_height_change(const struct VsrResult *result, double *rms, double *max);
 
 /**
- * Distances between the form-found and the input heights, over the plan bounding-box
- * diagonal (dimensionless): `hausdorff` = max |Δz|, `l2` = area-weighted RMS of Δz. Both
- * pointers required; written only on success. For an analysis result:
- * `VSR_STATUS_NOT_AVAILABLE`.
+ * Distances between the form-found and the input surfaces, over the plan bounding-box
+ * diagonal (dimensionless), sampled at vertices: `hausdorff` = the symmetric Hausdorff
+ * distance (the largest distance from a vertex of either surface to the other surface),
+ * `l2` = the RMS distance from the form-found vertices to the input surface, weighted by
+ * vertex area (for the height change itself see `vsr_result_height_change`). Both pointers required; written only
+ * on success. For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
  *
  * # Safety
  * `result`: a valid handle; the out-pointers writable.
@@ -1629,7 +1665,8 @@ VsrStatus vsr_assess_settings_set_fixed_supports(struct VsrAssessSettings *setti
 
 /**
  * Sets the weight per unit volume of the masonry: a face weighs its area on the middle
- * surface × its thickness × `unit_weight`. Finite and > 0. Default 1.
+ * surface × its thickness × `unit_weight`. Finite and >= 0 (0: the mesh's extra loads
+ * alone). Default 1.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

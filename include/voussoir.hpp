@@ -259,6 +259,22 @@ class Mesh {
     VOUSSOIR_DETAIL_GETTER(std::uint32_t, welded_ids, vsr_mesh_welded_ids, VsrMesh)
     VOUSSOIR_DETAIL_GETTER(std::uint32_t, plan_flips, vsr_mesh_plan_flips, VsrMesh)
     VOUSSOIR_DETAIL_GETTER(std::uint32_t, plan_nudges, vsr_mesh_plan_nudges, VsrMesh)
+    /// The marked polygon diagonals: #D by 2 vertex ids (vsr_mesh_polygon_diagonals).
+    VOUSSOIR_DETAIL_GETTER(std::uint32_t, polygon_diagonals, vsr_mesh_polygon_diagonals,
+                           VsrMesh)
+
+    /// Marks the edges that split the model's polygons into triangles (#D by 2 vertex ids),
+    /// which q_min does not bind, replacing those marked before
+    /// (vsr_mesh_set_polygon_diagonals).
+    Mesh &set_polygon_diagonals(const std::vector<std::uint32_t> &diagonals) {
+        check(try_set_polygon_diagonals(diagonals.data(),
+                                        detail::rows(diagonals.size(), 2, "diagonals")));
+        return *this;
+    }
+    [[nodiscard]] VsrStatus try_set_polygon_diagonals(const std::uint32_t *diagonals,
+                                                      std::size_t n_diagonals) noexcept {
+        return vsr_mesh_set_polygon_diagonals(get(), diagonals, n_diagonals);
+    }
 
     /// Weight per unit area of each face (#F values).
     Mesh &face_density(const std::vector<double> &density) {

@@ -11,69 +11,140 @@ const MAX_IDS_SHOWN: usize = 8;
 #[non_exhaustive]
 pub enum Error {
     /// An argument is invalid (empty, wrong length, NaN, out of range, ...).
-    InvalidArgument { name: &'static str, reason: String },
+    InvalidArgument {
+        /// The argument (or setting) at fault.
+        name: &'static str,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// The mesh has no vertices or no faces.
     EmptyMesh,
     /// A face refers to a vertex index `>= n_vertices`.
     IndexOutOfRange {
+        /// The face.
         face: usize,
+        /// The vertex index it refers to.
         index: u64,
+        /// The number of vertices.
         n_vertices: usize,
     },
     /// An anchored (support) id is `>= n_vertices` or repeated.
-    InvalidAnchor { index: u64, reason: &'static str },
+    InvalidAnchor {
+        /// The id.
+        index: u64,
+        /// `out of range` or `listed twice`.
+        reason: &'static str,
+    },
     /// A vertex has a NaN or infinite coordinate.
-    NonFiniteCoordinate { vertex: usize },
+    NonFiniteCoordinate {
+        /// The vertex.
+        vertex: usize,
+    },
     /// A face lists the same vertex twice.
-    RepeatedVertexInFace { face: usize },
+    RepeatedVertexInFace {
+        /// The face.
+        face: usize,
+    },
     /// Two faces have the same three vertices.
-    DuplicateFace { face: usize, first: usize },
+    DuplicateFace {
+        /// The later face.
+        face: usize,
+        /// The earlier face with the same vertices.
+        first: usize,
+    },
     /// Faces whose plan (x, y) projection has (near) zero area.
-    DegenerateFaces { faces: Vec<usize> },
+    DegenerateFaces {
+        /// The faces.
+        faces: Vec<usize>,
+    },
     /// An edge shared by more than two faces.
-    NonManifoldEdge { edge: [usize; 2], faces: Vec<usize> },
+    NonManifoldEdge {
+        /// The edge's vertices.
+        edge: [usize; 2],
+        /// The faces that share it.
+        faces: Vec<usize>,
+    },
     /// A vertex whose faces do not form a single fan (bow-tie).
-    NonManifoldVertex { vertex: usize },
+    NonManifoldVertex {
+        /// The vertex.
+        vertex: usize,
+    },
     /// Two faces traverse their shared edge in the same direction.
-    InconsistentOrientation { edge: [usize; 2], faces: [usize; 2] },
+    InconsistentOrientation {
+        /// The edge's vertices.
+        edge: [usize; 2],
+        /// The two faces.
+        faces: [usize; 2],
+    },
     /// Faces whose plan orientation is opposite to the majority: the plan folds over itself.
-    FlippedFaces { faces: Vec<usize> },
+    FlippedFaces {
+        /// The flipped faces.
+        faces: Vec<usize>,
+    },
     /// Vertices whose plan angles do not sum to 2π (interior vertices) or exceed 2π (boundary
     /// vertices): the plan wraps around them.
-    OverlappingPlan { vertices: Vec<usize> },
+    OverlappingPlan {
+        /// The vertices.
+        vertices: Vec<usize>,
+    },
     /// Two faces that overlap in plan away from any shared vertex (a strip winding over
     /// itself, two components stacked in plan).
-    OverlappingFaces { faces: [usize; 2] },
+    OverlappingFaces {
+        /// The two faces.
+        faces: [usize; 2],
+    },
     /// A connected component of the mesh has no anchored vertex.
     UnsupportedComponent {
+        /// The component.
         component: usize,
+        /// Its vertices.
         vertices: Vec<usize>,
     },
     /// No vertex is anchored at all.
     NoSupports,
     /// A hole could not be joined to its component's outer boundary or to another hole through
     /// interior vertices.
-    HoleNotCuttable { hole: usize, vertex: usize },
+    HoleNotCuttable {
+        /// The hole (its index among the mesh's holes).
+        hole: usize,
+        /// A vertex of its boundary.
+        vertex: usize,
+    },
     /// A numerical failure inside a solver (not a property of the input).
-    Numerical { what: String },
+    Numerical {
+        /// What failed, in words.
+        what: String,
+    },
     /// A file could not be read or written.
-    Io { path: String, reason: String },
+    Io {
+        /// The file.
+        path: String,
+        /// The system's reason.
+        reason: String,
+    },
     /// A file could be read but its content is malformed.
     Parse {
+        /// The file.
         path: String,
+        /// The line at fault (1-based).
         line: usize,
+        /// What is wrong there.
         reason: String,
     },
     /// A binary file (or a part of a file without lines) is malformed: `element` names the
     /// part at fault, such as `triangle 12` or `vertex 3`.
     Malformed {
+        /// The file.
         path: String,
+        /// The part at fault.
         element: String,
+        /// What is wrong there.
         reason: String,
     },
 }
 
-fn ids(list: &[usize]) -> String {
+/// At most [`MAX_IDS_SHOWN`] ids, comma-separated, then how many there are in all.
+pub(crate) fn ids(list: &[usize]) -> String {
     let mut s: Vec<String> = list
         .iter()
         .take(MAX_IDS_SHOWN)
@@ -160,38 +231,6 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
-/// The sentence a user reads for a termination (the C API's termination message).
-impl fmt::Display for crate::Termination {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        use crate::Termination::*;
-        match self {
-            Converged => write!(f, "converged: eps_inf is below the tolerance"),
-            MaxIterations => write!(f, "reached the iteration limit"),
-            Stalled { vertices } if vertices.is_empty() => {
-                write!(f, "stalled: eps_inf stopped improving")
-            }
-            Stalled { vertices } => {
-                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
-                write!(
-                    f,
-                    "stalled: eps_inf stopped improving; vertices {} carry (almost) no stress \
-                     (raise q_min)",
-                    ids(&list)
-                )
-            }
-            Infeasible { constraint } => {
-                write!(f, "infeasible stress constraints: relax {constraint}")
-            }
-            NumericalError { what } => write!(f, "numerical error: {what}"),
-            Cancelled => write!(f, "cancelled by the progress callback"),
-            Blocked { vertices, hint } => {
-                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
-                write!(f, "blocked: {hint}; vertices {}", ids(&list))
-            }
-        }
-    }
-}
-
 /// A failed sparse Cholesky factorisation of `matrix` as an [`Error::Numerical`] in words
 /// (faer's own `Display` of these errors is their `Debug` text), for the shape step's
 /// factorisations (`src/shape`).
@@ -228,7 +267,6 @@ pub type Result<T> = std::result::Result<T, Error>;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Termination;
 
     #[test]
     fn factorisation_failures_are_sentences() {
@@ -244,34 +282,5 @@ mod tests {
         let memory = LltError::Generic(faer::sparse::FaerError::OutOfMemory);
         let text = factorisation_failure("shape system", &memory).to_string();
         assert_eq!(text, "numerical failure: shape system: memory ran out");
-    }
-
-    #[test]
-    fn terminations_read_as_sentences() {
-        let stalled = Termination::Stalled {
-            vertices: vec![4, 9],
-        };
-        assert_eq!(
-            stalled.to_string(),
-            "stalled: eps_inf stopped improving; vertices 4, 9 carry (almost) no stress (raise q_min)"
-        );
-        let many = Termination::Stalled {
-            vertices: (0..20).collect(),
-        };
-        assert!(many.to_string().contains("... (20 in all)"), "{many}");
-        for t in [
-            Termination::Converged,
-            Termination::MaxIterations,
-            Termination::Cancelled,
-            Termination::Infeasible {
-                constraint: "q_min".into(),
-            },
-            Termination::NumericalError {
-                what: "stress QP failed".into(),
-            },
-        ] {
-            let text = t.to_string();
-            assert!(!text.contains(['{', '[', '(']), "{text}");
-        }
     }
 }

@@ -10,7 +10,9 @@ use spade::{
 /// A plan domain: an outer polygon and hole polygons (any orientation).
 #[derive(Debug, Clone, Default)]
 pub struct Domain {
+    /// The outer boundary, a closed polygon (counter-clockwise).
     pub outer: Vec<[f64; 2]>,
+    /// The holes, closed polygons inside it.
     pub holes: Vec<Vec<[f64; 2]>>,
 }
 
@@ -265,6 +267,7 @@ pub enum KnownPlan {
 }
 
 impl KnownPlan {
+    /// Every plan, for tests over all of them.
     pub const ALL: [KnownPlan; 5] = [
         KnownPlan::Disk,
         KnownPlan::Square,
@@ -359,6 +362,7 @@ pub enum Perturbation {
 }
 
 impl Perturbation {
+    /// Every perturbation, for tests over all of them.
     pub const ALL: [Perturbation; 5] = [
         Perturbation::Dent,
         Perturbation::Flatten,

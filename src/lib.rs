@@ -15,6 +15,7 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 #![deny(unsafe_code)]
+#![warn(missing_docs)]
 
 mod assess;
 pub mod capi;
@@ -23,7 +24,9 @@ pub mod generate;
 mod geometry;
 pub mod io;
 mod mesh;
+mod names;
 mod problem;
+pub mod report;
 mod setters;
 mod shape;
 mod smooth;
@@ -32,7 +35,10 @@ mod solve;
 mod stress;
 mod validate;
 
-pub use assess::{assess, AssessResult, AssessSettings, Envelope, Objective};
+pub use assess::{
+    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, FamilyThickness,
+    Objective,
+};
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;
 pub use geometry::loads::LoadRule;
@@ -57,5 +63,5 @@ pub mod internals {
     pub use crate::geometry::{Frame, Plan};
     pub use crate::stress::airy::AiryOperator;
     pub use crate::stress::holes::cut_holes;
-    pub use crate::stress::{analyse_at, analyse_cached, StressCache};
+    pub use crate::stress::{analyse_cached, StressCache};
 }

@@ -8,6 +8,7 @@ use crate::mesh::Mesh;
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct Problem {
+    /// The validated mesh.
     pub mesh: Mesh,
     /// Weight per unit area of each face (density × thickness × g). Default 1.
     pub face_density: Vec<f64>,
@@ -33,6 +34,8 @@ fn check_len(name: &'static str, len: usize, expected: usize, what: &str) -> Res
 }
 
 impl Problem {
+    /// `mesh` with the default loads: density 1 on every face, no extra loads, no horizontal
+    /// forces, τ = 0, no polygon diagonals.
     pub fn new(mesh: Mesh) -> Problem {
         let (nv, nf, ne) = (mesh.positions.len(), mesh.faces.len(), mesh.edges.len());
         Problem {
@@ -105,16 +108,25 @@ impl Problem {
     }
 
     /// Marks the edges (vertex pairs, either order) that split the model's polygons into
-    /// triangles, as [`crate::io::read_mesh_with_diagonals`] lists them: a force network on a
-    /// polygon mesh needs no force along them, so q_min does not bind them. Such a split can
+    /// triangles, as [`crate::io::read_mesh_with_diagonals`] lists them (and
+    /// [`crate::io::read_model`] marks them), replacing any marked before: a force network on
+    /// a polygon mesh needs no force along them, so q_min does not bind them. Such a split can
     /// leave no network with every q ≥ q_min > 0 (rings of quads all split along the same
     /// diagonal, as in a latitude-longitude dome). A pair that is no interior edge of the mesh
-    /// is an error naming it.
+    /// (a vertex id out of range included) is an [`Error::InvalidArgument`] naming it.
     pub fn with_polygon_diagonals(mut self, diagonals: &[[u32; 2]]) -> Result<Problem> {
         let mesh = &self.mesh;
+        let n = mesh.n_vertices();
+        let mut marked = vec![false; mesh.n_edges()];
         for (k, &[a, b]) in diagonals.iter().enumerate() {
+            if let Some(&v) = [a, b].iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidArgument {
+                    name: "diagonals",
+                    reason: format!("pair {k} has vertex {v}, but there are only {n} vertices"),
+                });
+            }
             match mesh.edge_between(a, b) {
-                Some(e) if !mesh.edges[e].is_boundary() => self.polygon_diagonal[e] = true,
+                Some(e) if !mesh.edges[e].is_boundary() => marked[e] = true,
                 _ => {
                     return Err(Error::InvalidArgument {
                         name: "diagonals",
@@ -123,7 +135,33 @@ impl Problem {
                 }
             }
         }
+        self.polygon_diagonal = marked;
         Ok(self)
+    }
+
+    /// The marked polygon diagonals (see [`Problem::with_polygon_diagonals`]) as vertex
+    /// pairs, smaller id first, in edge order.
+    pub fn polygon_diagonals(&self) -> Vec<[u32; 2]> {
+        (self.mesh.edges.iter().zip(&self.polygon_diagonal))
+            .filter(|(_, &d)| d)
+            .map(|(e, _)| e.v)
+            .collect()
+    }
+
+    /// The mean of `loads` (one per vertex, as [`crate::StressResult::loads`]) over the
+    /// non-anchored vertices: p̄, the unit of ε∞ and of relative force-density bounds (with
+    /// L₀). 1 when there is no such vertex or the mean is not positive, as the solver takes it.
+    pub fn mean_load(&self, loads: &[f64]) -> f64 {
+        let free: Vec<f64> = (0..self.mesh.n_vertices())
+            .filter(|&v| self.mesh.is_non_anchored(v))
+            .filter_map(|v| loads.get(v).copied())
+            .collect();
+        let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
+        if mean > 0.0 {
+            mean
+        } else {
+            1.0
+        }
     }
 
     /// Prescribed normal push per vertex (used at free boundary vertices): finite and >= 0.

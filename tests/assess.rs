@@ -6,8 +6,8 @@ mod common;
 
 use voussoir::generate::{self, KnownPlan};
 use voussoir::{
-    assess, AssessResult, AssessSettings, Envelope, Error, Mesh, Objective, Problem, Termination,
-    Thickness,
+    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error, Mesh,
+    Objective, Problem, Termination, Thickness,
 };
 
 /// A fan: a free centre at height `rise` over n rim supports on the circle of radius `r`.
@@ -145,6 +145,22 @@ fn a_self_supporting_middle_surface_is_its_own_nearest_thrust_surface() {
         .map(|(a, b)| (a[2] - b[2]).abs())
         .fold(0.0, f64::max);
     assert!(moved < 1e-4, "moved {moved}");
+    // Its least thickness over any family about it is 0.
+    let problem = Problem::new(truth.clone());
+    let envelope_at = |t: f64| Envelope::from_thickness(&truth, &Thickness::Uniform(t));
+    let family = min_thickness_of_family(
+        &problem,
+        envelope_at,
+        0.05,
+        1e-3,
+        &AssessSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        family.converged && family.thickness < 1e-7,
+        "{}",
+        family.thickness
+    );
 }
 
 /// A hemispherical dome: every analysis returns a certified thrust surface, the least
@@ -423,4 +439,89 @@ fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
         }
     }
     faces
+}
+
+/// The shell between radii 1 ± t/2 read on the vertical at plan radius `r`; below the
+/// intrados' footprint the springing plane z = 0 bounds it.
+fn shell(mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, t: f64) -> voussoir::Result<Envelope> {
+    let at = |rho: f64, r: f64| (rho * rho - r * r).max(0.0).sqrt();
+    let (lower, upper) = (mesh.positions.iter())
+        .map(|&p| (at(1.0 - 0.5 * t, radius(p)), at(1.0 + 0.5 * t, radius(p))))
+        .unzip();
+    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
+}
+
+/// A family whose bounds scale linearly about a fixed middle (a normal thickness read by the
+/// tangent plane) has the least-thickness analysis' answer: t_min = t · s.
+#[test]
+fn a_linear_family_gives_the_least_thickness_analysis_answer() {
+    let (p, t) = generate::polar_disk(4);
+    let height = |u: [f64; 2]| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt();
+    let mesh = generate::lift(&p, &t, height, |_, outer| outer).unwrap();
+    let problem = Problem::new(mesh.clone());
+    let envelope_at = |t: f64| Envelope::from_thickness(&mesh, &Thickness::Uniform(t));
+    let settings = AssessSettings::default().with_objective(Objective::MinThickness);
+    let direct = run(mesh.clone(), &envelope_at(0.1).unwrap(), settings.clone());
+    check_certificate(&mesh, &envelope_at(0.1).unwrap(), &direct, 1e-6);
+    let family = min_thickness_of_family(&problem, envelope_at, 0.1, 1e-3, &settings).unwrap();
+    assert!(family.converged, "{} rounds", family.rounds);
+    let expected = 0.1 * direct.thickness_scale;
+    assert!(
+        (family.thickness - expected).abs() <= 3e-3 * expected,
+        "family {} vs analysis {expected}",
+        family.thickness
+    );
+    let at_min = envelope_at(family.thickness).unwrap();
+    check_certificate(&mesh, &at_min, &family.result, 1e-6);
+    assert!(family.result.thickness_scale <= 1.0);
+}
+
+/// Over the shells 1 ± t/2 read vertically (Heyman's terms) a semicircular barrel's least
+/// thickness is certified inside its own shell, and a shell 3 % thinner holds no surface
+/// (the answer is a local least thickness of the family, not just a thickness that fits).
+#[test]
+fn the_least_shell_of_a_barrel_fits_and_a_thinner_one_does_not() {
+    let (nx, ny) = (16, 2);
+    let points: Vec<[f64; 2]> = (0..=ny)
+        .flat_map(|j| (0..=nx).map(move |i| [-1.0 + 2.0 * i as f64 / nx as f64, 0.1 * j as f64]))
+        .collect();
+    let height = |u: [f64; 2]| (1.0 - u[0] * u[0]).max(0.0).sqrt();
+    let faces = grid_faces(nx, ny);
+    let mesh = generate::lift(&points, &faces, height, |u, _| u[0].abs() > 1.0 - 1e-9).unwrap();
+    let problem = Problem::new(mesh.clone());
+    let envelope_at = |t: f64| shell(&mesh, |p| p[0].abs(), t);
+    let settings = AssessSettings::default();
+    let family = min_thickness_of_family(&problem, envelope_at, 0.2, 1e-3, &settings).unwrap();
+    let t = family.thickness;
+    check_certificate(&mesh, &envelope_at(t).unwrap(), &family.result, 1e-6);
+    assert!(family.converged && t > 0.02 && t < 0.2, "t_min {t}");
+    let thinner = envelope_at(0.97 * t).unwrap();
+    let fit = run(mesh.clone(), &thinner, settings.clone());
+    assert!(
+        !fit.feasible,
+        "a surface fits the shell of thickness {}",
+        0.97 * t
+    );
+}
+
+#[test]
+fn a_family_with_a_bad_start_or_no_surface_is_named() {
+    let mesh = fan(6, 1.0, 0.5);
+    let problem = Problem::new(mesh.clone());
+    let settings = AssessSettings::default();
+    let envelope_at = |t: f64| Envelope::from_thickness(&mesh, &Thickness::Uniform(t));
+    for (t, tol, name) in [(0.0, 1e-3, "thickness"), (0.1, f64::NAN, "scale_tolerance")] {
+        match min_thickness_of_family(&problem, envelope_at, t, tol, &settings) {
+            Err(Error::InvalidArgument { name: n, .. }) => assert_eq!(n, name),
+            other => panic!("expected an error naming {name}, got {other:?}"),
+        }
+    }
+    let failing = |_: f64| -> voussoir::Result<Envelope> {
+        Err(Error::InvalidArgument {
+            name: "envelope_at",
+            reason: "no such shell".into(),
+        })
+    };
+    let e = min_thickness_of_family(&problem, failing, 0.1, 1e-3, &settings).unwrap_err();
+    assert!(message(e).contains("no such shell"));
 }

@@ -15,7 +15,9 @@ use formfind_support::views::{match_faces, view_polygons};
 use formfind_support::xml::{parse_xml, Element};
 use formfind_support::*;
 use serde_json::Value;
-use voussoir::{assess, AssessSettings, Envelope, Mesh, Problem, Thickness};
+use voussoir::io::{read_model, ReadOptions, Supports};
+use voussoir::report::AssessmentReport;
+use voussoir::{assess, AssessSettings, Envelope, Mesh, Objective, Problem, Thickness};
 
 /// The 60° dome of the C ABI tests: 37 vertices, the rim (12) anchored.
 fn dome() -> Dome {
@@ -233,6 +235,35 @@ fn fit_writes_the_librarys_certified_thrust_surface() {
     );
     assert_eq!(bits(&numbers(&a["bounds"]["lower"])), bits(&lib.lower));
     assert_eq!(a["thrust_horizontal"].as_f64(), Some(lib.thrust_horizontal));
+}
+
+/// The report is the library's `AssessmentReport` of the same run (the one schema of both
+/// command lines): every value equal but the wall time.
+#[test]
+fn the_report_is_the_librarys_assessment_report() {
+    let dir = with_dome("assess-report");
+    let (code, err) = run_dome(&dir, &["--assess", "min-thickness", "--thickness", "0.1"]);
+    assert_eq!(code, 0, "{err}");
+    let cli = read_json(&dir.path("r.json"));
+
+    let model = read_model(&dir.path("dome.obj"), &ReadOptions::new(Supports::Boundary)).unwrap();
+    let thickness = Thickness::Uniform(0.1);
+    let envelope = Envelope::from_thickness(&model.problem.mesh, &thickness).unwrap();
+    let settings = AssessSettings::default().with_objective(Objective::MinThickness);
+    let r = assess(&model.problem, &envelope, &settings, None).unwrap();
+    let report = AssessmentReport::new(&model, &envelope, &settings, &r, Some(0.1));
+    let lib: Value = serde_json::from_str(&report.to_json()).unwrap();
+
+    let comparable = |mut v: Value| {
+        v["assessment"]["seconds"] = Value::Null;
+        v["settings"]["mesh"] = Value::Null;
+        v
+    };
+    assert_eq!(comparable(cli.clone()), comparable(lib));
+    assert_eq!(cli["settings"]["mesh"], "dome.obj");
+    assert_eq!(cli["settings"]["objective"], "min-thickness");
+    assert_eq!(cli["settings"]["load_rule"], "barycentric");
+    assert_eq!(cli["assessment"]["termination"], "converged");
 }
 
 #[test]

@@ -123,7 +123,7 @@ fn anchor_lowest_finds_the_supports_of_a_vault_on_the_ground() {
     assert!(lowest["settings"]["supports"]
         .as_str()
         .unwrap()
-        .contains("--anchor-lowest"));
+        .contains("lowest height"));
     // An absolute reach of half the vault's height anchors more.
     let wide = run_ok(
         &dir,

@@ -290,7 +290,7 @@ fn read_model_chooses_supports_turns_y_up_and_marks_diagonals() {
             assert!((a[k] - b[k]).abs() < 1e-15, "{a:?} {b:?}");
         }
     }
-    assert_eq!(turned.up, UpAxis::Y);
+    assert_eq!(turned.options.up, UpAxis::Y);
     let p = [1.0, 2.0, 3.0];
     assert_eq!(UpAxis::Y.to_file(UpAxis::Y.to_z_up(p)), p);
 }

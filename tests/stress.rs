@@ -579,7 +579,9 @@ fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     for (k, &(problem, positions, settings)) in steps.iter().enumerate() {
         let cached =
             internals::analyse_cached(problem, positions, settings, None, &mut cache).unwrap();
-        let fresh = internals::analyse_at(problem, positions, settings).unwrap();
+        let fresh =
+            internals::analyse_cached(problem, positions, settings, None, &mut Default::default())
+                .unwrap();
         assert_eq!(cached.solver, QpSolver::Native, "step {k}");
         assert_same_results(&format!("step {k}"), problem, cached, fresh);
     }
@@ -600,7 +602,8 @@ fn a_slightly_moved_shape_is_solved_from_the_previous_active_set() {
     assert!(first.iterations > 0);
     let raised = heights_scaled(&dome.mesh, 1.01);
     let warm = internals::analyse_cached(&dome, &raised, &settings, None, &mut cache).unwrap();
-    let cold = internals::analyse_at(&dome, &raised, &settings).unwrap();
+    let cold = internals::analyse_cached(&dome, &raised, &settings, None, &mut Default::default())
+        .unwrap();
     assert_eq!(warm.solver, QpSolver::Native);
     assert_eq!(warm.iterations, 0, "cold: {} iterations", cold.iterations);
     assert!(cold.iterations > 0);

@@ -1,6 +1,7 @@
 //! Command-line options, parsed with lexopt and validated before any file is read.
 
 use std::path::PathBuf;
+use std::str::FromStr;
 
 use crate::assess::args::AssessOptions;
 use voussoir::io::{ReadOptions, Supports, UpAxis};
@@ -9,38 +10,10 @@ use voussoir::{
     TauMode,
 };
 
-/// The choices of the enumerated options, as spelled on the command line.
-pub const METHODS: [(&str, FormMethod); 2] = [
-    ("nearest", FormMethod::Nearest),
-    ("paper", FormMethod::Paper),
-];
-pub const SOLVERS: [(&str, Formulation); 2] = [
-    ("reduced", Formulation::Reduced),
-    ("edge-based", Formulation::EdgeBased),
-];
-pub const QP_SOLVERS: [(&str, QpSolver); 2] = [
-    ("native", QpSolver::Native),
-    ("clarabel", QpSolver::Clarabel),
-];
-pub const SCOPES: [(&str, EdgeScope); 2] =
-    [("interior", EdgeScope::Interior), ("all", EdgeScope::All)];
-pub const TAUS: [(&str, TauMode); 2] = [("optimize", TauMode::Optimized), ("zero", TauMode::Zero)];
-pub const HOLES: [(&str, HoleMode); 2] = [
-    ("affine", HoleMode::Affine),
-    ("constant", HoleMode::Constant),
-];
-pub const LOADS: [(&str, LoadRule); 3] = [
-    ("barycentric", LoadRule::Barycentric),
-    ("voronoi", LoadRule::Voronoi),
-    ("plan", LoadRule::PlanArea),
-];
-
-/// The command-line spelling of `value` (its variant name when the table lacks it).
-pub fn name_of<T: PartialEq + Copy + std::fmt::Debug>(table: &[(&str, T)], value: T) -> String {
-    table.iter().find(|(_, v)| *v == value).map_or_else(
-        || crate::report::variant_name(&format!("{value:?}")),
-        |(n, _)| n.to_string(),
-    )
+/// The names of `all`, as the library spells them (`voussoir`'s `as_str`), joined by `sep`.
+fn names<T: std::fmt::Display>(all: &[T], sep: &str) -> String {
+    let names: Vec<String> = all.iter().map(|v| v.to_string()).collect();
+    names.join(sep)
 }
 
 /// A bound as typed on the command line: `X` (relative) or `Xabs`.
@@ -144,24 +117,24 @@ Assessment (instead of form finding; MESH is the masonry's middle surface):
 
 Solver:
   --stress-only          analyse the input shape only, do not move it
-  --method M             nearest | paper: the nearest self-supporting shape
+  --method M             {methods}: the nearest self-supporting shape
                          (least area-weighted squared height change), or
                          the paper's loop                                  [{method}]
   --fairness G           nearest method: weight of the change's smoothness [{fairness}]
   --max-height-change H  nearest method: no vertex moves more than H plan
                          diagonals                                         [{limit}]
-  --solver S             reduced | edge-based                              [{solver}]
-  --qp Q                 native | clarabel: the QP solver (native falls
+  --solver S             {solvers}                              [{solver}]
+  --qp Q                 {qps}: the QP solver (native falls
                          back to clarabel when it does not converge)       [{qp}]
   --tol T                stop when eps_inf = max|r_i| / mean load < T      [{tol:e}]
   --max-iter N           at most N stress steps                            [{max_iter}]
   --qmin X               lower bound on force densities, relative to p/L0
                          (mean load / half the plan diagonal); Xabs is
                          absolute, in force per length, e.g. 2.5abs        [{qmin}]
-  --qmin-scope S         interior | all: the edges --qmin applies to       [{scope}]
+  --qmin-scope S         {scopes}: the edges --qmin applies to       [{scope}]
   --qmax X               upper bound on force densities, as --qmin, or none [{qmax}]
-  --tau M                optimize | zero: normal push at free edges        [{tau}]
-  --holes H              affine | constant: how the Airy function jumps
+  --tau M                optimized | zero: normal push at free edges       [{tau}]
+  --holes H              {holes_}: how the Airy function jumps
                          around a hole (constant: the paper's, a torque
                          only; its optimum can be worse)                   [{holes}]
   --dual-smoothing MU    penalty MU on differences of force-diagram edge
@@ -172,7 +145,8 @@ Solver:
                          on the input first; the paper method one before
                          each of its first N stress steps                  [0]
   --density D            weight per unit area of every face                [1]
-  --load R               barycentric | voronoi | plan: face weight sharing [{load}]
+  --load R               {loads}: how a face's
+                         weight is shared among its vertices               [{load}]
   -h, --help             this text
 
 Exit status: 0 converged (or --stress-only solved; with --assess: a certified thrust
@@ -180,21 +154,27 @@ surface found and the analysis converged), 3 finished without converging or (--a
 no thrust surface inside the envelope (outputs written, the report says why), 2 bad input,
 options or output paths (nothing written), 1 other failure (nothing written).
 ",
-        method = name_of(&METHODS, d.method),
+        methods = names(FormMethod::ALL, " | "),
+        solvers = names(Formulation::ALL, " | "),
+        qps = names(QpSolver::ALL, " | "),
+        scopes = names(EdgeScope::ALL, " | "),
+        holes_ = names(HoleMode::ALL, " | "),
+        loads = names(LoadRule::ALL, " | "),
+        method = d.method,
         fairness = d.fairness,
         limit = d.max_height_change,
-        solver = name_of(&SOLVERS, st.formulation),
-        qp = name_of(&QP_SOLVERS, st.solver),
+        solver = st.formulation,
+        qp = st.solver,
         tol = d.tolerance,
         max_iter = d.max_iterations,
         qmin = bound_text(Some(st.q_min)),
-        scope = name_of(&SCOPES, st.q_min_scope),
+        scope = st.q_min_scope,
         qmax = bound_text(st.q_max),
-        tau = name_of(&TAUS, st.tau),
-        holes = name_of(&HOLES, st.holes),
+        tau = st.tau,
+        holes = st.holes,
         smooth = st.dual_length_smoothing,
         decay = d.smoothing_decay,
-        load = name_of(&LOADS, st.load_rule),
+        load = st.load_rule,
         weld = voussoir::io::DEFAULT_WELD_TOLERANCE,
     )
 }
@@ -331,15 +311,12 @@ fn tolerance(flag: &str, text: &str) -> Result<(f64, bool), String> {
     }
 }
 
-fn choice<T: Copy>(flag: &str, text: &str, choices: &[(&str, T)]) -> Result<T, String> {
-    choices
-        .iter()
-        .find(|(name, _)| *name == text)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<&str> = choices.iter().map(|(n, _)| *n).collect();
-            format!("{flag}: expected {}, got `{text}`", names.join(" or "))
-        })
+/// An enumerated option by its library name (`FromStr` of the library's enums).
+fn choice<T: FromStr<Err = voussoir::Error>>(flag: &str, text: &str) -> Result<T, String> {
+    text.parse().map_err(|e| match e {
+        voussoir::Error::InvalidArgument { reason, .. } => format!("{flag}: {reason}"),
+        e => format!("{flag}: {e}"),
+    })
 }
 
 /// Records `flag` in `given`, refusing a second use of it (or of the other spelling of the
@@ -422,7 +399,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             "--weld" => o.weld = Some(number(&flag, &value()?)?),
             "--no-weld" => o.weld = None,
             "--strict" => o.strict = true,
-            "--up" => o.up = choice(&flag, &value()?, &[("z", UpAxis::Z), ("y", UpAxis::Y)])?,
+            "--up" => o.up = choice(&flag, &value()?)?,
             "--out" => o.out = Some(value()?.into()),
             "--report" => o.report = Some(value()?.into()),
             "--pictures" => o.pictures = Some(value()?.into()),
@@ -440,11 +417,11 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
             }
             "--ascii" => o.ascii = true,
             "--stress-only" => o.stress_only = true,
-            "--method" => s.method = choice(&flag, &value()?, &METHODS)?,
+            "--method" => s.method = choice(&flag, &value()?)?,
             "--fairness" => s.fairness = number(&flag, &value()?)?,
             "--max-height-change" => s.max_height_change = number(&flag, &value()?)?,
-            "--solver" => s.stress.formulation = choice(&flag, &value()?, &SOLVERS)?,
-            "--qp" => s.stress.solver = choice(&flag, &value()?, &QP_SOLVERS)?,
+            "--solver" => s.stress.formulation = choice(&flag, &value()?)?,
+            "--qp" => s.stress.solver = choice(&flag, &value()?)?,
             "--tol" => s.tolerance = number(&flag, &value()?)?,
             "--max-iter" => {
                 let text = value()?;
@@ -453,7 +430,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                     .map_err(|_| format!("{flag}: expected an integer >= 1, got `{text}`"))?;
             }
             "--qmin" => s.stress.q_min = bound(&flag, &value()?)?,
-            "--qmin-scope" => s.stress.q_min_scope = choice(&flag, &value()?, &SCOPES)?,
+            "--qmin-scope" => s.stress.q_min_scope = choice(&flag, &value()?)?,
             "--qmax" => {
                 let text = value()?;
                 s.stress.q_max = match text.as_str() {
@@ -461,8 +438,16 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                     _ => Some(bound(&flag, &text)?),
                 };
             }
-            "--tau" => s.stress.tau = choice(&flag, &value()?, &TAUS)?,
-            "--holes" => s.stress.holes = choice(&flag, &value()?, &HOLES)?,
+            "--tau" => {
+                s.stress.tau = choice(&flag, &value()?)?;
+                if s.stress.tau == TauMode::Prescribed {
+                    return Err(format!(
+                        "{flag}: prescribed needs a value per vertex, which the command line \
+                         cannot give: use optimized or zero"
+                    ));
+                }
+            }
+            "--holes" => s.stress.holes = choice(&flag, &value()?)?,
             "--dual-smoothing" => s.stress.dual_length_smoothing = number(&flag, &value()?)?,
             "--smoothing-decay" => s.smoothing_decay = number(&flag, &value()?)?,
             "--odt" => {
@@ -480,7 +465,7 @@ pub fn parse(args: impl IntoIterator<Item = std::ffi::OsString>) -> Result<Parse
                 }
                 o.density = d;
             }
-            "--load" => s.stress.load_rule = choice(&flag, &value()?, &LOADS)?,
+            "--load" => s.stress.load_rule = choice(&flag, &value()?)?,
             _ => {
                 if !crate::assess::args::flag(&flag, &mut value, &mut o.assess)? {
                     return Err(format!("unknown option `{flag}`; try --help"));

@@ -78,26 +78,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// The report with one top-level key per line: objects indented, arrays kept on one line.
-fn report_text(report: &Value) -> String {
-    let Value::Object(map) = report else {
-        return report.to_string();
-    };
-    let lines: Vec<String> = map
-        .iter()
-        .map(|(k, v)| {
-            let value = match v {
-                Value::Object(_) => serde_json::to_string_pretty(v)
-                    .expect("JSON values serialise")
-                    .replace('\n', "\n  "),
-                _ => v.to_string(),
-            };
-            format!("  {}: {value}", Value::from(k.as_str()))
-        })
-        .collect();
-    format!("{{\n{}\n}}\n", lines.join(",\n"))
-}
-
 /// Where a run writes.
 struct Paths {
     out: PathBuf,
@@ -174,10 +154,10 @@ fn formfind() -> Result<ExitCode, Failure> {
     .map_err(bad_input)?;
 
     let outcome = run::run(model, &o).map_err(solver_failure)?;
-    let mut report = report::build(&o, &outcome);
+    let mut report = serde_json::to_value(outcome.report(&o.settings)).map_err(failed)?;
     let solid = match o.thickness() {
         Some(thickness) => {
-            let solid = voussoir::thicken(&outcome.model.mesh, &outcome.positions, &thickness)
+            let solid = voussoir::thicken(outcome.model.mesh(), &outcome.positions, &thickness)
                 .map_err(|e| bad_input(format!("--solid: {}", reason(&e))))?;
             report["solid"] = report::solid(&solid, &outcome, &o);
             Some(solid)
@@ -240,7 +220,7 @@ fn write_outputs(
 ) -> Result<(), Failure> {
     // Nothing is on disk before this point; the staging writes all files or none.
     let mut staging = output::Staging::default();
-    let mesh = &model.mesh;
+    let mesh = model.mesh();
     // Written meshes keep the input's axes.
     let axes_of_input = |positions: &[[f64; 3]]| -> Vec<[f64; 3]> {
         positions.iter().map(|&p| o.up.to_file(p)).collect()
@@ -264,7 +244,10 @@ fn write_outputs(
             .map_err(failed)?;
     }
     staging
-        .write(&paths.report, report_text(outputs.report).as_bytes())
+        .write(
+            &paths.report,
+            voussoir::report::json_text(outputs.report).as_bytes(),
+        )
         .map_err(failed)?;
     for (file, svg) in outputs.pictures {
         staging
@@ -345,18 +328,18 @@ pub fn input_paths(o: &args::Options) -> Vec<(&'static str, &Path)> {
 
 /// The lines about the input: sizes, welding, plan repairs.
 fn print_model(m: &model::Model) {
-    let mesh = &m.mesh;
+    let mesh = m.mesh();
     say!(
         "{} ({}): {}, {}, {}, {}, {} anchored",
         m.name,
-        m.source,
+        m.read.source,
         count(mesh.n_vertices(), "vertex", "vertices"),
         count(mesh.n_faces(), "face", "faces"),
         count(mesh.n_edges(), "edge", "edges"),
         count(mesh.holes().count(), "hole", "holes"),
         mesh.anchored.iter().filter(|a| **a).count()
     );
-    if let Some(w) = m.weld.as_ref().filter(|w| w.merged > 0) {
+    if let Some(w) = m.read.weld.as_ref().filter(|w| w.merged > 0) {
         say!(
             "welded: {} of {} input vertices merged (closer than {:.3e}), {} collapsed",
             w.merged,
@@ -365,16 +348,16 @@ fn print_model(m: &model::Model) {
             count(w.collapsed_faces.len(), "face", "faces")
         );
     }
-    if !m.repairs.is_empty() {
-        let flips = m
-            .repairs
+    let repairs = &m.read.repairs;
+    if !repairs.is_empty() {
+        let flips = repairs
             .iter()
             .filter(|r| matches!(r, voussoir::PlanRepair::Flip { .. }))
             .count();
         say!(
             "plan repaired: {}, {} (listed in the report; --strict rejects instead)",
             count(flips, "edge flip", "edge flips"),
-            count(m.repairs.len() - flips, "vertex nudge", "vertex nudges")
+            count(repairs.len() - flips, "vertex nudge", "vertex nudges")
         );
     }
 }
@@ -398,9 +381,12 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.tolerance,
                 outcome.before.eps_inf
             );
-            let detail = &report["termination_detail"];
             // A stall with no vertex to name has nothing to add to its own line.
-            if !detail.is_null() && *detail != serde_json::json!({ "vertices": [] }) {
+            let vertices = &report["termination_vertices"];
+            if vertices.as_array().is_some_and(|v| !v.is_empty()) {
+                say!("  vertices: {vertices}");
+            }
+            if let Some(detail) = report["termination_detail"].as_str() {
                 say!("  details: {detail}");
             }
             say!(

@@ -3,29 +3,29 @@
 use std::path::Path;
 
 use voussoir::generate::{self, Domain};
-use voussoir::io::{self, Supports, UpAxis, WeldSummary};
-use voussoir::{Mesh, PlanRepair};
+use voussoir::io::{self, UpAxis};
+use voussoir::{Mesh, Problem};
 
 use crate::args::Options;
 
-/// A validated mesh, the faces to write back (as read, before any reorientation) and where it
-/// came from.
+/// The problem of a run, how it was read, and the faces to write back (as read, before any
+/// reorientation).
 pub struct Model {
     /// Short name used for default output file names.
     pub name: String,
-    /// Where the mesh came from, for the report.
-    pub source: String,
+    /// How the supports were chosen, for the report.
     pub supports: String,
-    pub mesh: Mesh,
+    /// The problem (its loads those of `--density` once `run::run` set them) and how it was
+    /// read: the library's `io::read_model`, or `io::Model::from_problem` for the embedded
+    /// default.
+    pub read: io::Model,
     pub faces: Vec<[u32; 3]>,
-    /// The mesh vertex of each file vertex (identity when not welded).
-    pub welded_ids: Vec<u32>,
-    /// The welding of a mesh file (`None` for the embedded default and `--no-weld`).
-    pub weld: Option<WeldSummary>,
-    /// Plan repairs made before validation (none with `--strict`).
-    pub repairs: Vec<PlanRepair>,
-    /// The mesh edges that split the file's polygons into triangles (welded ids).
-    pub diagonals: Vec<[u32; 2]>,
+}
+
+impl Model {
+    pub fn mesh(&self) -> &Mesh {
+        &self.read.problem.mesh
+    }
 }
 
 /// Plan of the embedded default: a rectangle of half-widths `HALF_X` × `HALF_Y` whose sides bow
@@ -77,17 +77,12 @@ pub fn embedded_default() -> Model {
     let mesh = generate::lift(&points, &triangles, height, pillar)
         .expect("the embedded vault is a valid mesh");
     let faces = mesh.faces.clone();
-    let welded_ids = (0..mesh.n_vertices() as u32).collect();
+    let source = "embedded default: sail vault on four pillars, free arches, two oculi";
     Model {
         name: "vault".into(),
-        source: "embedded default: sail vault on four pillars, free arches, two oculi".into(),
         supports: "corner pillars".into(),
-        mesh,
+        read: io::Model::from_problem(Problem::new(mesh), source),
         faces,
-        welded_ids,
-        weld: None,
-        repairs: Vec::new(),
-        diagonals: Vec::new(),
     }
 }
 
@@ -113,35 +108,14 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
         }) => return Err(format!("--weld: {reason} (or --no-weld)")),
         other => other.map_err(|e| e.to_string())?,
     };
-    let supports = match &options.supports {
-        Supports::File(path) => path.display().to_string(),
-        Supports::Lowest {
-            tolerance,
-            absolute,
-        } => {
-            let unit = if *absolute {
-                ""
-            } else {
-                " x the bounding box diagonal"
-            };
-            format!("every vertex within {tolerance}{unit} of the lowest height (--anchor-lowest)")
-        }
-        _ => "every boundary vertex (--anchor-boundary)".into(),
-    };
     let name = mesh_path
         .file_stem()
         .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
-    let mesh = model.problem.mesh;
     Ok(Model {
         name,
-        source: mesh_path.display().to_string(),
-        supports,
-        faces: mesh.input_faces(),
-        mesh,
-        welded_ids: model.welded_ids,
-        weld: model.weld,
-        repairs: model.repairs,
-        diagonals: model.diagonals,
+        supports: options.supports.to_string(),
+        faces: model.problem.mesh.input_faces(),
+        read: model,
     })
 }
 

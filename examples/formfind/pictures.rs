@@ -10,7 +10,7 @@ use svg::Document;
 use voussoir::Mesh;
 
 use crate::draw::{self, bbox, colour_bar, fmt, line, page, text, View};
-use crate::run::{mean_load, Outcome};
+use crate::run::Outcome;
 
 const WIDTH: f64 = 900.0;
 const TOP: f64 = 70.0;
@@ -148,7 +148,7 @@ fn plan_forces(o: &Outcome) -> Document {
     let s = &o.stress;
     plan_forces_of(
         &o.model.name,
-        &o.model.mesh,
+        o.model.mesh(),
         &o.positions,
         &s.force_densities,
         &s.tau,
@@ -276,10 +276,10 @@ fn force_diagram(o: &Outcome) -> Document {
 
 /// (c) |r_i| / p̄ per vertex on a log scale, before and after.
 fn residuals(o: &Outcome) -> Document {
-    let mesh = &o.model.mesh;
+    let mesh = o.model.mesh();
     let tol = o.tolerance;
     let floor = (tol / 10.0).log10().floor();
-    let mut panels = vec![("input", &o.model.mesh.positions, &o.before)];
+    let mut panels = vec![("input", &o.model.mesh().positions, &o.before)];
     if o.termination.is_some() {
         panels.push(("form-found", &o.positions, &o.stress));
     }
@@ -287,7 +287,7 @@ fn residuals(o: &Outcome) -> Document {
     let rel: Vec<Vec<f64>> = panels
         .iter()
         .map(|(_, _, s)| {
-            let mean = mean_load(&o.model, &s.loads);
+            let mean = o.model.read.problem.mean_load(&s.loads);
             s.residuals.iter().map(|r| r.abs() / mean).collect()
         })
         .collect();
@@ -361,7 +361,7 @@ fn residuals(o: &Outcome) -> Document {
 
 /// (d) Height change per face (mean of its vertices), blue down, red up.
 fn height_change(o: &Outcome) -> Document {
-    let mesh = &o.model.mesh;
+    let mesh = o.model.mesh();
     let dz: Vec<f64> = (0..mesh.n_vertices())
         .map(|v| o.positions[v][2] - mesh.positions[v][2])
         .collect();
@@ -445,7 +445,7 @@ pub fn assessment(
     let out = [
         plan_forces_of(
             &a.model.name,
-            &a.model.mesh,
+            a.model.mesh(),
             &r.positions,
             &r.force_densities,
             &no_tau,

@@ -4,7 +4,8 @@
 use std::io::IsTerminal;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use voussoir::{analyse, form_find, Problem, QpSolver, StressResult, Termination};
+use voussoir::report::{Report, Run};
+use voussoir::{analyse, form_find, FormFindResult, StressResult, Termination};
 
 use crate::args::Options;
 use crate::model::Model;
@@ -12,6 +13,8 @@ use crate::model::Model;
 /// Everything a run produced.
 pub struct Outcome {
     pub model: Model,
+    /// The form finding (None for `--stress-only`).
+    pub found: Option<FormFindResult>,
     /// None for `--stress-only`.
     pub termination: Option<Termination>,
     pub positions: Vec<[f64; 3]>,
@@ -19,12 +22,8 @@ pub struct Outcome {
     pub stress: StressResult,
     /// Stress analysis of the input shape.
     pub before: StressResult,
-    /// ε∞ per stress step (plus the final certificate, see `FormFindResult::history`).
-    pub history: Vec<f64>,
     /// Stress steps taken.
     pub iterations: usize,
-    /// The QP solver that answered each stress step (see `FormFindResult::solvers`).
-    pub solvers: Vec<QpSolver>,
     pub hausdorff: f64,
     pub l2: f64,
     /// Area-weighted RMS and largest height change over the plan diagonal.
@@ -33,9 +32,6 @@ pub struct Outcome {
     pub stress_seconds: f64,
     pub shape_seconds: f64,
     pub total_seconds: f64,
-    /// Mean load over non-anchored vertices, and p̄ / L₀ (the unit of relative q bounds).
-    pub p_bar: f64,
-    pub q_unit: f64,
     /// The stopping tolerance used.
     pub tolerance: f64,
 }
@@ -47,6 +43,18 @@ impl Outcome {
             Some(t) => *t == Termination::Converged,
             None => self.stress.status.is_solved(),
         }
+    }
+
+    /// The library's report of the run (its settings section names the supports as the
+    /// model does).
+    pub fn report(&self, settings: &voussoir::FormFindSettings) -> Report {
+        let run = match &self.found {
+            Some(found) => Run::FormFinding(found),
+            None => Run::Analysis(&self.before),
+        };
+        let mut report = Report::new(&self.model.read, settings, run);
+        report.settings.supports = self.model.supports.clone();
+        report
     }
 }
 
@@ -67,36 +75,19 @@ pub fn progress_bar(max_iterations: usize, what: &str, figure: &str) -> Option<P
     Some(bar)
 }
 
-/// Mean load over non-anchored vertices (1 when there is none, as the library does).
-pub fn mean_load(model: &Model, loads: &[f64]) -> f64 {
-    let mesh = &model.mesh;
-    let free: Vec<f64> = (0..mesh.n_vertices())
-        .filter(|&v| mesh.is_non_anchored(v))
-        .map(|v| loads[v])
-        .collect();
-    let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
-    if mean > 0.0 {
-        mean
-    } else {
-        1.0
-    }
-}
-
-pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
-    let density = vec![o.density; model.mesh.n_faces()];
-    let problem = Problem::new(model.mesh.clone())
-        .with_face_density(density)?
-        .with_polygon_diagonals(&model.diagonals)?;
+pub fn run(mut model: Model, o: &Options) -> voussoir::Result<Outcome> {
+    let density = vec![o.density; model.mesh().n_faces()];
+    model.read.problem = model.read.problem.clone().with_face_density(density)?;
+    let problem = &model.read.problem;
     let settings = &o.settings;
-    let before = analyse(&problem, &settings.stress)?;
-    let mut outcome = if o.stress_only {
-        Outcome {
+    let before = analyse(problem, &settings.stress)?;
+    if o.stress_only {
+        return Ok(Outcome {
+            found: None,
             termination: None,
-            positions: model.mesh.positions.clone(),
+            positions: problem.mesh.positions.clone(),
             stress: before.clone(),
-            history: vec![before.eps_inf],
             iterations: 1,
-            solvers: vec![before.solver],
             hausdorff: 0.0,
             l2: 0.0,
             rms_change: 0.0,
@@ -105,47 +96,38 @@ pub fn run(model: Model, o: &Options) -> voussoir::Result<Outcome> {
             shape_seconds: 0.0,
             total_seconds: before.seconds,
             before,
-            p_bar: 0.0,
-            q_unit: 0.0,
             tolerance: settings.tolerance,
             model,
-        }
-    } else {
-        let bar = progress_bar(settings.max_iterations, "form finding", "ε∞");
-        let mut report = |k: usize, eps: f64| {
-            if let Some(bar) = &bar {
-                bar.set_position(k as u64 + 1);
-                bar.set_message(format!("{eps:.2e}"));
-            }
-            true
-        };
-        let result = form_find(&problem, settings, Some(&mut report));
+        });
+    }
+    let bar = progress_bar(settings.max_iterations, "form finding", "ε∞");
+    let mut report = |k: usize, eps: f64| {
         if let Some(bar) = &bar {
-            bar.finish_and_clear();
+            bar.set_position(k as u64 + 1);
+            bar.set_message(format!("{eps:.2e}"));
         }
-        let r = result?;
-        Outcome {
-            termination: Some(r.termination),
-            positions: r.positions,
-            stress: r.stress,
-            before,
-            history: r.history,
-            iterations: r.iterations,
-            solvers: r.solvers,
-            hausdorff: r.hausdorff,
-            l2: r.l2,
-            rms_change: r.rms_change,
-            max_change: r.max_change,
-            stress_seconds: r.stress_seconds,
-            shape_seconds: r.shape_seconds,
-            total_seconds: r.total_seconds,
-            p_bar: 0.0,
-            q_unit: 0.0,
-            tolerance: settings.tolerance,
-            model,
-        }
+        true
     };
-    outcome.p_bar = mean_load(&outcome.model, &outcome.stress.loads);
-    outcome.q_unit = outcome.p_bar / outcome.model.mesh.plan_scale(&outcome.positions);
-    Ok(outcome)
+    let result = form_find(problem, settings, Some(&mut report));
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let r = result?;
+    Ok(Outcome {
+        termination: Some(r.termination.clone()),
+        positions: r.positions.clone(),
+        stress: r.stress.clone(),
+        before,
+        iterations: r.iterations,
+        hausdorff: r.hausdorff,
+        l2: r.l2,
+        rms_change: r.rms_change,
+        max_change: r.max_change,
+        stress_seconds: r.stress_seconds,
+        shape_seconds: r.shape_seconds,
+        total_seconds: r.total_seconds,
+        tolerance: settings.tolerance,
+        found: Some(r),
+        model,
+    })
 }

@@ -2,19 +2,14 @@
 //! settings → `AssessSettings` (checked as the C API's `vsr_assess_settings_set_*` check them,
 //! with the same messages), and `voussoir::assess` with the GIL released.
 
-use crate::errors::{from_error, invalid, not_finite};
+use crate::errors::{from_error, invalid};
 use crate::mesh::{shape_text, Mesh};
 use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use voussoir::report::AssessmentReport;
 use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, QBound, Thickness};
 
-/// The Python spelling of the load rules (as `load_rule` of the other solves).
-const LOAD_RULES: [(&str, LoadRule); 3] = [
-    ("barycentric", LoadRule::Barycentric),
-    ("voronoi", LoadRule::Voronoi),
-    ("plan_area", LoadRule::PlanArea),
-];
 const OBJECTIVES: [&str; 5] = [
     "fit",
     "min-thickness",
@@ -35,7 +30,7 @@ fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(not_finite(name, x))
+        Err(invalid(name, format_args!("{x} is not finite")))
     }
 }
 
@@ -84,19 +79,7 @@ pub fn settings_from(kwargs: &Bound<'_, PyDict>) -> PyResult<AssessSettings> {
                     .map_err(|_| invalid(&key, "is not True or False"))?
             }
             "unit_weight" => s.unit_weight = finite(&key, &v)?,
-            "load_rule" => {
-                let name = text(&key, &v)?;
-                s.load_rule = (LOAD_RULES.iter().find(|(n, _)| *n == name))
-                    .map(|(_, r)| *r)
-                    .ok_or_else(|| {
-                        invalid(
-                            &key,
-                            format_args!(
-                                "'{name}' is not one of 'barycentric', 'voronoi', 'plan_area'"
-                            ),
-                        )
-                    })?;
-            }
+            "load_rule" => s.load_rule = crate::settings::named::<LoadRule>(&key, &v)?,
             "load_pattern" => {
                 s.load_pattern = if v.is_none() {
                     None
@@ -178,16 +161,18 @@ fn surface(name: &str, (v, f): &Surface<'_>) -> PyResult<Rows> {
     Ok((rows, faces))
 }
 
-/// The envelope of `thickness` (1 or #F values) or of intrados and extrados surfaces.
+/// The envelope of `thickness` (1 or #F values) or of intrados and extrados surfaces, and
+/// the thickness when it is one value.
 fn envelope(
     mesh: &voussoir::Mesh,
     thickness: Option<PyReadonlyArrayDyn<'_, f64>>,
     intrados: Option<Surface<'_>>,
     extrados: Option<Surface<'_>>,
-) -> PyResult<Envelope> {
+) -> PyResult<(Envelope, Option<f64>)> {
     match (thickness, intrados, extrados) {
         (Some(t), None, None) => {
             let values = floats("thickness", &t, "entry")?;
+            let uniform = (values.len() == 1).then(|| values[0]);
             let t = match values.len() {
                 1 => Thickness::Uniform(values[0]),
                 n if n == mesh.n_faces() => Thickness::PerFace(values),
@@ -201,12 +186,14 @@ fn envelope(
                     ))
                 }
             };
-            Envelope::from_thickness(mesh, &t).map_err(|e| from_error("thickness", e))
+            let env = Envelope::from_thickness(mesh, &t).map_err(|e| from_error("thickness", e))?;
+            Ok((env, uniform))
         }
         (None, Some(lo), Some(hi)) => {
             let (lo, hi) = (surface("intrados", &lo)?, surface("extrados", &hi)?);
-            Envelope::from_surfaces(mesh, (&lo.0, &lo.1), (&hi.0, &hi.1))
-                .map_err(|e| from_error("intrados", e))
+            let env = Envelope::from_surfaces(mesh, (&lo.0, &lo.1), (&hi.0, &hi.1))
+                .map_err(|e| from_error("intrados", e))?;
+            Ok((env, None))
         }
         _ => Err(invalid(
             "thickness",
@@ -215,9 +202,15 @@ fn envelope(
     }
 }
 
-/// `assess(mesh, thickness, intrados, extrados, settings, progress)`: the result's fields.
+/// The input files a report's settings name: intrados, extrados and load pattern.
+type ReportFiles = (Option<String>, Option<String>, Option<String>);
+
+/// `assess(mesh, thickness, intrados, extrados, settings, progress, report)`: the result's
+/// fields; with `report` (the input files to name), also the library's report as JSON text
+/// (`voussoir::report::AssessmentReport`, formfind's schema) under `"report"`.
 #[pyfunction]
-#[pyo3(signature = (mesh, thickness, intrados, extrados, settings, progress=None))]
+#[pyo3(signature = (mesh, thickness, intrados, extrados, settings, progress=None, report=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn assess<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, Mesh>,
@@ -226,10 +219,11 @@ pub fn assess<'py>(
     extrados: Option<Surface<'py>>,
     settings: &Bound<'py, PyDict>,
     progress: Option<Bound<'py, PyAny>>,
+    report: Option<ReportFiles>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let s = settings_from(settings)?;
     let m: &Mesh = mesh.get();
-    let env = envelope(&m.problem.mesh, thickness, intrados, extrados)?;
+    let (env, uniform) = envelope(&m.problem().mesh, thickness, intrados, extrados)?;
     if let Some(p) = &progress {
         if !p.is_none() && !p.is_callable() {
             return Err(invalid("progress", "is not callable"));
@@ -255,13 +249,20 @@ pub fn assess<'py>(
                 })
             })
         };
-        voussoir::assess(&m.problem, &env, &s, Some(&mut hook))
+        voussoir::assess(m.problem(), &env, &s, Some(&mut hook))
     });
     if let Some(e) = raised {
         return Err(e);
     }
     let result = result.map_err(|e| from_error("mesh", e))?;
-    fields(py, &m.problem.mesh, &env, &result)
+    let d = fields(py, &m.problem().mesh, &env, &result)?;
+    if let Some((intrados, extrados, load_pattern)) = report {
+        let mut r = AssessmentReport::new(&m.model, &env, &s, &result, uniform);
+        (r.settings.intrados, r.settings.extrados) = (intrados, extrados);
+        r.settings.load_pattern = load_pattern;
+        d.set_item("report", r.to_json())?;
+    }
+    Ok(d)
 }
 
 /// The fields of an assessment, with its envelope.
@@ -273,7 +274,8 @@ fn fields<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     use crate::results::matrix;
     let d = PyDict::new(py);
-    let (name, vertices, detail) = crate::results::termination(&r.termination);
+    let (vertices, detail) = crate::results::termination(&r.termination);
+    let name = r.termination.name();
     d.set_item("objective", r.objective.as_str())?;
     d.set_item("feasible", r.feasible)?;
     d.set_item("termination", name)?;
@@ -310,5 +312,77 @@ fn fields<'py>(
         "face_thickness",
         PyArray1::from_slice(py, &env.face_thickness),
     )?;
+    Ok(d)
+}
+
+/// Per-vertex bounds from `envelope_at(t)`: a pair (lower, upper) of n floats each.
+fn family_member(
+    py: Python<'_>,
+    mesh: &voussoir::Mesh,
+    envelope_at: &Py<PyAny>,
+    t: f64,
+) -> PyResult<Envelope> {
+    let answer = envelope_at.call1(py, (t,))?;
+    let (lower, upper): (PyReadonlyArrayDyn<'_, f64>, PyReadonlyArrayDyn<'_, f64>) =
+        answer.bind(py).extract().map_err(|_| {
+            invalid(
+                "envelope_at",
+                format_args!(
+                    "envelope_at({t}) did not return a pair (lower, upper) of float arrays"
+                ),
+            )
+        })?;
+    let lower = floats("envelope_at", &lower, "lower bound")?;
+    let upper = floats("envelope_at", &upper, "upper bound")?;
+    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
+        .map_err(|e| from_error("envelope_at", e))
+}
+
+/// `min_thickness_of_family(mesh, envelope_at, thickness, scale_tolerance, settings)`: the
+/// least certified thickness of the family and its analysis' fields, with `thickness`,
+/// `rounds` and `family_converged` added.
+#[pyfunction]
+pub fn min_thickness_of_family<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    envelope_at: Bound<'py, PyAny>,
+    thickness: f64,
+    scale_tolerance: f64,
+    settings: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !envelope_at.is_callable() {
+        return Err(invalid("envelope_at", "is not callable"));
+    }
+    let s = settings_from(settings)?;
+    let m: &Mesh = mesh.get();
+    let mesh_ref = &m.problem().mesh;
+    let callback = envelope_at.unbind();
+    let callback = &callback;
+    let mut raised: Option<PyErr> = None;
+    let found = py.detach(|| {
+        let member = |t: f64| {
+            Python::attach(|py| {
+                py.check_signals()
+                    .and_then(|_| family_member(py, mesh_ref, callback, t))
+            })
+            .map_err(|e| {
+                raised = Some(e);
+                voussoir::Error::InvalidArgument {
+                    name: "envelope_at",
+                    reason: "raised an exception".into(),
+                }
+            })
+        };
+        voussoir::min_thickness_of_family(m.problem(), member, thickness, scale_tolerance, &s)
+    });
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    let found = found.map_err(|e| from_error("envelope_at", e))?;
+    let env = family_member(py, mesh_ref, callback, found.thickness)?;
+    let d = fields(py, mesh_ref, &env, &found.result)?;
+    d.set_item("thickness", found.thickness)?;
+    d.set_item("rounds", found.rounds)?;
+    d.set_item("family_converged", found.converged)?;
     Ok(d)
 }

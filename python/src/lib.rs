@@ -26,9 +26,11 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WELD_TOLERANCE", voussoir::io::DEFAULT_WELD_TOLERANCE)?;
     m.add("REPAIR_TOLERANCE", voussoir::DEFAULT_REPAIR_TOLERANCE)?;
     m.add_function(wrap_pyfunction!(settings::defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(settings::choices, m)?)?;
     m.add_function(wrap_pyfunction!(solve::analyse, m)?)?;
     m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
     m.add_function(wrap_pyfunction!(assess::assess, m)?)?;
+    m.add_function(wrap_pyfunction!(assess::min_thickness_of_family, m)?)?;
     m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
     Ok(())
 }

@@ -4,19 +4,14 @@ use crate::errors::{from_error, invalid, VoussoirError};
 use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
-use voussoir::io::{read_model, ReadOptions, Supports, UpAxis};
-use voussoir::PlanRepair;
+use voussoir::io::{read_model, Model, ReadOptions, Supports, UpAxis};
 use voussoir::{Mesh as RustMesh, Problem};
 
 /// A validated triangle mesh with its supports and loads (native half of `voussoir.Mesh`).
 #[pyclass(frozen, module = "voussoir._voussoir")]
 pub struct Mesh {
-    pub problem: Problem,
-    /// The mesh vertex of each vertex of the file it was read from.
-    welded_ids: Option<Vec<u32>>,
-    repairs: Vec<PlanRepair>,
-    /// The up axis of the file it was read from (z for a mesh built from arrays).
-    pub up: UpAxis,
+    /// The problem and how it was read (`Model::from_problem` for arrays).
+    pub model: Model,
 }
 
 /// Rows of `width` numbers from an array of shape (n, width) (or (n,) when `width` is 1).
@@ -77,17 +72,13 @@ fn triples<T: Copy>(flat: &[T]) -> Vec<[T; 3]> {
 }
 
 impl Mesh {
-    fn new(problem: Problem) -> Mesh {
-        Mesh {
-            problem,
-            welded_ids: None,
-            repairs: Vec::new(),
-            up: UpAxis::Z,
-        }
+    /// The problem, with its loads.
+    pub fn problem(&self) -> &Problem {
+        &self.model.problem
     }
 
     fn mesh(&self) -> &RustMesh {
-        &self.problem.mesh
+        &self.model.problem.mesh
     }
 
     /// Faces in the orientation they were given (the library stores them counter-clockwise).
@@ -166,6 +157,20 @@ fn with_loads(
     })
 }
 
+/// The problem with the polygon diagonals `pairs` ((k, 2) vertex ids) marked.
+fn with_diagonals(problem: Problem, pairs: &PyReadonlyArrayDyn<'_, i64>) -> PyResult<Problem> {
+    let name = "polygon_diagonals";
+    let flat = match pairs.shape() {
+        [0] => Vec::new(),
+        _ => ids(name, rows(name, pairs, 2)?)?,
+    };
+    let pairs: Vec<[u32; 2]> = flat.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+    problem.with_polygon_diagonals(&pairs).map_err(|e| match e {
+        voussoir::Error::InvalidArgument { reason, .. } => invalid(name, reason),
+        e => from_error(name, e),
+    })
+}
+
 /// The one way of choosing supports among `Mesh.from_file`'s keywords.
 fn supports_of(
     file: Option<PathBuf>,
@@ -206,7 +211,8 @@ fn supports_of(
 #[pymethods]
 impl Mesh {
     #[new]
-    #[pyo3(signature = (vertices, faces, anchored, face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None))]
+    #[pyo3(signature = (vertices, faces, anchored, face_density=None, extra_loads=None, horizontal_forces=None, prescribed_tau=None, polygon_diagonals=None))]
+    #[allow(clippy::too_many_arguments)]
     fn py_new(
         vertices: PyReadonlyArrayDyn<'_, f64>,
         faces: PyReadonlyArrayDyn<'_, i64>,
@@ -215,6 +221,7 @@ impl Mesh {
         extra_loads: Array<'_>,
         horizontal_forces: Array<'_>,
         prescribed_tau: Array<'_>,
+        polygon_diagonals: Option<PyReadonlyArrayDyn<'_, i64>>,
     ) -> PyResult<Mesh> {
         let positions = triples(&rows("vertices", &vertices, 3)?);
         let faces = triples(&ids("faces", rows("faces", &faces, 3)?)?);
@@ -228,7 +235,13 @@ impl Mesh {
             horizontal_forces,
             prescribed_tau,
         )?;
-        Ok(Mesh::new(problem))
+        let problem = match polygon_diagonals {
+            Some(pairs) => with_diagonals(problem, &pairs)?,
+            None => problem,
+        };
+        Ok(Mesh {
+            model: Model::from_problem(problem, "arrays"),
+        })
     }
 
     /// Reads a mesh file with `voussoir::io::read_model` (as `vsr_mesh_read` does): weld,
@@ -263,16 +276,10 @@ impl Mesh {
             },
             other => other,
         };
-        let up = match up {
-            "z" => UpAxis::Z,
-            "y" => UpAxis::Y,
-            other => {
-                return Err(invalid(
-                    "up",
-                    format_args!("'{other}' is not one of 'z', 'y'"),
-                ))
-            }
-        };
+        let up = up.parse::<UpAxis>().map_err(|e| match e {
+            voussoir::Error::InvalidArgument { reason, .. } => invalid("up", reason),
+            e => from_error("up", e),
+        })?;
         let options = ReadOptions::new(supports)
             .with_weld_tolerance(weld_tolerance)
             .with_repair_tolerance(repair_tolerance)
@@ -289,19 +296,15 @@ impl Mesh {
             e if options.blames_supports_file(&e) => from_error("supports", e),
             e => from_error("path", e),
         })?;
-        let problem = with_loads(
+        let mut model = model;
+        model.problem = with_loads(
             model.problem,
             face_density,
             extra_loads,
             horizontal_forces,
             prescribed_tau,
         )?;
-        Ok(Mesh {
-            problem,
-            welded_ids: Some(model.welded_ids),
-            repairs: model.repairs,
-            up: model.up,
-        })
+        Ok(Mesh { model })
     }
 
     /// Vertex positions, (n, 3) float64: x, y plan, z height.
@@ -336,17 +339,19 @@ impl Mesh {
     /// built from arrays. (n_file,) uint32.
     #[getter]
     fn welded_ids<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
-        let ids = self
-            .welded_ids
-            .clone()
-            .unwrap_or_else(|| (0..self.mesh().n_vertices() as u32).collect());
-        PyArray1::from_vec(py, ids)
+        PyArray1::from_slice(py, &self.model.welded_ids)
+    }
+
+    /// The marked polygon diagonals, (k, 2) uint32, smaller id first, in edge order.
+    #[getter]
+    fn polygon_diagonals<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<u32>> {
+        crate::results::matrix(py, &self.model.problem.polygon_diagonals())
     }
 
     /// The plan repairs made while reading the file, one sentence each.
     #[getter]
     fn plan_repairs(&self) -> Vec<String> {
-        self.repairs.iter().map(|r| r.to_string()).collect()
+        self.model.repairs.iter().map(|r| r.to_string()).collect()
     }
 
     /// Number of holes (inner boundary loops).
@@ -357,21 +362,21 @@ impl Mesh {
 
     #[getter]
     fn face_density<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.problem.face_density)
+        PyArray1::from_slice(py, &self.model.problem.face_density)
     }
 
     #[getter]
     fn extra_loads<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.problem.extra_loads)
+        PyArray1::from_slice(py, &self.model.problem.extra_loads)
     }
 
     #[getter]
     fn horizontal_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        crate::results::matrix(py, &self.problem.horizontal_forces)
+        crate::results::matrix(py, &self.model.problem.horizontal_forces)
     }
 
     #[getter]
     fn prescribed_tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.problem.prescribed_tau)
+        PyArray1::from_slice(py, &self.model.problem.prescribed_tau)
     }
 }

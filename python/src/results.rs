@@ -1,10 +1,9 @@
 //! Results as dicts of numpy arrays and numbers (wrapped in typed classes by `_results.py`).
 
-use crate::settings::{formulation_name, name_of, QP_SOLVERS};
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use voussoir::{FormFindResult, Mesh, StressResult, StressStatus, Termination};
+use voussoir::{FormFindResult, Mesh, StressResult, Termination};
 
 /// An (n, W) array from rows of W numbers.
 pub fn matrix<'py, T: numpy::Element + Copy, const W: usize>(
@@ -20,17 +19,6 @@ pub fn matrix<'py, T: numpy::Element + Copy, const W: usize>(
 
 use numpy::PyArrayMethods;
 
-fn status_name(s: StressStatus) -> &'static str {
-    match s {
-        StressStatus::Solved => "solved",
-        StressStatus::AlmostSolved => "almost_solved",
-        StressStatus::Infeasible => "infeasible",
-        StressStatus::MaxIterations => "max_iterations",
-        StressStatus::NumericalError => "numerical_error",
-        _ => "unknown",
-    }
-}
-
 /// The fields of a stress result at `positions`.
 pub fn stress<'py>(
     py: Python<'py>,
@@ -39,7 +27,7 @@ pub fn stress<'py>(
     s: &StressResult,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("status", status_name(s.status))?;
+    d.set_item("status", s.status.as_str())?;
     d.set_item("positions", matrix(py, positions))?;
     let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
     d.set_item("edges", matrix(py, &edges))?;
@@ -78,27 +66,22 @@ pub fn stress<'py>(
         PyArray1::from_vec(py, segment_edges),
     )?;
     d.set_item("qp_iterations", s.iterations)?;
-    d.set_item("formulation", formulation_name(s.formulation))?;
-    d.set_item("qp_solver", name_of(&QP_SOLVERS, s.solver))?;
+    d.set_item("formulation", s.formulation.as_str())?;
+    d.set_item("qp_solver", s.solver.as_str())?;
     d.set_item("lifted", s.lifted)?;
     d.set_item("regularisation", s.regularisation)?;
     d.set_item("seconds", s.seconds)?;
     Ok(d)
 }
 
-/// (name, the vertices it lists, the constraint, hint or failure it names).
-pub fn termination(t: &Termination) -> (&'static str, Vec<u32>, Option<String>) {
+/// (the vertices it lists, the constraint, hint or failure it names).
+pub fn termination(t: &Termination) -> (Vec<u32>, Option<String>) {
     match t {
-        Termination::Converged => ("converged", vec![], None),
-        Termination::MaxIterations => ("max_iterations", vec![], None),
-        Termination::Stalled { vertices } => ("stalled", vertices.clone(), None),
-        Termination::Infeasible { constraint } => ("infeasible", vec![], Some(constraint.clone())),
-        Termination::NumericalError { what } => ("numerical_error", vec![], Some(what.clone())),
-        Termination::Cancelled => ("cancelled", vec![], None),
-        Termination::Blocked { vertices, hint } => {
-            ("blocked", vertices.clone(), Some(hint.clone()))
-        }
-        other => ("unknown", vec![], Some(other.to_string())),
+        Termination::Stalled { vertices } => (vertices.clone(), None),
+        Termination::Infeasible { constraint } => (vec![], Some(constraint.clone())),
+        Termination::NumericalError { what } => (vec![], Some(what.clone())),
+        Termination::Blocked { vertices, hint } => (vertices.clone(), Some(hint.clone())),
+        _ => (vec![], None),
     }
 }
 
@@ -109,14 +92,14 @@ pub fn form_found<'py>(
     r: &FormFindResult,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = stress(py, mesh, &r.positions, &r.stress)?;
-    let (name, vertices, detail) = termination(&r.termination);
-    d.set_item("termination", name)?;
+    let (vertices, detail) = termination(&r.termination);
+    d.set_item("termination", r.termination.name())?;
     d.set_item("termination_message", r.termination.to_string())?;
     d.set_item("termination_vertices", PyArray1::from_vec(py, vertices))?;
     d.set_item("termination_detail", detail)?;
     d.set_item("history", PyArray1::from_slice(py, &r.history))?;
     d.set_item("iterations", r.iterations)?;
-    let solvers: Vec<&str> = r.solvers.iter().map(|s| name_of(&QP_SOLVERS, *s)).collect();
+    let solvers: Vec<&str> = r.solvers.iter().map(|s| s.as_str()).collect();
     d.set_item("step_solvers", solvers)?;
     d.set_item("hausdorff", r.hausdorff)?;
     d.set_item("l2", r.l2)?;

@@ -5,59 +5,18 @@
 use crate::errors::invalid;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::str::FromStr;
+use voussoir::io::UpAxis;
 use voussoir::{
     EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
     TauMode,
 };
 
-/// The Python spelling of each enumerated value.
-const METHODS: [(&str, FormMethod); 2] = [
-    ("nearest", FormMethod::Nearest),
-    ("paper", FormMethod::Paper),
-];
-const TAUS: [(&str, TauMode); 3] = [
-    ("optimized", TauMode::Optimized),
-    ("zero", TauMode::Zero),
-    ("prescribed", TauMode::Prescribed),
-];
-const HOLES: [(&str, HoleMode); 2] = [
-    ("affine", HoleMode::Affine),
-    ("constant", HoleMode::Constant),
-];
-const LOAD_RULES: [(&str, LoadRule); 3] = [
-    ("barycentric", LoadRule::Barycentric),
-    ("voronoi", LoadRule::Voronoi),
-    ("plan_area", LoadRule::PlanArea),
-];
-const FORMULATIONS: [(&str, Formulation); 2] = [
-    ("reduced", Formulation::Reduced),
-    ("edge_based", Formulation::EdgeBased),
-];
-pub const QP_SOLVERS: [(&str, QpSolver); 2] = [
-    ("native", QpSolver::Native),
-    ("clarabel", QpSolver::Clarabel),
-];
-const SCOPES: [(&str, EdgeScope); 2] = [("all", EdgeScope::All), ("interior", EdgeScope::Interior)];
 const KINDS: [(&str, bool); 2] = [("relative", true), ("absolute", false)];
 
-/// The name of `value` in `table`.
-pub fn name_of<T: PartialEq + Copy>(table: &[(&'static str, T)], value: T) -> &'static str {
-    table
-        .iter()
-        .find(|(_, v)| *v == value)
-        .map_or("unknown", |(n, _)| n)
-}
-
-fn choice<T: Copy>(name: &str, value: &Bound<'_, PyAny>, table: &[(&str, T)]) -> PyResult<T> {
-    let text: String = value.extract().map_err(|_| {
-        invalid(
-            name,
-            format_args!(
-                "{} is not a string",
-                value.repr().map_or("?".into(), |r| r.to_string())
-            ),
-        )
-    })?;
+/// The relative/absolute kind of a bound, by name.
+fn choice(name: &str, value: &Bound<'_, PyAny>, table: &[(&str, bool)]) -> PyResult<bool> {
+    let text = string(name, value)?;
     table
         .iter()
         .find(|(n, _)| *n == text)
@@ -69,6 +28,51 @@ fn choice<T: Copy>(name: &str, value: &Bound<'_, PyAny>, table: &[(&str, T)]) ->
                 format_args!("'{text}' is not one of {}", allowed.join(", ")),
             )
         })
+}
+
+fn string(name: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
+    value.extract().map_err(|_| {
+        invalid(
+            name,
+            format_args!(
+                "{} is not a string",
+                value.repr().map_or("?".into(), |r| r.to_string())
+            ),
+        )
+    })
+}
+
+/// An enumerated setting by its library name (`FromStr` of the library's enums).
+pub fn named<T: FromStr<Err = voussoir::Error>>(
+    name: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<T> {
+    string(name, value)?.parse().map_err(|e| match e {
+        voussoir::Error::InvalidArgument { reason, .. } => invalid(name, reason),
+        e => invalid(name, e),
+    })
+}
+
+/// The names of every enumerated setting's values, from the library (`python -m voussoir`'s
+/// choices).
+#[pyfunction]
+pub fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    fn names<T: Copy + std::fmt::Display>(all: &[T]) -> Vec<String> {
+        all.iter().map(|v| v.to_string()).collect()
+    }
+    let d = PyDict::new(py);
+    d.set_item("method", names(FormMethod::ALL))?;
+    d.set_item("formulation", names(Formulation::ALL))?;
+    d.set_item("qp_solver", names(QpSolver::ALL))?;
+    d.set_item("q_min_scope", names(EdgeScope::ALL))?;
+    d.set_item("tau", names(TauMode::ALL))?;
+    d.set_item("holes", names(HoleMode::ALL))?;
+    d.set_item("load_rule", names(LoadRule::ALL))?;
+    d.set_item("up", names(UpAxis::ALL))?;
+    let kinds: Vec<&str> = KINDS.iter().map(|k| k.0).collect();
+    d.set_item("q_min_kind", kinds.clone())?;
+    d.set_item("q_max_kind", kinds)?;
+    Ok(d)
 }
 
 fn number(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
@@ -209,7 +213,7 @@ fn apply(
     }
     let s = &mut f.stress;
     match key {
-        "method" => f.method = choice(key, v, &METHODS)?,
+        "method" => f.method = named(key, v)?,
         "q_min" => s.q_min = bound(number(key, v)?, q_min_relative),
         "q_max" => {
             s.q_max = if v.is_none() || number(key, v)? == f64::INFINITY {
@@ -219,12 +223,12 @@ fn apply(
             }
         }
         "q_min_kind" | "q_max_kind" => {}
-        "q_min_scope" => s.q_min_scope = choice(key, v, &SCOPES)?,
-        "tau" => s.tau = choice(key, v, &TAUS)?,
-        "holes" => s.holes = choice(key, v, &HOLES)?,
-        "load_rule" => s.load_rule = choice(key, v, &LOAD_RULES)?,
-        "formulation" => s.formulation = choice(key, v, &FORMULATIONS)?,
-        "qp_solver" => s.solver = choice(key, v, &QP_SOLVERS)?,
+        "q_min_scope" => s.q_min_scope = named(key, v)?,
+        "tau" => s.tau = named(key, v)?,
+        "holes" => s.holes = named(key, v)?,
+        "load_rule" => s.load_rule = named(key, v)?,
+        "formulation" => s.formulation = named(key, v)?,
+        "qp_solver" => s.solver = named(key, v)?,
         "dual_length_bounds" => s.dual_length_bounds = dual_bounds(v)?,
         _ => return Err(invalid(key, "is not a setting (see voussoir.defaults())")),
     }
@@ -252,7 +256,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     let (q_min, q_min_kind) = split(Some(s.q_min));
     let (q_max, q_max_kind) = split(s.q_max);
-    d.set_item("method", name_of(&METHODS, f.method))?;
+    d.set_item("method", f.method.as_str())?;
     for (key, slot) in SCALARS {
         d.set_item(key, slot.get(py, &f)?)?;
     }
@@ -260,12 +264,12 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("q_min_kind", q_min_kind)?;
     d.set_item("q_max", q_max)?;
     d.set_item("q_max_kind", q_max_kind)?;
-    d.set_item("q_min_scope", name_of(&SCOPES, s.q_min_scope))?;
-    d.set_item("tau", name_of(&TAUS, s.tau))?;
-    d.set_item("holes", name_of(&HOLES, s.holes))?;
-    d.set_item("load_rule", name_of(&LOAD_RULES, s.load_rule))?;
-    d.set_item("formulation", name_of(&FORMULATIONS, s.formulation))?;
-    d.set_item("qp_solver", name_of(&QP_SOLVERS, s.solver))?;
+    d.set_item("q_min_scope", s.q_min_scope.as_str())?;
+    d.set_item("tau", s.tau.as_str())?;
+    d.set_item("holes", s.holes.as_str())?;
+    d.set_item("load_rule", s.load_rule.as_str())?;
+    d.set_item("formulation", s.formulation.as_str())?;
+    d.set_item("qp_solver", s.solver.as_str())?;
     d.set_item("dual_length_bounds", s.dual_length_bounds)?;
     Ok(d)
 }
@@ -278,9 +282,4 @@ fn split(b: Option<QBound>) -> (Option<f64>, &'static str) {
         Some(QBound::Absolute(v)) => (Some(v), "absolute"),
         Some(_) => (None, "other"),
     }
-}
-
-/// The names of enumerated result values.
-pub fn formulation_name(f: Formulation) -> &'static str {
-    name_of(&FORMULATIONS, f)
 }

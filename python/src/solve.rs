@@ -9,6 +9,7 @@ use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use voussoir::report::Report;
 
 fn settings_of(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<voussoir::FormFindSettings> {
     match kwargs {
@@ -17,22 +18,29 @@ fn settings_of(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<voussoir::FormFin
     }
 }
 
-/// Stress analysis of the mesh as it stands; returns the result's fields.
+/// Stress analysis of the mesh as it stands; returns the result's fields, plus the library's
+/// JSON report under "report" when `report` is true.
 #[pyfunction]
-#[pyo3(signature = (mesh, settings=None))]
+#[pyo3(signature = (mesh, settings=None, report=false))]
 pub fn analyse<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, Mesh>,
     settings: Option<&Bound<'py, PyDict>>,
+    report: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let form = settings_of(settings)?;
     let m: &Mesh = mesh.get();
     let stress = py
-        .detach(|| voussoir::analyse(&m.problem, &form.stress))
+        .detach(|| voussoir::analyse(m.problem(), &form.stress))
         .map_err(|e| from_error("mesh", e))?;
     // A Ctrl-C during the solve is a KeyboardInterrupt now, not somewhere after.
     py.check_signals()?;
-    results::stress(py, &m.problem.mesh, &m.problem.mesh.positions, &stress)
+    let d = results::stress(py, &m.problem().mesh, &m.problem().mesh.positions, &stress)?;
+    if report {
+        let run = voussoir::report::Run::Analysis(&stress);
+        d.set_item("report", Report::new(&m.model, &form, run).to_json())?;
+    }
+    Ok(d)
 }
 
 /// What the progress hook saw: a Python exception (KeyboardInterrupt from Ctrl-C, or one the
@@ -52,14 +60,16 @@ fn progress_step(
     Ok(answer.is_none() || answer.is_truthy()?)
 }
 
-/// Form finding; `progress(iteration, eps_inf)` is called after every stress step.
+/// Form finding; `progress(iteration, eps_inf)` is called after every stress step. The
+/// library's JSON report is added under "report" when `report` is true.
 #[pyfunction]
-#[pyo3(signature = (mesh, settings=None, progress=None))]
+#[pyo3(signature = (mesh, settings=None, progress=None, report=false))]
 pub fn form_find<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, Mesh>,
     settings: Option<&Bound<'py, PyDict>>,
     progress: Option<Bound<'py, PyAny>>,
+    report: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let form = settings_of(settings)?;
     if let Some(p) = &progress {
@@ -80,13 +90,18 @@ pub fn form_find<'py>(
                 }
             })
         };
-        voussoir::form_find(&m.problem, &form, Some(&mut hook))
+        voussoir::form_find(m.problem(), &form, Some(&mut hook))
     });
     if let Some(e) = raised {
         return Err(e);
     }
     let found = found.map_err(|e| from_error("mesh", e))?;
-    results::form_found(py, &m.problem.mesh, &found)
+    let d = results::form_found(py, &m.problem().mesh, &found)?;
+    if report {
+        let run = voussoir::report::Run::FormFinding(&found);
+        d.set_item("report", Report::new(&m.model, &form, run).to_json())?;
+    }
+    Ok(d)
 }
 
 /// Writes `positions` with the mesh's faces (as given) to `path`, in the format of its
@@ -98,7 +113,7 @@ pub fn write_mesh(
     path: PathBuf,
 ) -> PyResult<()> {
     let m: &Mesh = mesh.get();
-    let n = m.problem.mesh.n_vertices();
+    let n = m.problem().mesh.n_vertices();
     if positions.shape() != [n, 3] {
         return Err(invalid(
             "positions",
@@ -111,7 +126,7 @@ pub fn write_mesh(
     let flat: Vec<f64> = positions.as_array().iter().copied().collect();
     // Written in the axes of the file the mesh was read from.
     let rows: Vec<[f64; 3]> = (flat.chunks_exact(3))
-        .map(|c| m.up.to_file([c[0], c[1], c[2]]))
+        .map(|c| m.model.options.up.to_file([c[0], c[1], c[2]]))
         .collect();
     voussoir::io::write_mesh(&path, &rows, &m.input_faces()).map_err(|e| from_error("path", e))
 }

@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+import typing
 
 import numpy as np
 import pytest
@@ -15,7 +16,8 @@ import pytest
 import voussoir
 from conftest import REPO, SQUARE_ANCHORED, SQUARE_FACES, SQUARE_POSITIONS
 
-from voussoir._settings import SETTING_NAMES
+from voussoir import _voussoir as _native
+from voussoir._settings import SETTING_NAMES, Settings
 
 
 def square(**loads) -> voussoir.Mesh:
@@ -32,6 +34,19 @@ def test_settings_list_every_default_and_nothing_else():
     d = voussoir.defaults()
     assert set(d) == set(SETTING_NAMES)
     assert d["method"] == "nearest" and d["q_max"] is None and d["dual_length_bounds"] is None
+
+
+def test_the_typed_choices_are_the_library_names():
+    """`Settings`' Literal types list the names the library parses and reports."""
+    hints = typing.get_type_hints(Settings)
+    for key, names in _native.choices().items():
+        if key == "up":
+            continue
+        assert list(typing.get_args(hints[key])) == names, key
+    for key, names in _native.choices().items():
+        for name in names:
+            if key != "up":
+                voussoir.analyse(square(), **{key: name})
 
 
 def test_a_default_given_explicitly_changes_nothing():
@@ -207,3 +222,34 @@ def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):
     assert done.returncode == 0, done.stderr
     report = json.loads((tmp_path / "r.json").read_text())
     assert len(report["anchored"]) == 4 and len(report["positions"]) == 5
+
+
+def quad_dome(path, rings=4, sectors=16):
+    """A latitude-longitude dome in quads (split along one diagonal per ring when read); its
+    rim's vertex ids."""
+    lines = ["v 0 0 0.6"]
+    for r in range(1, rings + 1):
+        for s in range(sectors):
+            a, rr = 2 * np.pi * s / sectors, r / rings
+            lines.append(f"v {float(rr * np.cos(a))!r} {float(rr * np.sin(a))!r} {0.6 * (1 - rr)!r}")
+    vid = lambda r, s: 2 + (r - 1) * sectors + s % sectors  # noqa: E731 (1-based)
+    lines += [f"f 1 {vid(1, s)} {vid(1, s + 1)}" for s in range(sectors)]
+    for r in range(1, rings):
+        for s in range(sectors):
+            lines.append(f"f {vid(r, s)} {vid(r + 1, s)} {vid(r + 1, s + 1)} {vid(r, s + 1)}")
+    path.write_text("\n".join(lines) + "\n")
+    return [vid(rings, s) - 1 for s in range(sectors)]
+
+
+def test_polygon_diagonals_from_arrays_solve_as_those_of_a_file(tmp_path):
+    rim = quad_dome(tmp_path / "dome.obj")
+    read = voussoir.Mesh.from_file(tmp_path / "dome.obj", anchored=rim)
+    assert read.polygon_diagonals.shape == (3 * 16, 2)
+    arrays = voussoir.Mesh(read.vertices, read.faces, read.anchored,
+                           polygon_diagonals=read.polygon_diagonals[:, ::-1])
+    assert np.array_equal(arrays.polygon_diagonals, read.polygon_diagonals)
+    expected = voussoir.analyse(read).force_densities
+    assert np.array_equal(voussoir.analyse(arrays).force_densities, expected)
+    plain = voussoir.Mesh(read.vertices, read.faces, read.anchored)
+    assert plain.polygon_diagonals.shape == (0, 2)
+    assert not np.array_equal(voussoir.analyse(plain).force_densities, expected)

@@ -164,7 +164,7 @@ def test_fixed_supports_and_settings():
         ({"thickness": [0.1, 0.2]}, "thickness", "one per face"),
         ({}, "thickness", "give the masonry's envelope"),
         ({"thickness": 0.1, "objective": "max"}, "objective", "'fit'"),
-        ({"thickness": 0.1, "unit_weight": 0.0}, "unit_weight", "> 0"),
+        ({"thickness": 0.1, "unit_weight": -1.0}, "unit_weight", ">= 0"),
         ({"thickness": 0.1, "tolerance": 2.0}, "tolerance", "(0, 1)"),
         ({"thickness": 0.1, "max_iterations": 0}, "max_iterations", "at least 1"),
         ({"thickness": 0.1, "load_rule": "area"}, "load_rule", "'plan_area'"),
@@ -222,7 +222,9 @@ def test_progress_sees_each_step_and_can_stop():
 
     r = voussoir.assess(mesh, 0.1, objective="min-thrust", progress=stop_at_three)
     assert [s for s, _ in steps] == [1, 2, 3]
-    assert r.termination == "cancelled" and r.iterations == 3
+    # The search starts from fit's surface (found without the callback): its steps count too.
+    fit = voussoir.assess(mesh, 0.1)
+    assert r.termination == "cancelled" and r.iterations == 3 + fit.iterations
 
     def fail(step, infeasibility):
         raise RuntimeError("stop here")
@@ -258,3 +260,55 @@ def test_the_command_line_assesses_as_formfind(files, formfind):
     )
     assert bad.returncode == 2 and "--thickness" in bad.stderr
     assert not (files / "bad.obj").exists()
+
+
+def vertex_normals_z(v, f):
+    """z-component of the unit vertex normals (area-weighted means of the face normals)."""
+    cross = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    normals = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(normals, f[:, k], cross)
+    return normals[:, 2] / np.linalg.norm(normals, axis=1)
+
+
+def test_a_linear_family_gives_the_least_thickness_analysis_answer():
+    """Bounds z -+ t / (2 n_z) with uniform t are `assess(thickness=t)`'s envelope at every t,
+    so the family's least thickness is t times that analysis' least scale."""
+    v, f, rim = dome(rings=4, angle=math.radians(85))
+    mesh = voussoir.Mesh(v, f, anchored=rim)
+    nz = vertex_normals_z(v, f)
+    calls = []
+
+    def envelope_at(t):
+        calls.append(t)
+        return v[:, 2] - t / (2 * nz), v[:, 2] + t / (2 * nz)
+
+    direct = voussoir.assess(mesh, 0.1, objective="min-thickness")
+    check_certificate(direct, rim)
+    r = voussoir.min_thickness_of_family(mesh, envelope_at, 0.1)
+    check_certificate(r, rim)
+    assert r.objective == "min-thickness" and r.family_converged
+    assert r.rounds == len(calls) - 1  # and one more call for the answer's envelope
+    expected = 0.1 * direct.thickness_scale
+    assert abs(r.thickness_min - expected) <= 3e-3 * expected
+    assert 1 - 1e-3 <= r.thickness_scale <= 1
+    assert np.allclose(r.envelope_lower, v[:, 2] - r.thickness_min / (2 * nz))
+
+
+def test_a_bad_family_is_named_and_its_exceptions_propagate():
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, anchored=rim)
+    with pytest.raises(voussoir.VoussoirError, match="envelope_at"):
+        voussoir.min_thickness_of_family(mesh, 3.0, 0.1)
+    with pytest.raises(voussoir.VoussoirError, match="pair"):
+        voussoir.min_thickness_of_family(mesh, lambda t: 1.0, 0.1)
+    with pytest.raises(voussoir.VoussoirError, match="vertex"):
+        voussoir.min_thickness_of_family(mesh, lambda t: (v[:, 2] + t, v[:, 2] - t), 0.1)
+    with pytest.raises(voussoir.VoussoirError, match="thickness"):
+        voussoir.min_thickness_of_family(mesh, lambda t: (v[:, 2] - t, v[:, 2] + t), -1.0)
+
+    def failing(t):
+        raise ZeroDivisionError("no shell")
+
+    with pytest.raises(ZeroDivisionError, match="no shell"):
+        voussoir.min_thickness_of_family(mesh, failing, 0.1)

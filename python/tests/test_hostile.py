@@ -176,6 +176,21 @@ def test_bad_loads():
     )
 
 
+def test_bad_polygon_diagonals():
+    raises(
+        "argument `polygon_diagonals`: pair 0 (0, 1) is not an interior edge of the mesh",
+        mesh,
+        polygon_diagonals=[[0, 1]],
+    )
+    raises(
+        "argument `polygon_diagonals`: pair 1 has vertex 9, but there are only 5 vertices",
+        mesh,
+        polygon_diagonals=[[0, 4], [4, 9]],
+    )
+    raises("argument `polygon_diagonals`: has shape (3,), expected (n, 2)", mesh, polygon_diagonals=[0, 4, 2])
+    assert mesh(polygon_diagonals=[]).polygon_diagonals.shape == (0, 2)
+
+
 def test_zero_density_is_nothing_to_balance():
     zero = mesh(face_density=[0, 0, 0, 0])
     for solve in (voussoir.analyse, voussoir.form_find):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -91,3 +92,25 @@ def test_every_format_reads_as_the_rust_api_reads_it(name, models, formfind, tmp
                 result = voussoir.analyse(mesh)
                 assert np.array_equal(result.force_densities, np.array(report["force_densities"])), what
                 assert np.array_equal(result.residuals, np.array(report["residuals"])), what
+
+
+def test_both_command_lines_write_one_report(models, formfind, tmp_path):
+    """`python -m voussoir` and the formfind example write the library's report: the same
+    keys and, but for timings, the same values."""
+    obj, supports = models / "four_holes.obj", models / "four_holes.json"
+    common = [obj, "--supports", supports, "--stress-only", "--solver", "edge_based",
+              "--load", "plan_area", "--tau", "zero", "--out", "out.obj"]
+    rust = subprocess.run([formfind, *common, "--report", "rust.json", "--pictures", "pics"],
+                          cwd=tmp_path, capture_output=True, text=True)
+    assert rust.returncode in (0, 3), rust.stderr
+    python = subprocess.run([sys.executable, "-m", "voussoir", *map(str, common), "--report",
+                             "python.json"], cwd=tmp_path, capture_output=True, text=True)
+    assert python.returncode in (0, 3), python.stderr
+    a = json.loads((tmp_path / "rust.json").read_text())
+    b = json.loads((tmp_path / "python.json").read_text())
+    assert set(a) == set(b) and set(a["settings"]) == set(b["settings"])
+    for report in (a, b):
+        report.pop("timings_s")
+    assert a["settings"]["formulation"] == "edge_based"
+    assert a["settings"]["load_rule"] == "plan_area" and a["settings"]["tau"] == "zero"
+    assert a == b

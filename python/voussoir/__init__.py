@@ -38,6 +38,7 @@ __all__ = [
     "analyse",
     "form_find",
     "assess",
+    "min_thickness_of_family",
     "defaults",
     "AssessmentResult",
     "FormFindResult",
@@ -94,6 +95,9 @@ class Mesh:
             free boundary vertices; default 0.
         prescribed_tau: (n,) inward normal push per free boundary vertex, used with
             ``tau="prescribed"``; finite and >= 0; default 0.
+        polygon_diagonals: (k, 2) integer vertex ids of the edges that split the model's
+            polygons into triangles (interior edges): q_min does not bind them. `from_file`
+            marks those of a file's polygons.
         A single number given for `face_density`, `extra_loads` or `prescribed_tau` stands
             for every face or vertex.
 
@@ -114,6 +118,7 @@ class Mesh:
         extra_loads: Any = None,
         horizontal_forces: Any = None,
         prescribed_tau: Any = None,
+        polygon_diagonals: Any = None,
     ) -> None:
         self._native = _native.Mesh(
             _floats("vertices", _required("vertices", vertices)),
@@ -123,6 +128,7 @@ class Mesh:
             _floats("extra_loads", extra_loads),
             _floats("horizontal_forces", horizontal_forces),
             _floats("prescribed_tau", prescribed_tau),
+            None if polygon_diagonals is None else _ids("polygon_diagonals", polygon_diagonals),
         )
 
     @classmethod
@@ -217,6 +223,12 @@ class Mesh:
     def welded_ids(self) -> np.ndarray:
         """(n_file,) uint32: the mesh vertex of each vertex of the file read."""
         return self._native.welded_ids
+
+    @property
+    def polygon_diagonals(self) -> np.ndarray:
+        """(k, 2) uint32 marked polygon diagonals (q_min does not bind them), smaller id
+        first, in edge order."""
+        return self._native.polygon_diagonals
 
     @property
     def plan_repairs(self) -> List[str]:
@@ -361,7 +373,7 @@ def assess(
             the supports) or "max-load" (the largest factor on `load_pattern`).
         fixed_supports: keep the supports at the mesh's heights (by default the thrust meets
             each support anywhere within the envelope).
-        unit_weight: weight per unit volume (> 0).
+        unit_weight: weight per unit volume (>= 0; 0: the mesh's extra loads alone).
         load_pattern: (n,) downward load per vertex that "max-load" multiplies.
         progress: called as ``progress(step, infeasibility)`` after every step (1-based;
             infeasibility: the largest vertical residual over the mean load). Returning False
@@ -394,6 +406,63 @@ def assess(
     )
     least = None if uniform is None else fields["thickness_scale"] * uniform
     return AssessmentResult._from_native(fields, least)
+
+
+def min_thickness_of_family(
+    mesh: Mesh,
+    envelope_at: Callable[[float], Tuple[Any, Any]],
+    thickness: float,
+    *,
+    scale_tolerance: float = 1e-3,
+    fixed_supports: bool = False,
+    unit_weight: float = 1.0,
+    **settings: Any,
+) -> AssessmentResult:
+    """The least thickness t of a family of envelopes whose bounds are functions of t, such as
+    Heyman's dome (the spheres R +- t/2 read vertically) or compas_tno's ``zlb``/``zub``.
+
+    Each round runs the "min-thickness" analysis on ``envelope_at(t)`` (self-weight: area x t x
+    `unit_weight` on its middle surface) and moves t towards the thickness whose least scale is
+    1 (secant steps inside a bracket, at most twelve rounds); see docs/method.md section 16.5.
+
+    Args:
+        mesh: the vault; its plan is the form diagram.
+        envelope_at: called with a thickness t, returns ``(lower, upper)``, the (n,) intrados
+            and extrados heights per vertex of that thickness.
+        thickness: the first thickness tried (the vault's own, say).
+        scale_tolerance: the search ends when the least scale lies in [1 - this, 1].
+        fixed_supports, unit_weight, **settings: as for `assess`.
+
+    Returns:
+        The "min-thickness" analysis at the least certified thickness; ``thickness_min`` is
+        that thickness, ``rounds`` the analyses run and ``family_converged`` whether the last
+        scale met `scale_tolerance` (a local least thickness of a nested family).
+
+    Raises:
+        VoussoirError: `envelope_at` returned something else than two arrays of n finite
+            floats with lower <= upper (the message names the vertex), no round found a
+            certified surface, or a bad setting. An exception `envelope_at` raises propagates.
+    """
+    native = _check_mesh(mesh)
+    if not callable(envelope_at):
+        raise VoussoirError("argument `envelope_at`: is not callable")
+
+    def member(t: float) -> Tuple[np.ndarray, np.ndarray]:
+        answer = envelope_at(t)
+        try:
+            lower, upper = answer
+        except (TypeError, ValueError):
+            raise VoussoirError(
+                f"argument `envelope_at`: envelope_at({t}) did not return a pair (lower, upper)"
+            ) from None
+        return _floats("envelope_at", lower), _floats("envelope_at", upper)
+
+    kwargs: Dict[str, Any] = dict(settings)
+    kwargs.update(fixed_supports=fixed_supports, unit_weight=unit_weight)
+    fields = _native.min_thickness_of_family(
+        native, member, float(thickness), float(scale_tolerance), kwargs
+    )
+    return AssessmentResult._from_native(fields, fields["thickness"])
 
 
 WELD_TOLERANCE: float = _native.WELD_TOLERANCE

@@ -52,6 +52,10 @@ def _bound(flag: str, text: str) -> Tuple[float, str]:
 
 def parser() -> argparse.ArgumentParser:
     d = voussoir.defaults()
+    # The library's names of each choice (those of the formfind example and the report);
+    # the command line cannot give per-vertex values, so no `--tau prescribed`.
+    names = _native.choices()
+    taus = [t for t in names["tau"] if t != "prescribed"]
     p = argparse.ArgumentParser(
         prog="python -m voussoir",
         description="The nearest self-supporting (compression-only) shape to a triangulated "
@@ -66,30 +70,30 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--weld", type=float, default=voussoir.WELD_TOLERANCE,
                    help=f"merge vertices closer than TOL x bounding-box diagonal [{voussoir.WELD_TOLERANCE:g}]")
     p.add_argument("--no-weld", action="store_true", help="keep the file's vertices as they are")
-    p.add_argument("--up", choices=["z", "y"], default="z",
+    p.add_argument("--up", choices=names["up"], default="z",
                    help="the axis that points up in MESH; y for Y-up files (outputs keep MESH's axes) [z]")
     p.add_argument("--strict", action="store_true", help="reject plan slivers instead of mending them")
     p.add_argument("--out", type=Path, help="form-found mesh [formfind-out/NAME-formfound.obj]")
     p.add_argument("--report", type=Path, help="everything computed, as JSON [formfind-out/report.json]")
     p.add_argument("--stress-only", action="store_true", help="analyse the input shape only")
-    p.add_argument("--method", choices=["nearest", "paper"], default=d["method"], help=f"[{d['method']}]")
+    p.add_argument("--method", choices=names["method"], default=d["method"], help=f"[{d['method']}]")
     p.add_argument("--fairness", type=float, help=f"nearest method: smoothness weight [{d['fairness']}]")
     p.add_argument("--max-height-change", type=float,
                    help=f"nearest method: largest height change, plan diagonals [{d['max_height_change']}]")
-    p.add_argument("--solver", choices=["reduced", "edge-based"], help=f"[{d['formulation']}]")
-    p.add_argument("--qp", choices=["native", "clarabel"], help=f"QP solver [{d['qp_solver']}]")
+    p.add_argument("--solver", choices=names["formulation"], help=f"[{d['formulation']}]")
+    p.add_argument("--qp", choices=names["qp_solver"], help=f"QP solver [{d['qp_solver']}]")
     p.add_argument("--tol", type=float, help=f"stop when eps_inf < T [{d['tolerance']:g}]")
     p.add_argument("--max-iter", type=int, help=f"at most N stress steps [{d['max_iterations']}]")
     p.add_argument("--qmin", help=f"lower bound on force densities, X (relative) or Xabs [{d['q_min']}]")
-    p.add_argument("--qmin-scope", choices=["interior", "all"], help=f"[{d['q_min_scope']}]")
+    p.add_argument("--qmin-scope", choices=names["q_min_scope"], help=f"[{d['q_min_scope']}]")
     p.add_argument("--qmax", help="upper bound on force densities as --qmin, or none [none]")
-    p.add_argument("--tau", choices=["optimize", "zero"], help="normal push at free edges [optimize]")
-    p.add_argument("--holes", choices=["affine", "constant"], help=f"[{d['holes']}]")
+    p.add_argument("--tau", choices=taus, help=f"normal push at free edges [{d['tau']}]")
+    p.add_argument("--holes", choices=names["holes"], help=f"[{d['holes']}]")
     p.add_argument("--dual-smoothing", type=float, help=f"force-diagram smoothing weight [{d['dual_length_smoothing']}]")
     p.add_argument("--smoothing-decay", type=float, help=f"decay of --dual-smoothing per step [{d['smoothing_decay']}]")
     p.add_argument("--odt", type=int, help=f"ODT sweeps of the plan [{d['odt_iterations']}]")
     p.add_argument("--density", type=float, default=1.0, help="weight per unit area of every face [1]")
-    p.add_argument("--load", choices=["barycentric", "voronoi", "plan"], help=f"[{d['load_rule']}]")
+    p.add_argument("--load", choices=names["load_rule"], help=f"[{d['load_rule']}]")
     a = p.add_argument_group("assessment (instead of form finding; MESH is the middle surface)")
     a.add_argument("--assess", choices=["fit", "min-thickness", "min-thrust", "max-thrust", "max-load"],
                    help="a compression-only thrust surface inside the masonry: the one nearest the "
@@ -115,18 +119,15 @@ def settings_of(a: argparse.Namespace) -> Dict[str, Any]:
         "max_iterations": a.max_iter,
         "q_min_scope": a.qmin_scope,
         "holes": a.holes,
+        "formulation": a.solver,
+        "tau": a.tau,
+        "load_rule": a.load,
         "dual_length_smoothing": a.dual_smoothing,
         "smoothing_decay": a.smoothing_decay,
         "odt_iterations": a.odt,
         "qp_solver": a.qp,
     }
     s.update({k: v for k, v in plain.items() if v is not None})
-    if a.solver:
-        s["formulation"] = a.solver.replace("-", "_")
-    if a.tau:
-        s["tau"] = {"optimize": "optimized", "zero": "zero"}[a.tau]
-    if a.load:
-        s["load_rule"] = {"plan": "plan_area"}.get(a.load, a.load)
     if a.qmin is not None:
         s["q_min"], s["q_min_kind"] = _bound("--qmin", a.qmin)
     if a.qmax is not None and a.qmax != "none":
@@ -153,25 +154,6 @@ def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
         up=a.up,
         face_density=density,
     )
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return value
-
-
-def report(mesh: voussoir.Mesh, result: voussoir.StressResult, settings: Dict[str, Any]) -> Dict[str, Any]:
-    fields = {k: _jsonable(v) for k, v in vars(result).items()}
-    fields.update(
-        anchored=mesh.anchored.tolist(),
-        plan_repairs=mesh.plan_repairs,
-        settings={**voussoir.defaults(), **settings},
-        voussoir_version=voussoir.__version__,
-        units="input units: lengths as in the mesh file, loads = density x area, "
-        "force densities = force / length",
-    )
-    return fields
 
 
 def _file_kind(mode: int) -> str:
@@ -304,33 +286,6 @@ def _surface(path: Path) -> Tuple[np.ndarray, np.ndarray]:
     return vertices, faces.astype(np.int64)
 
 
-def assessment_report(r: voussoir.AssessmentResult, thickness: Optional[float],
-                      pattern: Optional[np.ndarray]) -> Dict[str, Any]:
-    """The report's "assessment", as formfind writes it."""
-    detail = r.termination_detail
-    if r.termination == "stalled":
-        detail = {"vertices": r.termination_vertices.tolist()}
-    elif detail is not None:
-        detail = {"what": detail}
-    nonzero = np.flatnonzero(np.abs(r.reactions).sum(axis=1))
-    return {
-        "objective": r.objective, "feasible": r.feasible, "termination": r.termination,
-        "termination_detail": detail, "iterations": r.iterations, "seconds": r.seconds,
-        "thickness": thickness, "thickness_min": r.thickness_min,
-        "thickness_scale": r.thickness_scale, "safety_factor": r.safety_factor,
-        "thrust_horizontal": r.thrust_horizontal, "load_factor": r.load_factor,
-        "eps_inf": r.eps_inf, "horizontal_imbalance": r.horizontal_imbalance,
-        "worst_bound": {"excess": r.worst_bound, "vertex": r.worst_bound_vertex},
-        "worst_residual_vertex": r.worst_residual_vertex,
-        "bounds": {"lower": r.lower.tolist(), "upper": r.upper.tolist()},
-        "envelope": {"lower": r.envelope_lower.tolist(), "upper": r.envelope_upper.tolist(),
-                     "middle": r.envelope_middle.tolist(),
-                     "face_thickness": r.face_thickness.tolist()},
-        "reactions": [[int(v), *r.reactions[v].tolist()] for v in nonzero],
-        "load_pattern": None if pattern is None else pattern.tolist(),
-    }
-
-
 def run_assess(a: argparse.Namespace) -> int:
     """`--assess`: the thrust surface as OUT, the report with its "assessment"."""
     name = a.mesh.stem
@@ -342,32 +297,29 @@ def run_assess(a: argparse.Namespace) -> int:
     settings: Dict[str, Any] = {"objective": a.assess, "fixed_supports": a.fixed_supports,
                                 "unit_weight": 1.0 if a.unit_weight is None else a.unit_weight}
     if a.load:
-        settings["load_rule"] = {"plan": "plan_area"}.get(a.load, a.load)
+        settings["load_rule"] = a.load
     if a.tol is not None:
         settings["tolerance"] = a.tol
     if a.max_iter is not None:
         settings["max_iterations"] = a.max_iter
     if a.qmin is not None:
         settings["q_min"], settings["q_min_kind"] = _bound("--qmin", a.qmin)
+    # The input files the report's settings name, as given.
+    files = tuple(None if p is None else os.fspath(p)
+                  for p in (a.intrados, a.extrados, a.load_pattern))
     try:
         mesh = read_model(a, 1.0)
-        pattern = None if a.load_pattern is None else _load_pattern(a.load_pattern, mesh)
-        if thickness is not None:
-            r = voussoir.assess(mesh, thickness, load_pattern=pattern, **settings)
-        else:
-            r = voussoir.assess(mesh, intrados=_surface(a.intrados),
-                                extrados=_surface(a.extrados), load_pattern=pattern, **settings)
+        if a.load_pattern is not None:
+            settings["load_pattern"] = _load_pattern(a.load_pattern, mesh)
+        envelope = ((np.array([thickness]), None, None) if thickness is not None
+                    else (None, _surface(a.intrados), _surface(a.extrados)))
+        # The natives, asked for the library's report (the formfind example's schema).
+        fields = _native.assess(mesh._native, *envelope, settings, None, files)
     except voussoir.VoussoirError as e:
         raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
-    report = {
-        "assessment": assessment_report(r, thickness, pattern),
-        "edges": r.edges.tolist(), "force_densities": r.force_densities.tolist(),
-        "loads": r.loads.tolist(), "residuals": r.residuals.tolist(),
-        "anchored": mesh.anchored.tolist(), "plan_repairs": mesh.plan_repairs,
-        "settings": {**settings, "mesh": os.fspath(a.mesh)},
-        "voussoir_version": voussoir.__version__,
-    }
-    text = json.dumps(report, indent=1) + "\n"
+    least = None if thickness is None else fields["thickness_scale"] * thickness
+    r = voussoir.AssessmentResult._from_native(fields, least)
+    text = fields["report"]
     try:
         _write_all([(out, lambda p: mesh.write(p, r.positions)),
                     (report_path, lambda p: Path(p).write_text(text))])
@@ -404,12 +356,15 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         raise Failure(f"--out and --report name the same file {out}; give each its own path")
     try:
         mesh = read_model(a, a.density)
+        # The natives, asked for the library's report (the formfind example's schema).
         if a.stress_only:
-            result: voussoir.StressResult = voussoir.analyse(mesh, **settings)
+            fields = _native.analyse(mesh._native, settings, True)
+            result: voussoir.StressResult = voussoir.StressResult._from_native(fields)
             done = result.status in ("solved", "almost_solved")
             summary = f"stress only ({result.status}): eps_inf = {result.eps_inf:.2e}"
         else:
-            found = voussoir.form_find(mesh, **settings)
+            fields = _native.form_find(mesh._native, settings, None, True)
+            found = voussoir.FormFindResult._from_native(fields)
             result, done = found, found.converged
             summary = (
                 f"{found.termination.replace('_', ' ')} after {found.iterations} iterations: "
@@ -418,7 +373,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
             )
     except voussoir.VoussoirError as e:
         raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
-    text = json.dumps(report(mesh, result, settings), indent=1) + "\n"
+    text = fields["report"]
 
     def write_report(path: str) -> None:
         Path(path).write_text(text)

@@ -189,14 +189,25 @@ class AssessmentResult:
     area x thickness x unit weight)."""
     thickness_min: Optional[float] = None
     """thickness_scale x the thickness when one uniform thickness was given (the least
-    thickness for "min-thickness"); None for per-face thicknesses and surfaces."""
+    thickness for "min-thickness"); the least thickness of `min_thickness_of_family`; None
+    for per-face thicknesses and surfaces."""
+    rounds: Optional[int] = None
+    """`min_thickness_of_family`: the least-thickness analyses run; None otherwise."""
+    family_converged: Optional[bool] = None
+    """`min_thickness_of_family`: the last round's scale met the tolerance; None otherwise."""
 
     @classmethod
     def _from_native(
         cls, fields: Dict[str, Any], thickness_min: Optional[float]
     ) -> "AssessmentResult":
-        names = [f.name for f in dataclasses.fields(cls) if f.name != "thickness_min"]
-        return cls(**{name: fields[name] for name in names}, thickness_min=thickness_min)
+        extra = ("thickness_min", "rounds", "family_converged")
+        names = [f.name for f in dataclasses.fields(cls) if f.name not in extra]
+        return cls(
+            **{name: fields[name] for name in names},
+            thickness_min=thickness_min,
+            rounds=fields.get("rounds"),
+            family_converged=fields.get("family_converged"),
+        )
 
     @property
     def converged(self) -> bool:

@@ -1,6 +1,6 @@
 """Type stub of the native module (python/src). Use the wrappers in `voussoir` instead."""
 
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional
 
 import numpy as np
 
@@ -20,6 +20,7 @@ class Mesh:
         extra_loads: Optional[np.ndarray] = ...,
         horizontal_forces: Optional[np.ndarray] = ...,
         prescribed_tau: Optional[np.ndarray] = ...,
+        polygon_diagonals: Optional[np.ndarray] = ...,
     ) -> None: ...
     @staticmethod
     def read(
@@ -48,6 +49,8 @@ class Mesh:
     @property
     def welded_ids(self) -> np.ndarray: ...
     @property
+    def polygon_diagonals(self) -> np.ndarray: ...
+    @property
     def plan_repairs(self) -> List[str]: ...
     @property
     def n_holes(self) -> int: ...
@@ -61,11 +64,15 @@ class Mesh:
     def prescribed_tau(self) -> np.ndarray: ...
 
 def defaults() -> Dict[str, Any]: ...
-def analyse(mesh: Mesh, settings: Optional[Dict[str, Any]] = ...) -> Dict[str, Any]: ...
+def choices() -> Dict[str, List[str]]: ...
+def analyse(
+    mesh: Mesh, settings: Optional[Dict[str, Any]] = ..., report: bool = ...
+) -> Dict[str, Any]: ...
 def form_find(
     mesh: Mesh,
     settings: Optional[Dict[str, Any]] = ...,
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
+    report: bool = ...,
 ) -> Dict[str, Any]: ...
 def assess(
     mesh: Mesh,
@@ -74,5 +81,13 @@ def assess(
     extrados: Optional[Tuple[np.ndarray, np.ndarray]],
     settings: Dict[str, Any],
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
+    report: Optional[Tuple[Optional[str], Optional[str], Optional[str]]] = ...,
+) -> Dict[str, Any]: ...
+def min_thickness_of_family(
+    mesh: Mesh,
+    envelope_at: Callable[[float], Tuple[np.ndarray, np.ndarray]],
+    thickness: float,
+    scale_tolerance: float,
+    settings: Dict[str, Any],
 ) -> Dict[str, Any]: ...
 def write_mesh(mesh: Mesh, positions: np.ndarray, path: str) -> None: ...

@@ -12,11 +12,13 @@
 //! returned heights and forces.
 
 mod envelope;
+mod family;
 mod model;
 mod qp;
 mod sqp;
 
 pub use envelope::Envelope;
+pub use family::{min_thickness_of_family, FamilyThickness};
 
 use crate::error::{Error, Result};
 use crate::geometry::loads::LoadRule;
@@ -82,6 +84,7 @@ impl std::str::FromStr for Objective {
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct AssessSettings {
+    /// What to optimise. Default [`Objective::Fit`].
     pub objective: Objective,
     /// Keep the supports at the mesh's heights instead of letting the thrust meet each
     /// support anywhere within the envelope. Default false.
@@ -151,44 +154,29 @@ impl AssessSettings {
         Ok(())
     }
 
-    pub fn with_objective(mut self, objective: Objective) -> Self {
-        self.objective = objective;
-        self
-    }
-    pub fn with_fixed_supports(mut self, fixed: bool) -> Self {
-        self.fixed_supports = fixed;
-        self
-    }
-    pub fn with_unit_weight(mut self, unit_weight: f64) -> Self {
-        self.unit_weight = unit_weight;
-        self
-    }
-    pub fn with_load_rule(mut self, rule: LoadRule) -> Self {
-        self.load_rule = rule;
-        self
-    }
+    /// These settings with `load_pattern` set to `pattern`.
+    #[must_use]
     pub fn with_load_pattern(mut self, pattern: Vec<f64>) -> Self {
         self.load_pattern = Some(pattern);
         self
     }
-    pub fn with_q_min(mut self, q_min: QBound) -> Self {
-        self.q_min = q_min;
-        self
-    }
-    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
-        self.tolerance = tolerance;
-        self
-    }
-    pub fn with_max_iterations(mut self, n: usize) -> Self {
-        self.max_iterations = n;
-        self
-    }
 }
+
+crate::setters::with_setters!(AssessSettings {
+    with_objective: objective: Objective,
+    with_fixed_supports: fixed_supports: bool,
+    with_unit_weight: unit_weight: f64,
+    with_load_rule: load_rule: LoadRule,
+    with_q_min: q_min: QBound,
+    with_tolerance: tolerance: f64,
+    with_max_iterations: max_iterations: usize,
+});
 
 /// The outcome of [`assess`], in physical units.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct AssessResult {
+    /// The analysis that was run.
     pub objective: Objective,
     /// True when `positions` with `force_densities` is a certified thrust surface: ε∞ <
     /// tolerance, every q within its bounds (q ≥ 0), and every height within
@@ -196,6 +184,7 @@ pub struct AssessResult {
     pub feasible: bool,
     /// Converged; or how the search ended (the best state reached is returned).
     pub termination: Termination,
+    /// Sequential QP iterations (the starting `fit` search's included).
     pub iterations: usize,
     /// The thrust surface: the mesh's plan with the found heights.
     pub positions: Vec<[f64; 3]>,
@@ -209,8 +198,10 @@ pub struct AssessResult {
     pub eps_inf: f64,
     /// Largest horizontal imbalance at a non-anchored vertex over the mean load.
     pub horizontal_imbalance: f64,
-    /// Envelope at the reported thickness (scaled by `thickness_scale`).
+    /// Lower bound per vertex: the envelope at the reported thickness (scaled by
+    /// `thickness_scale`).
     pub lower: Vec<f64>,
+    /// Upper bound per vertex, likewise.
     pub upper: Vec<f64>,
     /// Scale of the envelope's half extents: 1, or the least scale found by
     /// [`Objective::MinThickness`].
@@ -232,6 +223,7 @@ pub struct AssessResult {
     /// least thickness scale at which one was found (above 1: the envelope is too thin), and
     /// the vertex where that surface leaves the given envelope the most. None otherwise.
     pub needed_scale: Option<(f64, Option<u32>)>,
+    /// Wall time, seconds.
     pub seconds: f64,
 }
 

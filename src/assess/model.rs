@@ -3,11 +3,11 @@
 //! functions of a state (residuals, objective, reactions); and the certificate of a run.
 
 use super::envelope::Envelope;
-use super::sqp::Run;
 use super::{AssessResult, AssessSettings, Objective};
 use crate::error::{Error, Result};
 use crate::geometry::loads;
 use crate::problem::Problem;
+use crate::solve::Termination;
 use crate::stress::linear::LinearStress;
 use crate::stress::{equilibrium, StressSettings, TauMode};
 
@@ -453,4 +453,12 @@ fn worst_bound(
                 }
             },
         )
+}
+
+/// What the search (`sqp::solve`) returns: the best state reached and how it ended.
+pub(super) struct Run {
+    pub state: State,
+    pub termination: Termination,
+    pub iterations: usize,
+    pub seconds: f64,
 }

@@ -6,20 +6,12 @@
 //! and then ρ grows. ν grows while the linearised residuals cannot be met at its price and
 //! otherwise follows the step's multipliers (ten times the largest).
 
-use super::model::{other_end, Model, State};
+use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
 use super::{AssessSettings, Objective};
 use crate::error::Result;
 use crate::solve::{Progress, Termination};
 use std::time::Instant;
-
-/// What the search returns: the best state reached and how it ended.
-pub(super) struct Run {
-    pub state: State,
-    pub termination: Termination,
-    pub iterations: usize,
-    pub seconds: f64,
-}
 
 /// Accept a step when φ falls by this fraction of the predicted fall.
 const ACCEPT: f64 = 0.1;

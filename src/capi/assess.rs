@@ -7,66 +7,14 @@ use super::boundary::{
     boundary, checked_len, copy_out, from_error, handle, handle_mut, input, out_ptr, CResult,
     Failure,
 };
+use super::enum_args;
 use super::mesh::VsrMesh;
 use super::settings::VsrProgressFn;
-use super::status::{self, VsrStatus};
-use crate::assess::{assess, AssessSettings, Envelope, Objective};
+use super::status::VsrStatus;
+use crate::assess::{assess, AssessSettings, Envelope};
 use crate::solid::Thickness;
 use crate::stress::QBound;
 use std::ffi::c_void;
-
-/// What `vsr_assess` optimises (`vsr_assess_settings_set_objective`,
-/// `vsr_assessment_objective`).
-#[repr(u32)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum VsrObjective {
-    /// Default: does a thrust surface fit? The one nearest the middle surface (least
-    /// area-weighted squared height difference).
-    Fit = 0,
-    /// The least thickness: the smallest scale s of the envelope's half extents about the
-    /// middle surface that still holds a thrust surface (the loads stay those of the given
-    /// thickness); the geometric safety factor is 1 / s.
-    MinThickness = 1,
-    /// The least horizontal thrust, Σ over supports of |H| (the passive state).
-    MinThrust = 2,
-    /// The greatest horizontal thrust (the active state).
-    MaxThrust = 3,
-    /// The largest factor λ on the load pattern (`vsr_assess_settings_set_load_pattern`)
-    /// added to the self-weight.
-    MaxLoad = 4,
-}
-
-impl VsrObjective {
-    pub(crate) fn of(o: Objective) -> VsrObjective {
-        match o {
-            Objective::Fit => VsrObjective::Fit,
-            Objective::MinThickness => VsrObjective::MinThickness,
-            Objective::MinThrust => VsrObjective::MinThrust,
-            Objective::MaxThrust => VsrObjective::MaxThrust,
-            Objective::MaxLoad => VsrObjective::MaxLoad,
-        }
-    }
-}
-
-fn objective(name: &str, v: u32) -> CResult<Objective> {
-    Ok(match v {
-        0 => Objective::Fit,
-        1 => Objective::MinThickness,
-        2 => Objective::MinThrust,
-        3 => Objective::MaxThrust,
-        4 => Objective::MaxLoad,
-        _ => {
-            return Err(Failure::new(
-                VsrStatus::InvalidEnum,
-                format!(
-                    "argument `{name}`: {v} is not one of VSR_OBJECTIVE_FIT (0), \
-                     VSR_OBJECTIVE_MIN_THICKNESS (1), VSR_OBJECTIVE_MIN_THRUST (2), \
-                     VSR_OBJECTIVE_MAX_THRUST (3), VSR_OBJECTIVE_MAX_LOAD (4)"
-                ),
-            ))
-        }
-    })
-}
 
 /// Opaque handle: the masonry's envelope over a mesh's plan, per vertex an intrados (lower)
 /// and an extrados (upper) height and per face the thickness whose weight loads the vault.
@@ -439,7 +387,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_objective(
     objective: u32,
 ) -> VsrStatus {
     boundary!({
-        let o = self::objective("objective", objective)?;
+        let o = enum_args::objective("objective", objective)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, |s| s.objective = o) }
     })
@@ -463,7 +411,8 @@ pub unsafe extern "C" fn vsr_assess_settings_set_fixed_supports(
 }
 
 /// Sets the weight per unit volume of the masonry: a face weighs its area on the middle
-/// surface × its thickness × `unit_weight`. Finite and > 0. Default 1.
+/// surface × its thickness × `unit_weight`. Finite and >= 0 (0: the mesh's extra loads
+/// alone). Default 1.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
@@ -490,7 +439,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_load_rule(
     rule: u32,
 ) -> VsrStatus {
     boundary!({
-        let rule = status::load_rule("rule", rule)?;
+        let rule = enum_args::load_rule("rule", rule)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, |s| s.load_rule = rule) }
     })
@@ -532,7 +481,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_q_min(
     kind: u32,
 ) -> VsrStatus {
     boundary!({
-        let relative = status::bound_kind("kind", kind)?;
+        let relative = enum_args::bound_kind("kind", kind)?;
         let v = finite("value", value)?;
         let bound = if relative {
             QBound::Relative(v)

@@ -1,9 +1,8 @@
 //! `VsrAssessment` (the outcome of `vsr_assess`) and its getters. Array getters copy out as
 //! `VsrResult`'s do: `(assessment, out, len, needed)`.
 
-use super::assess::VsrObjective;
 use super::boundary::{boundary, copy_out, handle, out_ptr, CResult};
-use super::status::{VsrStatus, VsrTermination};
+use super::status::{VsrObjective, VsrStatus, VsrTermination};
 use crate::assess::AssessResult;
 use crate::mesh::Mesh;
 use std::ffi::c_char;

@@ -376,3 +376,82 @@ pub unsafe extern "C" fn vsr_mesh_edges(
         unsafe { copy_out(&edges, out, len, needed) }
     })
 }
+
+/// Marks the edges that split the polygons of the model into triangles, as `vsr_mesh_read`
+/// marks those of a file's polygons: q_min does not bind them (only q >= 0), since a force
+/// network on a polygon mesh needs no force along them. Without them a mesh of quads split
+/// along one diagonal per ring (a latitude-longitude dome) may admit no stress with every
+/// q >= q_min > 0. Replaces the diagonals marked before (`n_diagonals` = 0 clears them).
+///
+/// `diagonals`: #D by 2 `uint32_t` vertex ids, row-major, each pair an interior edge of the
+/// mesh (either order); NULL only when `n_diagonals` is 0. Copied.
+///
+/// Errors: NULL `mesh`, or `diagonals` with a non-zero count (`VSR_STATUS_NULL_POINTER`);
+/// `n_diagonals * 2` overflowing (`VSR_STATUS_LENGTH_OVERFLOW`); a vertex id `>= #V`
+/// (`VSR_STATUS_INDEX_OUT_OF_RANGE`); a pair that is no interior edge
+/// (`VSR_STATUS_INVALID_ARGUMENT`). The message names the pair; on failure the mesh keeps
+/// the diagonals it had.
+///
+/// # Safety
+/// `mesh`: a valid handle with exclusive access; `diagonals`: `2 n_diagonals` readable ids.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_set_polygon_diagonals(
+    mesh: *mut VsrMesh,
+    diagonals: *const u32,
+    n_diagonals: usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract (valid handle, exclusive access).
+        let mesh = unsafe { handle_mut("mesh", mesh)? };
+        if n_diagonals > 0 && diagonals.is_null() {
+            return Err(Failure::null("diagonals"));
+        }
+        let n = checked_len::<u32>("diagonals", "n_diagonals", n_diagonals, 2)?;
+        // SAFETY: length checked; readability is the caller's contract.
+        let ids = unsafe { input("diagonals", diagonals, n)? };
+        let n_vertices = mesh.problem.mesh.n_vertices();
+        if let Some(i) = ids.iter().position(|&v| v as usize >= n_vertices) {
+            return Err(Failure::new(
+                VsrStatus::IndexOutOfRange,
+                format!(
+                    "argument `diagonals`: pair {} has vertex {}, but there are only \
+                     {n_vertices} vertices",
+                    i / 2,
+                    ids[i]
+                ),
+            ));
+        }
+        let pairs: Vec<[u32; 2]> = ids.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        let problem =
+            (mesh.problem.clone().with_polygon_diagonals(&pairs)).map_err(|e| match e {
+                crate::Error::InvalidArgument { reason, .. } => {
+                    Failure::invalid("diagonals", reason)
+                }
+                e => from_error("diagonals", e),
+            })?;
+        mesh.problem = problem;
+        Ok(())
+    })
+}
+
+/// Copies the marked polygon diagonals (`vsr_mesh_set_polygon_diagonals`, or those of the
+/// polygons of a file `vsr_mesh_read` read): #D by 2 `uint32_t` vertex ids, row-major,
+/// smaller id first, in edge order. Copy-out as described in the header's introduction.
+///
+/// # Safety
+/// `mesh`: a valid handle; `out`: NULL or `len` writable ids; `needed`: NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_mesh_polygon_diagonals(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let mesh = unsafe { handle("mesh", mesh)? };
+        let pairs: Vec<u32> = mesh.problem.polygon_diagonals().concat();
+        // SAFETY: caller's contract.
+        unsafe { copy_out(&pairs, out, len, needed) }
+    })
+}

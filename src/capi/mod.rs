@@ -12,6 +12,7 @@
 #![allow(unsafe_code)]
 
 mod boundary;
+mod enum_args;
 mod files;
 mod mesh;
 mod result;
@@ -32,8 +33,8 @@ pub use settings::*;
 pub use solid::*;
 pub use solve::*;
 pub use status::{
-    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrQpSolver,
-    VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
+    VsrBoundKind, VsrEdgeScope, VsrFormulation, VsrHoleMode, VsrLoadRule, VsrMethod, VsrObjective,
+    VsrQpSolver, VsrResultKind, VsrStatus, VsrStressStatus, VsrTauMode, VsrTermination,
 };
 
 use boundary::boundary;

@@ -748,10 +748,12 @@ pub unsafe extern "C" fn vsr_result_height_change(
     })
 }
 
-/// Distances between the form-found and the input heights, over the plan bounding-box
-/// diagonal (dimensionless): `hausdorff` = max |Δz|, `l2` = area-weighted RMS of Δz. Both
-/// pointers required; written only on success. For an analysis result:
-/// `VSR_STATUS_NOT_AVAILABLE`.
+/// Distances between the form-found and the input surfaces, over the plan bounding-box
+/// diagonal (dimensionless), sampled at vertices: `hausdorff` = the symmetric Hausdorff
+/// distance (the largest distance from a vertex of either surface to the other surface),
+/// `l2` = the RMS distance from the form-found vertices to the input surface, weighted by
+/// vertex area (for the height change itself see `vsr_result_height_change`). Both pointers required; written only
+/// on success. For an analysis result: `VSR_STATUS_NOT_AVAILABLE`.
 ///
 /// # Safety
 /// `result`: a valid handle; the out-pointers writable.

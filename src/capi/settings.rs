@@ -11,7 +11,8 @@
 //! capi_header`).
 
 use super::boundary::{boundary, handle_mut, out_ptr, CResult, Failure};
-use super::status::{self, VsrStatus};
+use super::enum_args;
+use super::status::VsrStatus;
 use crate::stress::QBound;
 use crate::FormFindSettings;
 use std::ffi::{c_int, c_void};
@@ -193,7 +194,7 @@ pub unsafe extern "C" fn vsr_settings_set_q_min(
     kind: u32,
 ) -> VsrStatus {
     boundary!({
-        let relative = status::bound_kind("kind", kind)?;
+        let relative = enum_args::bound_kind("kind", kind)?;
         let bound = if relative {
             QBound::Relative(value)
         } else {
@@ -216,7 +217,7 @@ pub unsafe extern "C" fn vsr_settings_set_q_min_scope(
     scope: u32,
 ) -> VsrStatus {
     boundary!({
-        let scope = status::edge_scope("scope", scope)?;
+        let scope = enum_args::edge_scope("scope", scope)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.q_min_scope = scope) }
     })
@@ -235,7 +236,7 @@ pub unsafe extern "C" fn vsr_settings_set_q_max(
     kind: u32,
 ) -> VsrStatus {
     boundary!({
-        let relative = status::bound_kind("kind", kind)?;
+        let relative = enum_args::bound_kind("kind", kind)?;
         let bound = if value == f64::INFINITY {
             None
         } else if relative {
@@ -259,7 +260,7 @@ pub unsafe extern "C" fn vsr_settings_set_tau_mode(
     mode: u32,
 ) -> VsrStatus {
     boundary!({
-        let mode = status::tau_mode("mode", mode)?;
+        let mode = enum_args::tau_mode("mode", mode)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.tau = mode) }
     })
@@ -276,7 +277,7 @@ pub unsafe extern "C" fn vsr_settings_set_hole_mode(
     mode: u32,
 ) -> VsrStatus {
     boundary!({
-        let mode = status::hole_mode("mode", mode)?;
+        let mode = enum_args::hole_mode("mode", mode)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.holes = mode) }
     })
@@ -292,7 +293,7 @@ pub unsafe extern "C" fn vsr_settings_set_method(
     method: u32,
 ) -> VsrStatus {
     boundary!({
-        let method = status::method("method", method)?;
+        let method = enum_args::method("method", method)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.method = method) }
     })
@@ -345,7 +346,7 @@ pub unsafe extern "C" fn vsr_settings_set_load_rule(
     rule: u32,
 ) -> VsrStatus {
     boundary!({
-        let rule = status::load_rule("rule", rule)?;
+        let rule = enum_args::load_rule("rule", rule)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.load_rule = rule) }
     })
@@ -362,7 +363,7 @@ pub unsafe extern "C" fn vsr_settings_set_formulation(
     formulation: u32,
 ) -> VsrStatus {
     boundary!({
-        let formulation = status::formulation("formulation", formulation)?;
+        let formulation = enum_args::formulation("formulation", formulation)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.formulation = formulation) }
     })
@@ -380,7 +381,7 @@ pub unsafe extern "C" fn vsr_settings_set_qp_solver(
     solver: u32,
 ) -> VsrStatus {
     boundary!({
-        let solver = status::qp_solver("solver", solver)?;
+        let solver = enum_args::qp_solver("solver", solver)?;
         // SAFETY: forwarded caller's contract.
         unsafe { update(settings, &[], |f| f.stress.solver = solver) }
     })

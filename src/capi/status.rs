@@ -1,14 +1,12 @@
 //! Status codes and the enumerations that cross the C ABI.
 //!
 //! Values are explicit and never reused: a removed variant leaves a gap. Enum *inputs* cross as
-//! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`); enum *outputs* are written as these
-//! types (`uint32_t` in C).
+//! `uint32_t` and are checked (`VSR_STATUS_INVALID_ENUM`, in `enum_args.rs`); enum *outputs*
+//! are written as these types (`uint32_t` in C).
 
-use super::boundary::{CResult, Failure};
-use crate::geometry::loads::LoadRule;
-use crate::stress::airy::HoleMode;
-use crate::stress::{EdgeScope, Formulation, QpSolver, StressStatus, TauMode};
-use crate::{FormMethod, Termination};
+use crate::assess::Objective;
+use crate::stress::{QpSolver, StressStatus};
+use crate::Termination;
 
 /// Result of every fallible function. `VSR_STATUS_OK` (0) is success; on any other value the
 /// function wrote no output (except `needed` with `VSR_STATUS_BUFFER_TOO_SMALL`) and
@@ -146,6 +144,7 @@ pub enum VsrStressStatus {
     /// Stopped short of even the reduced accuracy: the iteration limit was reached, or (the
     /// native solver beyond 20k unknowns) 10 iterations went by without progress.
     MaxIterations = 3,
+    /// A solver failed numerically; `vsr_result_termination_message` says where.
     NumericalError = 4,
 }
 
@@ -273,120 +272,35 @@ pub enum VsrMethod {
     Paper = 1,
 }
 
-fn bad_enum(name: &str, value: u32, allowed: &str) -> Failure {
-    Failure::new(
-        super::VsrStatus::InvalidEnum,
-        format!("argument `{name}`: {value} is not one of {allowed}"),
-    )
+/// What `vsr_assess` optimises (`vsr_assess_settings_set_objective`,
+/// `vsr_assessment_objective`).
+#[repr(u32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VsrObjective {
+    /// Default: does a thrust surface fit? The one nearest the middle surface (least
+    /// area-weighted squared height difference).
+    Fit = 0,
+    /// The least thickness: the smallest scale s of the envelope's half extents about the
+    /// middle surface that still holds a thrust surface (the loads stay those of the given
+    /// thickness); the geometric safety factor is 1 / s.
+    MinThickness = 1,
+    /// The least horizontal thrust, Σ over supports of |H| (the passive state).
+    MinThrust = 2,
+    /// The greatest horizontal thrust (the active state).
+    MaxThrust = 3,
+    /// The largest factor λ on the load pattern (`vsr_assess_settings_set_load_pattern`)
+    /// added to the self-weight.
+    MaxLoad = 4,
 }
 
-pub(crate) fn tau_mode(name: &str, v: u32) -> CResult<TauMode> {
-    Ok(match v {
-        0 => TauMode::Optimized,
-        1 => TauMode::Zero,
-        2 => TauMode::Prescribed,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_TAU_MODE_OPTIMIZED (0), VSR_TAU_MODE_ZERO (1), VSR_TAU_MODE_PRESCRIBED (2)",
-            ))
+impl VsrObjective {
+    pub(crate) fn of(o: Objective) -> VsrObjective {
+        match o {
+            Objective::Fit => VsrObjective::Fit,
+            Objective::MinThickness => VsrObjective::MinThickness,
+            Objective::MinThrust => VsrObjective::MinThrust,
+            Objective::MaxThrust => VsrObjective::MaxThrust,
+            Objective::MaxLoad => VsrObjective::MaxLoad,
         }
-    })
-}
-
-pub(crate) fn method(name: &str, v: u32) -> CResult<FormMethod> {
-    Ok(match v {
-        0 => FormMethod::Nearest,
-        1 => FormMethod::Paper,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_METHOD_NEAREST (0), VSR_METHOD_PAPER (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn hole_mode(name: &str, v: u32) -> CResult<HoleMode> {
-    Ok(match v {
-        0 => HoleMode::Constant,
-        1 => HoleMode::Affine,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_HOLE_MODE_CONSTANT (0), VSR_HOLE_MODE_AFFINE (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn load_rule(name: &str, v: u32) -> CResult<LoadRule> {
-    Ok(match v {
-        0 => LoadRule::Barycentric,
-        1 => LoadRule::Voronoi,
-        2 => LoadRule::PlanArea,
-        _ => return Err(bad_enum(
-            name,
-            v,
-            "VSR_LOAD_RULE_BARYCENTRIC (0), VSR_LOAD_RULE_VORONOI (1), VSR_LOAD_RULE_PLAN_AREA (2)",
-        )),
-    })
-}
-
-pub(crate) fn qp_solver(name: &str, v: u32) -> CResult<QpSolver> {
-    Ok(match v {
-        0 => QpSolver::Native,
-        1 => QpSolver::Clarabel,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_QP_SOLVER_NATIVE (0), VSR_QP_SOLVER_CLARABEL (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn formulation(name: &str, v: u32) -> CResult<Formulation> {
-    Ok(match v {
-        0 => Formulation::Reduced,
-        1 => Formulation::EdgeBased,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_FORMULATION_REDUCED (0), VSR_FORMULATION_EDGE_BASED (1)",
-            ))
-        }
-    })
-}
-
-pub(crate) fn edge_scope(name: &str, v: u32) -> CResult<EdgeScope> {
-    Ok(match v {
-        0 => EdgeScope::Interior,
-        1 => EdgeScope::All,
-        _ => {
-            return Err(bad_enum(
-                name,
-                v,
-                "VSR_EDGE_SCOPE_INTERIOR (0), VSR_EDGE_SCOPE_ALL (1)",
-            ))
-        }
-    })
-}
-
-/// True for `VSR_BOUND_KIND_RELATIVE`.
-pub(crate) fn bound_kind(name: &str, v: u32) -> CResult<bool> {
-    match v {
-        0 => Ok(false),
-        1 => Ok(true),
-        _ => Err(bad_enum(
-            name,
-            v,
-            "VSR_BOUND_KIND_ABSOLUTE (0), VSR_BOUND_KIND_RELATIVE (1)",
-        )),
     }
 }

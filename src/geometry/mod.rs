@@ -13,7 +13,9 @@ use crate::mesh::Mesh;
 /// The nondimensional frame: centre of the plan bounding box and L₀.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
+    /// Centre of the plan bounding box.
     pub centre: [f64; 2],
+    /// L₀: half the plan bounding-box diagonal (1 for a plan of no extent).
     pub scale: f64,
 }
 
@@ -34,7 +36,8 @@ impl Frame {
         }
     }
 
-    pub fn to_local(&self, p: &[f64; 3]) -> [f64; 2] {
+    /// The plan position of `p` in the frame: (u − centre) / L₀.
+    pub fn to_local(self, p: &[f64; 3]) -> [f64; 2] {
         [
             (p[0] - self.centre[0]) / self.scale,
             (p[1] - self.centre[1]) / self.scale,
@@ -90,6 +93,7 @@ pub fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 impl Plan {
+    /// The plan of `positions` in `frame`.
     pub fn new(mesh: &Mesh, positions: &[[f64; 3]], frame: &Frame) -> Plan {
         let u: Vec<[f64; 2]> = positions.iter().map(|p| frame.to_local(p)).collect();
         let mut area = Vec::with_capacity(mesh.faces.len());

@@ -8,6 +8,31 @@ use super::{read_mesh_with_diagonals, read_supports, weld, MeshFormat, Welded};
 use crate::mesh::repair::{repair_plan, PlanRepair, DEFAULT_REPAIR_TOLERANCE};
 use crate::{Error, Mesh, Problem, Result};
 
+impl std::fmt::Display for Supports {
+    /// How the supports are chosen, in words (for reports).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Supports::Ids(ids) => write!(f, "{} vertex ids given", ids.len()),
+            Supports::File(path) => write!(f, "{}", path.display()),
+            Supports::Boundary => write!(f, "every boundary vertex"),
+            Supports::Lowest {
+                tolerance,
+                absolute,
+            } => {
+                let unit = if *absolute {
+                    ""
+                } else {
+                    " x the bounding box diagonal"
+                };
+                write!(
+                    f,
+                    "every vertex within {tolerance}{unit} of the lowest height"
+                )
+            }
+        }
+    }
+}
+
 /// Which vertices of a mesh file are anchored (its supports).
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -22,7 +47,12 @@ pub enum Supports {
     /// Every vertex of some face within `tolerance` of the lowest such vertex's height:
     /// `tolerance` is relative to the bounding box diagonal of those vertices unless
     /// `absolute`.
-    Lowest { tolerance: f64, absolute: bool },
+    Lowest {
+        /// The reach above the lowest height.
+        tolerance: f64,
+        /// Whether `tolerance` is a length (else a multiple of the bounding box diagonal).
+        absolute: bool,
+    },
 }
 
 /// The axis that points up in a mesh file.
@@ -132,7 +162,7 @@ crate::setters::with_setters!(ReadOptions {
 });
 
 /// How the file's vertices were welded.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct WeldSummary {
     /// The file's vertex count.
@@ -164,8 +194,32 @@ pub struct Model {
     /// The mesh edges that split the file's polygons into triangles (those welding and the
     /// repairs left), marked on `problem`.
     pub diagonals: Vec<[u32; 2]>,
-    /// The file's up axis (positions in `problem` are Z-up).
-    pub up: UpAxis,
+    /// The file's path (or what the problem was made from).
+    pub source: String,
+    /// The options it was read with (its up axis: positions in `problem` are Z-up).
+    pub options: ReadOptions,
+}
+
+impl Model {
+    /// A problem built from arrays, as a model read from `source` would describe it: every
+    /// vertex its own, no repair, supports given as ids, z up.
+    pub fn from_problem(problem: Problem, source: impl Into<String>) -> Model {
+        let mesh = &problem.mesh;
+        let n = mesh.n_vertices() as u32;
+        let anchored = (0..n).filter(|&v| mesh.anchored[v as usize]).collect();
+        let diagonals = problem.polygon_diagonals();
+        Model {
+            welded_ids: (0..n).collect(),
+            weld: None,
+            repairs: Vec::new(),
+            diagonals,
+            source: source.into(),
+            options: ReadOptions::new(Supports::Ids(anchored))
+                .with_weld_tolerance(None)
+                .with_repair_tolerance(0.0),
+            problem,
+        }
+    }
 }
 
 /// Reads a mesh file (OBJ, OFF, STL or PLY, by its extension; polygons split into fans) into a
@@ -242,7 +296,8 @@ pub fn read_model(path: &Path, options: &ReadOptions) -> Result<Model> {
         weld: summary,
         repairs,
         diagonals,
-        up: options.up,
+        source: path.display().to_string(),
+        options: options.clone(),
     })
 }
 

@@ -20,7 +20,9 @@ mod tests;
 /// A face adjacent to an edge, and the vertex of that face opposite the edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Side {
+    /// The face.
     pub face: u32,
+    /// Its vertex opposite the edge.
     pub opposite: u32,
 }
 
@@ -29,12 +31,16 @@ pub struct Side {
 /// plan), `right` the face that contains `v[1]`→`v[0]`. A boundary edge has exactly one side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Edge {
+    /// The two vertices, smaller id first.
     pub v: [u32; 2],
+    /// The face with the directed edge `v[0]`→`v[1]`.
     pub left: Option<Side>,
+    /// The face with the directed edge `v[1]`→`v[0]`.
     pub right: Option<Side>,
 }
 
 impl Edge {
+    /// Whether the edge has one side only.
     pub fn is_boundary(&self) -> bool {
         self.left.is_none() || self.right.is_none()
     }
@@ -43,6 +49,7 @@ impl Edge {
 /// A closed boundary loop, its vertices in order with the surface on the left.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BoundaryLoop {
+    /// The loop's vertices, in order, the surface on their left.
     pub vertices: Vec<u32>,
     /// Connected component the loop belongs to.
     pub component: u32,
@@ -68,6 +75,7 @@ pub struct Mesh {
     pub face_edges: Vec<[u32; 3]>,
     /// CSR vertex → incident edge ids: `vertex_edges[vertex_edge_start[v]..vertex_edge_start[v+1]]`.
     pub vertex_edge_start: Vec<u32>,
+    /// The incident edge ids of every vertex, concatenated (see `vertex_edge_start`).
     pub vertex_edges: Vec<u32>,
     /// Anchored (support) flag per vertex.
     pub anchored: Vec<bool>,
@@ -77,7 +85,9 @@ pub struct Mesh {
     pub referenced: Vec<bool>,
     /// Connected component per vertex (u32::MAX for unreferenced vertices) and per face.
     pub vertex_component: Vec<u32>,
+    /// Connected component per face.
     pub face_component: Vec<u32>,
+    /// The number of connected components.
     pub n_components: usize,
     /// Boundary loops of all components; holes are the loops with `is_outer == false`.
     pub loops: Vec<BoundaryLoop>,

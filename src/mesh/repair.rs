@@ -12,21 +12,30 @@ use crate::{Error, Result};
 /// Default tolerance of [`repair_plan`], relative to the median plan area of the faces.
 pub const DEFAULT_REPAIR_TOLERANCE: f64 = 1e-4;
 
-/// One change made by [`repair_plan`].
-#[derive(Clone, Debug, PartialEq)]
+/// One change made by [`repair_plan`]. Serialised (in reports) as `{"flip": {...}}` or
+/// `{"nudge": {...}}`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum PlanRepair {
     /// Faces `faces[0]` and `faces[1]` shared the edge `removed`; they now share `added`.
     Flip {
+        /// The two faces (they keep their ids).
         faces: [usize; 2],
+        /// The edge they shared.
         removed: [u32; 2],
+        /// The edge they share now.
         added: [u32; 2],
     },
     /// Vertex `vertex` moved in plan from `from` to `to` (its height unchanged), to mend `face`.
     Nudge {
+        /// The moved vertex.
         vertex: u32,
+        /// The face it mended.
         face: usize,
+        /// Its plan position before.
         from: [f64; 2],
+        /// Its plan position after.
         to: [f64; 2],
     },
 }

@@ -17,11 +17,14 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Mat, Side};
 
 /// Parameters of the paper's proximal schedule ([`crate::FormMethod::Paper`]): μ_k = max(μ₀ βᵏ, μ_min) · mean diag(KᵀK).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct Schedule {
+    /// μ₀: the first step's weight (relative to mean diag(KᵀK)).
     pub mu0: f64,
+    /// β: the factor on μ per step, in [0, 1].
     pub beta: f64,
+    /// μ_min: the smallest μ.
     pub mu_min: f64,
     /// η in λ_i = ‖r‖∞ / (|r_i| + η ‖r‖∞).
     pub eta: f64,

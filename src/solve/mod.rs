@@ -5,7 +5,7 @@
 mod nearest;
 mod paper;
 
-use crate::error::Result;
+use crate::error::{ids, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
 use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus};
@@ -17,18 +17,23 @@ use std::time::Instant;
 pub enum Termination {
     /// ε∞ < tolerance.
     Converged,
+    /// The iteration limit was reached first.
     MaxIterations,
     /// ε∞ stopped improving; the vertices with the largest residual that carry (almost) no
     /// stress are listed: they cannot be balanced by moving heights (raise q_min).
     Stalled {
+        /// The vertices that carry (almost) no stress.
         vertices: Vec<u32>,
     },
     /// The stress constraints admit no solution (q_min, q_max, prescribed forces, straight free
     /// edges without τ); `constraint` names the setting to relax.
     Infeasible {
+        /// The settings to relax.
         constraint: String,
     },
+    /// A solver failed numerically.
     NumericalError {
+        /// Where, in words.
         what: String,
     },
     /// The progress callback asked to stop.
@@ -38,9 +43,43 @@ pub enum Termination {
     /// force densities down, or the height limit) and `vertices` lists where (the vertices at
     /// the height limit, or those beside edges at q_max with the largest residuals).
     Blocked {
+        /// Where it is blocked.
         vertices: Vec<u32>,
+        /// What blocks, in words.
         hint: String,
     },
+}
+
+/// The sentence a user reads for a termination (the C API's termination message).
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use Termination::*;
+        match self {
+            Converged => write!(f, "converged: eps_inf is below the tolerance"),
+            MaxIterations => write!(f, "reached the iteration limit"),
+            Stalled { vertices } if vertices.is_empty() => {
+                write!(f, "stalled: eps_inf stopped improving")
+            }
+            Stalled { vertices } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(
+                    f,
+                    "stalled: eps_inf stopped improving; vertices {} carry (almost) no stress \
+                     (raise q_min)",
+                    ids(&list)
+                )
+            }
+            Infeasible { constraint } => {
+                write!(f, "infeasible stress constraints: relax {constraint}")
+            }
+            NumericalError { what } => write!(f, "numerical error: {what}"),
+            Cancelled => write!(f, "cancelled by the progress callback"),
+            Blocked { vertices, hint } => {
+                let list: Vec<usize> = vertices.iter().map(|&v| v as usize).collect();
+                write!(f, "blocked: {hint}; vertices {}", ids(&list))
+            }
+        }
+    }
 }
 
 /// How form finding moves the shape.
@@ -57,10 +96,13 @@ pub enum FormMethod {
     Paper,
 }
 
-/// Settings of the whole loop.
-#[derive(Debug, Clone, PartialEq)]
+/// Settings of the whole loop. Serialised (in reports) flat, with the names of Python's
+/// keyword settings.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct FormFindSettings {
+    /// Settings of every stress step.
+    #[serde(flatten)]
     pub stress: StressSettings,
     /// Default [`FormMethod::Nearest`].
     pub method: FormMethod,
@@ -144,6 +186,7 @@ pub type Progress<'a> = dyn FnMut(usize, f64) -> bool + 'a;
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct FormFindResult {
+    /// Why the loop stopped.
     pub termination: Termination,
     /// Final positions (heights moved; the plan too when ODT is on): without convergence, those
     /// of the lowest-ε∞ state reached.
@@ -174,6 +217,7 @@ pub struct FormFindResult {
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
+    /// Area-weighted RMS distance to the input surface / plan diagonal.
     pub l2: f64,
     /// The nearest method's objective: the RMS height change of the non-anchored vertices
     /// weighted by their plan area shares, over the plan bounding-box diagonal.
@@ -182,7 +226,9 @@ pub struct FormFindResult {
     pub max_change: f64,
     /// Seconds summed over iterations.
     pub stress_seconds: f64,
+    /// Seconds in height steps.
     pub shape_seconds: f64,
+    /// Seconds in all.
     pub total_seconds: f64,
 }
 
@@ -389,6 +435,35 @@ fn distances(problem: &Problem, positions: &[[f64; 3]]) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn terminations_read_as_sentences() {
+        let stalled = Termination::Stalled {
+            vertices: vec![4, 9],
+        };
+        assert_eq!(
+            stalled.to_string(),
+            "stalled: eps_inf stopped improving; vertices 4, 9 carry (almost) no stress (raise q_min)"
+        );
+        let many = Termination::Stalled {
+            vertices: (0..20).collect(),
+        };
+        assert!(many.to_string().contains("... (20 in all)"), "{many}");
+        for t in [
+            Termination::Converged,
+            Termination::MaxIterations,
+            Termination::Cancelled,
+            Termination::Infeasible {
+                constraint: "q_min".into(),
+            },
+            Termination::NumericalError {
+                what: "stress QP failed".into(),
+            },
+        ] {
+            let text = t.to_string();
+            assert!(!text.contains(['{', '[', '(']), "{text}");
+        }
+    }
 
     #[test]
     fn only_a_step_short_of_its_optimum_that_balances_worse_gives_way() {

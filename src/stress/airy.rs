@@ -24,6 +24,7 @@ pub enum HoleMode {
 }
 
 impl HoleMode {
+    /// The unknowns per hole: 1 (constant) or 3 (affine).
     pub fn width(self) -> usize {
         match self {
             HoleMode::Constant => 1,
@@ -43,7 +44,9 @@ pub struct AiryOperator {
     /// First column of the hole coefficients; hole h uses `width` columns from
     /// `hole_start + h * width`: (c, a_x, a_y) in frame coordinates.
     pub hole_start: usize,
+    /// Columns per hole: 1 (constant jumps) or 3 (affine).
     pub hole_width: usize,
+    /// The cuts that join the holes to the outer boundary, in the order made.
     pub cuts: Vec<HoleCut>,
     /// The cuts whose right faces contain face t, in increasing order:
     /// `face_cuts[face_cut_start[t]..face_cut_start[t + 1]]` (see `cuts_at_face`).
@@ -77,6 +80,7 @@ fn hole_basis(u: [f64; 2]) -> [f64; 3] {
 }
 
 impl AiryOperator {
+    /// The operator of `mesh` over `plan`, with hole jumps of `mode`.
     pub fn new(mesh: &Mesh, plan: &Plan, mode: HoleMode) -> Result<AiryOperator> {
         let n = mesh.positions.len();
         let gauge = gauge::pinned_vertices(mesh, plan);
@@ -124,6 +128,7 @@ impl AiryOperator {
         Ok(op)
     }
 
+    /// The number of unknowns (columns of S).
     #[cfg(any(test, feature = "internals"))]
     pub fn n_unknowns(&self) -> usize {
         self.s.ncols

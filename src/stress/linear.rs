@@ -4,8 +4,9 @@
 //! units, as the stress step of §8 sees them.
 
 use super::airy::AiryOperator;
+use super::attempts::{force_model, ForceMap};
+use super::framed::{boundary_normals, edge_bounds, horizontal_terms, non_anchored};
 use super::sparse::Csr;
-use super::{boundary_normals, edge_bounds, force_model, horizontal_terms, ForceMap};
 use super::{Formulation, StressSettings};
 use crate::error::Result;
 use crate::geometry::{Frame, Plan};
@@ -40,7 +41,7 @@ impl LinearStress {
         let normal = boundary_normals(mesh, &plan.u);
         let (external, _) = horizontal_terms(problem, settings, &normal, p_bar);
         let bounds = edge_bounds(problem, &plan, settings, unit);
-        let free: Vec<u32> = super::non_anchored(mesh);
+        let free: Vec<u32> = non_anchored(mesh);
         let (map, balance) = force_model(
             mesh,
             &plan,

@@ -31,10 +31,14 @@ pub enum TauMode {
 
 /// A force-density bound, either physical (force per length) or relative to the problem's
 /// natural scale p̄ / L₀ (mean load over non-anchored vertices / half the plan diagonal).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Serialised (in reports) as `{"absolute": v}` or `{"relative": v}`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum QBound {
+    /// Force per length, in the model's units.
     Absolute(f64),
+    /// A multiple of p̄ / L₀.
     Relative(f64),
 }
 
@@ -82,8 +86,9 @@ pub enum QpSolver {
 
 /// Settings of one stress step. The defaults are those of form finding
 /// (`FormFindSettings::default().stress`) and of the C API's `vsr_settings_create`, so that
-/// `analyse` and `vsr_analyse` give the same answer.
-#[derive(Debug, Clone, PartialEq)]
+/// `analyse` and `vsr_analyse` give the same answer. Serialised (in reports) with the names
+/// of Python's keyword settings.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[non_exhaustive]
 pub struct StressSettings {
     /// Lower bound on force densities (default: 0.05 p̄/L₀, `QBound::Relative(0.05)`, on all
@@ -93,10 +98,13 @@ pub struct StressSettings {
     pub q_min_scope: EdgeScope,
     /// Optional upper bound on force densities (allowable stress × thickness).
     pub q_max: Option<QBound>,
+    /// Normal stress at free boundary vertices (default optimised).
     pub tau: TauMode,
     /// How the Airy function may jump around a hole (default affine: the true optimum).
     pub holes: HoleMode,
+    /// How face weights become vertex loads (default barycentric).
     pub load_rule: LoadRule,
+    /// The formulation of the QP (default reduced).
     pub formulation: Formulation,
     /// Bounds (lo, hi) on the dual (force-diagram) edge length of interior edges, in units of
     /// the mean load p̄: lo ≤ q_e l_e / p̄ ≤ hi. A lower bound keeps every force-diagram edge
@@ -113,6 +121,8 @@ pub struct StressSettings {
     /// numerical failure (degenerate problems: straight free edges force q = 0) the
     /// step is repeated with ε × 100, up to twice, and the result says which ε was used.
     pub regularisation: f64,
+    /// The QP solver (default native).
+    #[serde(rename = "qp_solver")]
     pub solver: QpSolver,
 }
 

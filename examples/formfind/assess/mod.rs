@@ -22,7 +22,7 @@ fn solver_failure(e: voussoir::Error) -> Failure {
 /// Reads the envelope and load pattern, checks the outputs, runs, writes everything.
 pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<ExitCode, Failure> {
     let section = o.assess.section.unwrap_or_default();
-    pictures::section::check(&model.mesh, section).map_err(bad_input)?;
+    pictures::section::check(model.mesh(), section).map_err(bad_input)?;
     let envelope = run::envelope(&model, o).map_err(bad_input)?;
     let pattern = (o.assess.load_pattern.as_ref())
         .map(|p| run::load_pattern(&model, p))
@@ -40,7 +40,7 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
     .map_err(bad_input)?;
 
     let a = run::run(model, envelope, settings, o).map_err(solver_failure)?;
-    let report = report::build(o, &a);
+    let report = serde_json::to_value(report::build(o, &a)).map_err(failed)?;
     let pictures = pictures::assessment(&a, section);
     let outputs = Outputs {
         positions: &a.result.positions,
@@ -86,11 +86,10 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
 fn summary(a: &run::Assessed) {
     crate::print_model(&a.model);
     let r = &a.result;
-    let (termination, _) = report::termination(&r.termination);
     say!(
         "assessment {}: {} after {} iterations, {:.2} s",
         r.objective.as_str(),
-        termination.replace('_', " "),
+        r.termination.name().replace('_', " "),
         r.iterations,
         r.seconds
     );

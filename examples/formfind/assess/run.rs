@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use serde_json::Value;
-use voussoir::{assess, io, AssessResult, AssessSettings, Envelope, Objective, Problem};
+use voussoir::{assess, io, AssessResult, AssessSettings, Envelope, Objective};
 
 use crate::args::Options;
 use crate::model::Model;
@@ -56,7 +56,7 @@ fn surface(flag: &str, path: &Path, up: UpAxis) -> Result<Surface, String> {
 pub fn envelope(model: &Model, o: &Options) -> Result<Envelope, String> {
     let a = &o.assess;
     if let Some(thickness) = crate::assess::args::thickness(o) {
-        return Envelope::from_thickness(&model.mesh, &thickness)
+        return Envelope::from_thickness(model.mesh(), &thickness)
             .map_err(|e| message(&e, "--thickness"));
     }
     let (Some(intrados), Some(extrados)) = (&a.intrados, &a.extrados) else {
@@ -64,7 +64,7 @@ pub fn envelope(model: &Model, o: &Options) -> Result<Envelope, String> {
     };
     let lower = surface("--intrados", intrados, o.up)?;
     let upper = surface("--extrados", extrados, o.up)?;
-    Envelope::from_surfaces(&model.mesh, (&lower.0, &lower.1), (&upper.0, &upper.1))
+    Envelope::from_surfaces(model.mesh(), (&lower.0, &lower.1), (&upper.0, &upper.1))
         .map_err(|e| message(&e, "--intrados"))
 }
 
@@ -113,8 +113,8 @@ fn pattern_entries(text: &str, n_input: usize) -> Result<Vec<(usize, f64)>, Stri
 pub fn load_pattern(model: &Model, path: &Path) -> Result<Vec<f64>, String> {
     let fail = |e: String| format!("--load-pattern: {}: {e}", path.display());
     let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
-    let n = model.mesh.n_vertices();
-    let welded = &model.welded_ids;
+    let n = model.mesh().n_vertices();
+    let welded = &model.read.welded_ids;
     let mut loads = vec![0.0; n];
     for (v, x) in pattern_entries(&text, welded.len()).map_err(fail)? {
         loads[welded[v] as usize] += x;
@@ -153,7 +153,7 @@ pub fn run(
     settings: AssessSettings,
     o: &Options,
 ) -> Result<Assessed, voussoir::Error> {
-    let problem = Problem::new(model.mesh.clone()).with_polygon_diagonals(&model.diagonals)?;
+    let problem = model.read.problem.clone();
     let bar = crate::run::progress_bar(settings.max_iterations, "assessment", "infeasibility");
     let mut report = |k: usize, infeasibility: f64| {
         if let Some(bar) = &bar {

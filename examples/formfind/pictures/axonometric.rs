@@ -166,7 +166,7 @@ fn face_change(mesh: &Mesh, before: &[V3], after: &[V3]) -> Vec<f64> {
 /// The input and (after form finding) the form-found shape, seen from [`AZIMUTH_DEG`] and
 /// [`ELEVATION_DEG`]; faces coloured by the height change (neutral without form finding).
 pub fn shape_3d(o: &Outcome) -> Document {
-    let mesh = &o.model.mesh;
+    let mesh = o.model.mesh();
     let projection = Projection::new();
     let mut panels = vec![("input", &mesh.positions)];
     if o.termination.is_some() {

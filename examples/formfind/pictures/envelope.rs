@@ -20,7 +20,7 @@ const VEIL: f64 = 0.3;
 /// at the extrados (outside [0, 1] where the surface leaves the envelope).
 pub fn depth_in_masonry(a: &Assessed) -> Vec<f64> {
     let r = &a.result;
-    (a.model.mesh.faces.iter())
+    (a.model.mesh().faces.iter())
         .map(|f| {
             f.iter()
                 .map(|&v| {
@@ -39,7 +39,7 @@ pub fn depth_in_masonry(a: &Assessed) -> Vec<f64> {
 }
 
 pub fn shape_3d(a: &Assessed) -> Document {
-    let mesh = &a.model.mesh;
+    let mesh = a.model.mesh();
     let projection = Projection::new();
     let middle = a.envelope.middle_positions(mesh);
     let extrados: Vec<[f64; 3]> = (mesh.positions.iter().zip(&a.envelope.upper))

@@ -183,7 +183,7 @@ fn supports(mesh: &Mesh, segments: &[[Station; 2]], z: &[f64], view: &View) -> G
 /// (a hinge), within 1e-6 of the plan diagonal.
 fn contacts(a: &Assessed, segments: &[[Station; 2]], z: &[f64], view: &View) -> Group {
     let r = &a.result;
-    let (lo, hi) = plan_box(&a.model.mesh, &r.positions);
+    let (lo, hi) = plan_box(a.model.mesh(), &r.positions);
     let slack = 1e-6 * (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
     let mut g = Group::new().set("id", "contacts");
     let mut seen: Vec<f64> = Vec::new();
@@ -211,7 +211,7 @@ fn contacts(a: &Assessed, segments: &[[Station; 2]], z: &[f64], view: &View) -> 
 
 /// The section picture of an assessment.
 pub fn section(a: &Assessed, section: Section) -> Document {
-    let mesh = &a.model.mesh;
+    let mesh = a.model.mesh();
     let r = &a.result;
     let at = position(mesh, section);
     let segments = cut(mesh, section.axis, at);

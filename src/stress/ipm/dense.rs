@@ -14,7 +14,6 @@
 //! rounding where M_s is nearly singular along M_s⁻¹ aᵀ, the refinement against the exact
 //! system recovers.
 
-use super::pattern::Pattern;
 use crate::stress::sparse::{bucketed, Csr};
 
 /// A row is dense beyond max(`DENSE_FROM`, `DENSE_SQRT` √n) entries (n unknowns): below, its
@@ -151,7 +150,7 @@ impl DenseRows {
         // Each column's new rows (n + k, k increasing) come after its old ones (all < n):
         // rows stay sorted.
         let (ptr, idx) = bucketed(n_factor, nnz, || {
-            super::pattern::entries(&col_ptr, &row_idx)
+            super::graph::entries(&col_ptr, &row_idx)
                 .map(|(r, c)| (c, r))
                 .chain(couplings())
                 .chain(diagonals.clone())
@@ -178,11 +177,17 @@ pub(super) struct DenseQuad {
 }
 
 impl DenseQuad {
-    pub(super) fn new(pattern: &Pattern, quad: &Csr, quad_weight: &[f64]) -> DenseQuad {
-        let rows = (pattern.dense.rows.iter())
+    /// The split rows of `dense` that are rows of P, their columns relabelled by `label`.
+    pub(super) fn new(
+        dense: &DenseRows,
+        label: &[usize],
+        quad: &Csr,
+        quad_weight: &[f64],
+    ) -> DenseQuad {
+        let rows = (dense.rows.iter())
             .filter(|(source, _)| *source == Source::Quad)
             .map(|&(_, r)| {
-                let entries = quad.row(r).map(|(c, v)| (pattern.label[c], v)).collect();
+                let entries = quad.row(r).map(|(c, v)| (label[c], v)).collect();
                 (quad_weight[r], entries)
             })
             .collect();
@@ -209,12 +214,11 @@ impl DenseQuad {
 /// couple by their entries; their diagonals, −1/w with the step's weight, are set per
 /// Newton system.
 pub(super) fn fill_couplings(
-    pattern: &Pattern,
+    dense: &DenseRows,
     (quad, quad_weight): (&Csr, &[f64]),
     cons: &Csr,
     values: &mut [f64],
 ) {
-    let dense = &pattern.dense;
     for (k, row) in dense.entries(quad, cons) {
         let (source, r) = dense.rows[k];
         let w = if source == Source::Quad {

@@ -2,8 +2,12 @@
 //! iterations still make progress.
 
 use super::pattern::Normal;
-use super::polish::{POLISH_FEAS, POLISH_GAP};
 use super::{abs_mul_t, abs_row_norm, dot, inf_norm, mul_t, Qp, Tolerances};
+
+/// When `Kkt::near` holds, so that polishing may guess the active set: residuals within this
+/// many times the tolerance, relative gap below `POLISH_GAP`.
+const POLISH_FEAS: f64 = 1e3;
+const POLISH_GAP: f64 = 1e-5;
 
 /// The residuals of the KKT conditions at a point, each with the size of the terms that make
 /// it up (a backward error: at the optimum E x ≈ f is often 0 while its terms are not).

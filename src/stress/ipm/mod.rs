@@ -29,6 +29,7 @@ use super::sparse::Csr;
 mod dense;
 mod factorise;
 mod gmres;
+mod graph;
 mod kkt;
 mod newton;
 mod ordering;

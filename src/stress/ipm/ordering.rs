@@ -9,7 +9,7 @@
 //! separator, ordered after both sides. Parts of up to `LEAF` unknowns are ordered by minimum
 //! degree, counting their couplings to the separators around them.
 
-use super::pattern::{amd_labels, entries};
+use super::graph::{amd_labels, entries};
 use crate::stress::sparse::bucketed;
 
 /// Parts of up to this many unknowns are ordered by minimum degree (`order_leaf`): the leaf

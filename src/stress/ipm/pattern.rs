@@ -4,14 +4,14 @@
 
 use super::dense::{fill_couplings, DenseQuad, DenseRows, Source};
 use super::factorise::Plan;
+use super::graph::{amd_labels, entries};
 use super::ordering::nested_dissection_labels;
 use super::supernodal::Split;
 use crate::stress::sparse::{bucketed, Csr};
-use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
-use faer::sparse::linalg::{amd, SupernodalThreshold};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::SymbolicSparseColMatRef;
 
 /// The structure of the normal matrix P + Cᵀ W C (lower triangle, compressed columns): its
@@ -212,22 +212,6 @@ pub(super) fn product_slots(
 /// threads still factor it well.
 const DISSECT_FROM: usize = 40_000;
 
-/// The new label of every unknown in the approximate-minimum-degree order of a symmetric
-/// pattern (its lower triangle, rows sorted in each column).
-pub(super) fn amd_labels(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Option<Vec<usize>> {
-    let (mut order, mut label) = (vec![0; n], vec![0; n]);
-    let mut buffer = MemBuffer::try_new(amd::order_scratch::<usize>(n, row_idx.len())).ok()?;
-    amd::order(
-        &mut order,
-        &mut label,
-        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
-        amd::Control::default(),
-        MemStack::new(&mut buffer),
-    )
-    .ok()?;
-    Some(label)
-}
-
 /// The lower triangle of a symmetric pattern (given by its lower triangle) with its unknowns
 /// relabelled, rows sorted in each column.
 pub(super) fn relabelled_lower(
@@ -256,18 +240,6 @@ pub(super) fn transpose(
     row_idx: &[usize],
 ) -> (Vec<usize>, Vec<usize>) {
     bucketed(n, row_idx.len(), || entries(col_ptr, row_idx))
-}
-
-/// The (row, column) entries of a compressed-column pattern, column by column.
-pub(super) fn entries<'a>(
-    col_ptr: &'a [usize],
-    row_idx: &'a [usize],
-) -> impl Iterator<Item = (usize, usize)> + 'a {
-    (0..col_ptr.len() - 1).flat_map(move |c| {
-        row_idx[col_ptr[c]..col_ptr[c + 1]]
-            .iter()
-            .map(move |&r| (r, c))
-    })
 }
 
 /// The symbolic factorisation of a pattern already in its elimination order (given as an
@@ -387,7 +359,7 @@ impl<'p> Normal<'p> {
         for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(kept) {
             p_values[slot] += quad_weight[r] * va * vb;
         }
-        fill_couplings(pattern, (quad, quad_weight), cons, &mut p_values);
+        fill_couplings(&pattern.dense, (quad, quad_weight), cons, &mut p_values);
         let mut row_prod = Vec::with_capacity(pattern.row_slot.len());
         row_prod.extend(
             products_of(cons, |r| !pattern.dense.is_split(Source::Cons, r))
@@ -397,7 +369,7 @@ impl<'p> Normal<'p> {
             pattern,
             p_values,
             row_prod,
-            dense_quad: DenseQuad::new(pattern, quad, quad_weight),
+            dense_quad: DenseQuad::new(&pattern.dense, &pattern.label, quad, quad_weight),
         }
     }
 

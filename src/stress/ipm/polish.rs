@@ -7,11 +7,6 @@ use super::pattern::Normal;
 use super::{mul_t, Qp, Tolerances};
 use crate::stress::sparse::Csr;
 
-/// When `Kkt::near` holds: residuals within this many times the tolerance, relative gap
-/// below `POLISH_GAP`.
-pub(super) const POLISH_FEAS: f64 = 1e3;
-pub(super) const POLISH_GAP: f64 = 1e-5;
-
 /// The iterate polishing starts from (its slacks only enter through the active-set guess).
 #[derive(Clone, Copy)]
 pub(super) struct Point<'a> {

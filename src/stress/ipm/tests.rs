@@ -1,8 +1,9 @@
+use super::graph::amd_labels;
 use super::kkt::{Progress, STALL_WINDOW};
 use super::newton::{FactorSpace, Newton};
 use super::pattern::{
-    amd_labels, product_pattern, products, relabel_vector, relabelled_lower, stacked,
-    symbolic_cholesky, transpose, Normal, Pattern, PatternCache,
+    product_pattern, products, relabel_vector, relabelled_lower, stacked, symbolic_cholesky,
+    transpose, Normal, Pattern, PatternCache,
 };
 use super::polish::{
     active_guess, polish, polish_step, Corrections, Hopeless, Point, PolishFailure, PolishFrom,

@@ -1,0 +1,302 @@
+//! The attempts of a stress step: the native solver, then clarabel on the reduced QP plain
+//! and lifted, with a larger ε, then the edge-based formulation, until one answer is final.
+
+use super::airy::{self, AiryOperator};
+use super::cache::{PlanKey, Prior, StressCache};
+use super::framed::FramedStep;
+use super::sparse::Csr;
+use super::{ipm, qp, Formulation, QpSolver, StressSettings, StressStatus};
+use crate::error::Result;
+use crate::geometry::Plan;
+use crate::mesh::Mesh;
+use crate::problem::Problem;
+use Formulation::{EdgeBased, Reduced};
+
+/// The attempts of a stress step in order: (solver, formulation, lifted, factor on ε).
+///
+/// The native solver goes first. Interior-point methods can fail on degenerate problems
+/// (straight free edges force q = 0: no strictly feasible point), and only clarabel
+/// certifies infeasibility, so when it does not converge clarabel takes over: the plain
+/// reduced QP is fastest; the lifted one (q as variables) copes with problems where the
+/// plain one reaches only reduced accuracy. Then ε is raised, then the edge-based
+/// formulation (same optimum) is used; the result says which solver, formulation and ε.
+pub(super) fn attempt_list(
+    settings: &StressSettings,
+    lifted_first: bool,
+    native: Formulation,
+) -> Vec<(QpSolver, Formulation, bool, f64)> {
+    use QpSolver::{Clarabel, Native};
+    let (a, b) = (lifted_first, !lifted_first);
+    let mut attempts: Vec<(QpSolver, Formulation, bool, f64)> = Vec::new();
+    if settings.solver == Native {
+        attempts.push((Native, native, false, 1.0));
+    }
+    match settings.formulation {
+        Reduced => attempts.extend_from_slice(&[
+            (Clarabel, Reduced, a, 1.0),
+            (Clarabel, Reduced, b, 1.0),
+            (Clarabel, Reduced, a, 100.0),
+            (Clarabel, Reduced, b, 100.0),
+            (Clarabel, EdgeBased, false, 1.0),
+            (Clarabel, EdgeBased, false, 100.0),
+        ]),
+        EdgeBased => attempts.extend_from_slice(&[
+            (Clarabel, EdgeBased, false, 1.0),
+            (Clarabel, EdgeBased, false, 100.0),
+            (Clarabel, EdgeBased, false, 1e4),
+        ]),
+    }
+    attempts
+}
+
+/// A vertex with more edges than this is a hub (a fan's centre, a UV sphere's pole): see
+/// `native_formulation`.
+const HUB_EDGES: usize = 64;
+
+/// The formulation of the native attempt: the requested one, except that the reduced QP of a
+/// mesh with a hub is solved in the edge-based form, which has the same optimum (§9 of
+/// docs/method.md; with constant hole jumps only where there are no holes). A hub's thin
+/// fan of faces makes the Airy values' map to force densities ill-conditioned (its cotangents
+/// grow with the fan's size) and the bounds of the edges around it dependent when all are
+/// active: on a wheel of 1000 spokes the interior-point iterations stalled short of the
+/// tolerances, while in the edge-based form each bound is a force density of its own.
+fn native_formulation(mesh: &Mesh, settings: &StressSettings) -> Formulation {
+    let same_optimum = settings.holes == airy::HoleMode::Affine || mesh.holes().next().is_none();
+    let hub = (0..mesh.positions.len()).any(|v| mesh.edges_at(v).len() > HUB_EDGES);
+    if settings.formulation == Reduced && same_optimum && hub {
+        EdgeBased
+    } else {
+        settings.formulation
+    }
+}
+
+/// The index of a formulation's force model in `Attempts::models`.
+pub(super) fn slot(f: Formulation) -> usize {
+    (f == EdgeBased) as usize
+}
+
+/// What the attempts of a stress step leave: the best answer, the force models built (index
+/// `slot`), and the key of the reduced operator taken from the cache, if one was.
+pub(super) struct Attempts {
+    pub(super) best: Attempt,
+    pub(super) models: [Option<ForceModel>; 2],
+    pub(super) kept_key: Option<PlanKey>,
+}
+
+/// Runs the attempts of `attempt_list` until one is final (`attempt_is_final`), building
+/// each formulation's force model at most once, and keeps the best answer.
+pub(super) fn run_attempts(
+    problem: &Problem,
+    step: &FramedStep,
+    settings: &StressSettings,
+    prior: Option<Prior>,
+    cache: &mut StressCache,
+) -> Result<Attempts> {
+    use QpSolver::{Clarabel, Native};
+    let mesh = &problem.mesh;
+    let plan = &step.plan;
+    let native = native_formulation(mesh, settings);
+    let attempts = attempt_list(settings, prior.is_some_and(|p| p.lifted_first), native);
+    let base = prior.map_or(settings.regularisation, |p| p.weight);
+    let prior_frame: Option<Vec<f64>> =
+        prior.map(|p| p.force_densities.iter().map(|q| q / step.unit).collect());
+    let mut models: [Option<ForceModel>; 2] = [None, None];
+    let mut best: Option<Attempt> = None;
+    let mut clarabel_tries = 0;
+    // The key of a kept reduced operator, stored back with it after the step.
+    let mut kept_key = None;
+    for &(solver, formulation, lift_forces, factor) in &attempts {
+        if models[slot(formulation)].is_none() {
+            let kept = (cache.reduced.take())
+                .filter(|(key, _)| formulation == Reduced && key.fits(mesh, plan, settings.holes))
+                .map(|(key, op)| {
+                    kept_key = Some(key);
+                    op
+                });
+            models[slot(formulation)] = Some(force_model(
+                mesh,
+                plan,
+                settings.holes,
+                formulation,
+                &step.bounds,
+                &step.free,
+                kept,
+            )?);
+        }
+        let (map, balance) = models[slot(formulation)].as_ref().expect("built above");
+        let s = map.s();
+        let regularisation = (base * factor).max(if factor > 1.0 { 1e-12 } else { 0.0 });
+        let input = qp::QpInput {
+            s,
+            edges: &step.edges,
+            length: &plan.length,
+            u: &plan.u,
+            z: &step.z,
+            residual_vertices: &step.free,
+            load: &step.p,
+            balance_vertices: balance,
+            external: &step.external,
+            tau_normal: &step.tau_normal,
+            bounds: &step.bounds,
+            regularisation,
+            prior: prior_frame.as_deref(),
+            smoothing_pairs: &step.smoothing_pairs,
+            smoothing: settings.dual_length_smoothing,
+            lift_forces,
+        };
+        let out = match solver {
+            Native => qp::solve_native(&input, &mut cache.normal, cache.coarse, cache.inexact),
+            Clarabel => {
+                clarabel_tries += 1;
+                qp::solve_clarabel(&input)
+            }
+        };
+        let status = out.status;
+        let n_unknowns = out.y.len();
+        if best
+            .as_ref()
+            .is_none_or(|b| status.rank() < b.out.status.rank())
+        {
+            best = Some(Attempt {
+                solver,
+                formulation,
+                lifted: lift_forces,
+                out,
+                regularisation,
+            });
+        }
+        if attempt_is_final(solver, status, n_unknowns, clarabel_tries) {
+            break;
+        }
+    }
+    Ok(Attempts {
+        best: best.expect("at least one attempt"),
+        models,
+        kept_key,
+    })
+}
+
+/// One solve of the stress QP: the formulation, the outcome and ε.
+pub(super) struct Attempt {
+    pub(super) solver: QpSolver,
+    pub(super) formulation: Formulation,
+    pub(super) lifted: bool,
+    pub(super) out: qp::QpOutput,
+    pub(super) regularisation: f64,
+}
+
+/// The force map q = S y of a formulation: the reduced operator, whose S it is, or the
+/// edge-based selection of the edges that carry force.
+pub(super) enum ForceMap {
+    Airy(AiryOperator),
+    Selection(Csr),
+}
+
+impl ForceMap {
+    pub(super) fn s(&self) -> &Csr {
+        match self {
+            ForceMap::Airy(op) => &op.s,
+            ForceMap::Selection(s) => s,
+        }
+    }
+
+    pub(super) fn airy(self) -> Option<AiryOperator> {
+        match self {
+            ForceMap::Airy(op) => Some(op),
+            ForceMap::Selection(_) => None,
+        }
+    }
+}
+
+/// A formulation's force map and the vertices that need explicit horizontal balance rows.
+pub(super) type ForceModel = (ForceMap, Vec<u32>);
+
+pub(super) fn force_model(
+    mesh: &Mesh,
+    plan: &Plan,
+    holes: airy::HoleMode,
+    formulation: Formulation,
+    bounds: &[Option<(f64, f64)>],
+    free: &[u32],
+    kept: Option<AiryOperator>,
+) -> Result<ForceModel> {
+    Ok(match formulation {
+        Formulation::Reduced => {
+            let op = match kept {
+                Some(op) => op,
+                None => AiryOperator::new(mesh, plan, holes)?,
+            };
+            let balance = free
+                .iter()
+                .copied()
+                .filter(|&v| mesh.on_boundary[v as usize])
+                .collect();
+            (ForceMap::Airy(op), balance)
+        }
+        Formulation::EdgeBased => {
+            let mut s = Csr::new(bounds.iter().flatten().count());
+            let mut col = 0;
+            for b in bounds {
+                s.push_row(if b.is_some() {
+                    vec![(col, 1.0)]
+                } else {
+                    Vec::new()
+                });
+                col += b.is_some() as usize;
+            }
+            // Interior point supports take vertical reactions only (docs/method.md §6).
+            let balance = (0..mesh.positions.len())
+                .filter(|&v| mesh.referenced[v] && (!mesh.anchored[v] || !mesh.on_boundary[v]))
+                .map(|v| v as u32)
+                .collect();
+            (ForceMap::Selection(s), balance)
+        }
+    })
+}
+
+/// Whether an attempt's answer ends the list of attempts in `analyse_cached`.
+/// - Native: only a converged answer stands (at reduced accuracy it can sit at a point that
+///   is not optimal), except on large problems, where the fallback would take many minutes:
+///   there an answer at reduced accuracy, at the iteration limit or where the iterations
+///   stalled is kept and reported as such.
+/// - Clarabel solved or infeasible: done. Reduced accuracy: one more try with the other form
+///   of the same problem, then keep the better. Numerical failure: go down the list.
+pub(super) fn attempt_is_final(
+    solver: QpSolver,
+    status: StressStatus,
+    n_unknowns: usize,
+    clarabel_tries: usize,
+) -> bool {
+    use QpSolver::Native;
+    match (solver, status) {
+        (Native, StressStatus::AlmostSolved | StressStatus::MaxIterations) => {
+            ipm::fallback_is_costly(n_unknowns)
+        }
+        (Native, s) => s == StressStatus::Solved,
+        (_, StressStatus::Solved | StressStatus::Infeasible) => true,
+        (_, StressStatus::AlmostSolved | StressStatus::MaxIterations) => clarabel_tries >= 2,
+        (_, StressStatus::NumericalError) => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn large_native_answers_short_of_the_optimum_are_kept() {
+        use QpSolver::{Clarabel, Native};
+        use StressStatus::*;
+        let (small, large) = (5_000, 100_000);
+        for status in [AlmostSolved, MaxIterations] {
+            assert!(!attempt_is_final(Native, status, small, 0));
+            assert!(attempt_is_final(Native, status, large, 0));
+            assert!(!attempt_is_final(Clarabel, status, large, 1));
+            assert!(attempt_is_final(Clarabel, status, large, 2));
+        }
+        // Only clarabel certifies infeasibility: a failed native solve falls back at any size.
+        assert!(!attempt_is_final(Native, NumericalError, large, 0));
+        assert!(attempt_is_final(Native, Solved, small, 0));
+        assert!(attempt_is_final(Clarabel, Infeasible, large, 1));
+    }
+}
