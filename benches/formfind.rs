@@ -4,6 +4,7 @@
 //!     cargo bench --bench formfind -- --known       # known-answer cases only
 //!     cargo bench --bench formfind -- --models      # shared models only
 //!     cargo bench --bench formfind -- --seeds 5     # more seeds per known-answer case
+//!     cargo bench --bench formfind -- --large       # also the 97k-vertex dome
 //!
 //! Known-answer cases: a self-supporting vault (the truth, `generate::self_supporting`) is
 //! perturbed (`generate::perturb`); the truth is a feasible answer for the perturbed input, so
@@ -13,7 +14,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 use voussoir::generate::{self, KnownPlan, Perturbation};
-use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem};
+use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem, QpSolver};
 
 /// Area-weighted RMS and largest height difference between two position sets of `mesh`,
 /// non-anchored vertices only (plan area shares as weights), computed here independently of
@@ -120,49 +121,109 @@ fn plan_diagonal(mesh: &Mesh) -> f64 {
     (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }
 
-fn models() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if !dir.is_dir() {
-        println!("\nshared models: {} not found", dir.display());
-        return;
+/// Runs of the cold stress step timed for its median: at least `MIN_RUNS`, then more until
+/// they add up to a second or number `MAX_RUNS` (one run when it takes a second or more).
+const MIN_RUNS: usize = 5;
+const MAX_RUNS: usize = 21;
+
+/// One cold stress step of the input (default stress settings, no cache): median seconds and
+/// the QP iterations of the last run.
+fn cold_step(problem: &Problem) -> (f64, u32) {
+    let settings = FormFindSettings::default().stress;
+    let mut seconds = Vec::new();
+    loop {
+        let t = Instant::now();
+        let r = voussoir::analyse(problem, &settings).expect("valid problem");
+        seconds.push(t.elapsed().as_secs_f64());
+        let total: f64 = seconds.iter().sum();
+        let enough = seconds.len() >= MIN_RUNS && (total >= 1.0 || seconds.len() == MAX_RUNS);
+        if enough || seconds[0] >= 1.0 {
+            seconds.sort_by(f64::total_cmp);
+            return (seconds[seconds.len() / 2], r.iterations);
+        }
     }
-    println!("\nShared models, default settings (distances over the plan diagonal)\n");
-    println!("| model | V | method | end | steps | s | Hausdorff | L2 | RMS change | max change |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
-    for name in [
-        "free_vault",
-        "dome_with_doors",
-        "lilium",
-        "cheese",
-        "four_holes",
-        "neumunster",
-        "hex",
-        "three_pillar",
-        "vault_pq",
-    ] {
-        let problem = voussoir::io::load_model(
-            &dir.join(format!("{name}.obj")),
-            &dir.join(format!("{name}.json")),
-        )
-        .expect("model");
+}
+
+/// "n native, m clarabel" over the stress steps of a form finding.
+fn solver_counts(r: &FormFindResult) -> String {
+    let native = r.solvers.iter().filter(|s| **s == QpSolver::Native).count();
+    let other = r.solvers.len() - native;
+    if other == 0 {
+        format!("{native} native")
+    } else {
+        format!("{native} native, {other} clarabel")
+    }
+}
+
+/// The models of the form-finding table: the shared ones (when found), the generated
+/// Cas-size stand-in and, with `--large`, the 97k-vertex dome.
+fn model_list(large: bool) -> Vec<(String, Problem)> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
+    let mut list = Vec::new();
+    if dir.is_dir() {
+        for name in SHARED {
+            let problem = voussoir::io::load_model(
+                &dir.join(format!("{name}.obj")),
+                &dir.join(format!("{name}.json")),
+            )
+            .expect("model");
+            list.push((name.to_string(), problem));
+        }
+    } else {
+        println!("\nshared models: {} not found", dir.display());
+    }
+    let mut generated = vec![5951];
+    if large {
+        generated.push(100_000);
+    }
+    for n in generated {
+        let mesh = generate::dome_with_hole(n).expect("dome");
+        let name = format!("gen. dome_with_hole {}", mesh.positions.len());
+        list.push((name, Problem::new(mesh)));
+    }
+    list
+}
+
+const SHARED: [&str; 9] = [
+    "free_vault",
+    "dome_with_doors",
+    "lilium",
+    "cheese",
+    "four_holes",
+    "neumunster",
+    "hex",
+    "three_pillar",
+    "vault_pq",
+];
+
+fn models(large: bool) {
+    println!("\nForm finding, default settings (distances over the plan diagonal; \"/ cold\": the form finding's time over one cold stress step of the input)\n");
+    println!("| model | V | cold step s (QP its) | method | end | steps | QP its | from last answer | solvers | s | / cold | Hausdorff | L2 | RMS change | max change |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for (name, problem) in model_list(large) {
+        let (cold, cold_its) = cold_step(&problem);
         for method in [FormMethod::Nearest, FormMethod::Paper] {
             let s = FormFindSettings::default().with_method(method);
             let t = Instant::now();
             let r = form_find(&problem, &s, None).expect("form finding");
+            let secs = t.elapsed().as_secs_f64();
+            let its: u32 = r.qp_iterations.iter().sum();
+            let warm = r.qp_iterations.iter().filter(|&&k| k == 0).count();
             println!(
-                "| {name} | {} | {} | {} | {} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                "| {name} | {} | {cold:.4} ({cold_its}) | {} | {} | {} | {its} | {warm} | {} | {secs:.2} | {:.1} | {:.4} | {:.4} | {:.4} | {:.4} |",
                 problem.mesh.positions.len(),
                 method_name(method),
                 outcome(&r),
                 r.iterations,
-                t.elapsed().as_secs_f64(),
+                solver_counts(&r),
+                secs / cold,
                 r.hausdorff,
                 r.l2,
                 r.rms_change,
                 r.max_change,
             );
             if name == "lilium" {
-                println!("|   lilium | | | normalised Hausdorff {:.4} (the paper: 0.04975) | | | | | | |", r.hausdorff);
+                println!("|   lilium | | | | normalised Hausdorff {:.4} (the paper: 0.04975) | | | | | | | | | | |", r.hausdorff);
             }
         }
     }
@@ -182,6 +243,6 @@ fn main() {
         known(seeds, &[400, 1500]);
     }
     if !only_known {
-        models();
+        models(has("--large"));
     }
 }

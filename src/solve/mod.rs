@@ -210,6 +210,10 @@ pub struct FormFindResult {
     /// native method did not converge (see `QpSolver::Native`); also for a step whose answer
     /// gave way to the forces at hand (see `history`).
     pub solvers: Vec<QpSolver>,
+    /// The QP iterations of each stress step (interior-point iterations of the answering
+    /// solver; 0 where the native solver reached the optimum from the previous step's answer
+    /// alone), in the order of `solvers`.
+    pub qp_iterations: Vec<u32>,
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
     pub hausdorff: f64,
@@ -271,6 +275,7 @@ struct Run {
     termination: Termination,
     iterations: usize,
     solvers: Vec<QpSolver>,
+    qp_iterations: Vec<u32>,
     positions: Vec<[f64; 3]>,
     stress: StressResult,
     history: Vec<f64>,
@@ -286,6 +291,7 @@ fn finish(problem: &Problem, run: Run, start: Instant) -> FormFindResult {
         termination: run.termination,
         iterations: run.iterations,
         solvers: run.solvers,
+        qp_iterations: run.qp_iterations,
         positions: run.positions,
         stress: run.stress,
         history: run.history,

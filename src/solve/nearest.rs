@@ -51,6 +51,9 @@ const RESIDUAL_FACTOR: f64 = 0.5;
 const SETTLED: f64 = 1e-3;
 /// What blocks a loop whose heights reached the limit, where q_max does not.
 const LIMIT_HINT: &str = "the shape cannot stand within the height limit (raise max_height_change)";
+/// The loosest relative gap of an inexact stress QP (see `Nearest::inexact_gap`).
+const INEXACT_GAP_MAX: f64 = 1e-4;
+
 /// Stalling is judged only once w has grown by this factor from its start: before, the pull
 /// to the input may hold ε∞ up on purpose (rounds that still lower L also count as progress).
 const STALL_AFTER_GROWTH: f64 = 1e3;
@@ -87,6 +90,7 @@ pub(super) fn nearest(
             termination,
             iterations: state.iterations,
             solvers: state.solvers,
+            qp_iterations: state.qp_iterations,
             positions,
             stress,
             history: state.history,
@@ -128,6 +132,9 @@ struct Nearest<'a, 'p> {
     w: f64,
     /// The lowest-E state in equilibrium (ε∞ < tolerance) reached.
     feasible: Option<Best>,
+    /// Whether the held forces come from a QP solved to its full tolerances (not loosened by
+    /// `Nearest::inexact_gap`).
+    exact: bool,
     /// Multipliers of the equilibrium rows (units of r̂), per row of `shape`.
     lambda: Vec<f64>,
     /// −p̄ √n λ / 2w per vertex, physical: the loads' shift in both steps.
@@ -135,6 +142,7 @@ struct Nearest<'a, 'p> {
     best: Best,
     history: Vec<f64>,
     solvers: Vec<QpSolver>,
+    qp_iterations: Vec<u32>,
     iterations: usize,
     stress_seconds: f64,
     shape_seconds: f64,
@@ -181,6 +189,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             held: placeholder(),
             w: 0.0,
             feasible: None,
+            exact: true,
             lambda: vec![0.0; n_rows],
             load_offset: vec![0.0; positions.len()],
             best: Best {
@@ -192,6 +201,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             positions,
             history: Vec::new(),
             solvers: Vec::new(),
+            qp_iterations: Vec::new(),
             iterations: 0,
             stress_seconds: 0.0,
             shape_seconds,
@@ -302,6 +312,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         };
         self.iterations += r.iterations;
         self.solvers.extend(&r.solvers);
+        self.qp_iterations.extend(&r.qp_iterations);
         self.history.extend(&r.history);
         self.stress_seconds += r.stress_seconds;
         self.shape_seconds += r.shape_seconds;
@@ -387,7 +398,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         }
         // An answer in equilibrium counts once its QP met the full tolerances, so that the
         // horizontal rows hold as tightly as an analysis's.
-        let solved = self.held.status == StressStatus::Solved;
+        let solved = self.held.status == StressStatus::Solved && self.exact;
         if !(solved && self.held.eps_inf < self.settings.tolerance) {
             return false;
         }
@@ -418,6 +429,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
         });
         self.cache
             .far_from_balance(held.is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
+        // Only where the merit judges a loosened answer (see below).
+        let judged = settings.dual_length_smoothing == 0.0;
+        self.cache
+            .set_inexact(held.filter(|_| judged).and_then(inexact_gap));
         let answer = analyse_cached(
             self.problem,
             &self.positions,
@@ -426,6 +441,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             &mut self.cache,
         )?;
         self.solvers.push(answer.solver);
+        self.qp_iterations.push(answer.iterations);
         // A solved answer is the optimum over the constraints at these heights (relative
         // bounds move with the loads), which the held forces may no longer meet.
         let short = self.cache.last_was_coarse()
@@ -441,7 +457,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
             {
                 h.clone()
             }
-            _ => answer,
+            _ => {
+                self.exact = !self.cache.last_was_inexact();
+                answer
+            }
         };
         self.iterations += 1;
         self.history.push(answer.eps_inf);
@@ -745,6 +764,19 @@ impl<'a, 'p> Nearest<'a, 'p> {
             })
             .collect()
     }
+}
+
+/// The relative gap at which a stress QP may stop, given the forces at hand certified at its
+/// heights (`held`): ε∞², at most `INEXACT_GAP_MAX`, where that is looser than the QP's
+/// own tolerance (an inexact Newton method's forcing term: a relative gap g leaves the
+/// residual vector within √(2g) of the optimum's, so the answer's residuals are right to about
+/// ε∞ of themselves). Far from balance the loop moves the shape anyway; near it the QPs are
+/// solved to their full tolerances, and only such answers count as states in equilibrium
+/// (`Nearest::record`). The smoothing-free loop judges every inexact answer by its merit
+/// (`Nearest::stress_step`).
+fn inexact_gap(held: &StressResult) -> Option<f64> {
+    let gap = held.eps_inf.powi(2).min(INEXACT_GAP_MAX);
+    gap.is_finite().then_some(gap)
 }
 
 /// Mean load over the rows (1 when zero, as the stress step's scale).

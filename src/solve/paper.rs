@@ -76,8 +76,7 @@ pub(super) fn paper_within(
     // Large QPs are solved to coarse optimality: the loop's answer is certified by its own
     // residuals, not by the QPs' optimality (see `StressCache::for_form_finding`).
     let mut cache = StressCache::for_form_finding();
-    let mut stress_steps = 0;
-    let mut solvers = Vec::new();
+    let (mut solvers, mut qp_iterations) = (Vec::new(), Vec::new());
     let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
         if k < settings.odt_iterations {
@@ -91,6 +90,7 @@ pub(super) fn paper_within(
         cache.far_from_balance(last.as_ref().is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         solvers.push(stress.solver);
+        qp_iterations.push(stress.iterations);
         let stress = keep_better(
             stress,
             last.take(),
@@ -99,7 +99,6 @@ pub(super) fn paper_within(
             k >= settings.odt_iterations,
         );
         stress_s += t.elapsed().as_secs_f64();
-        stress_steps += 1;
         history.push(stress.eps_inf);
         let status = stress.status;
         let eps = stress.eps_inf;
@@ -161,8 +160,9 @@ pub(super) fn paper_within(
         problem,
         Run {
             termination,
-            iterations: stress_steps,
+            iterations: solvers.len(),
             solvers,
+            qp_iterations,
             positions,
             stress,
             history,

@@ -145,7 +145,7 @@ pub(super) fn run_attempts(
             lift_forces,
         };
         let out = match solver {
-            Native => qp::solve_native(&input, &mut cache.normal, cache.coarse),
+            Native => qp::solve_native(&input, &mut cache.normal, cache.coarse, cache.inexact),
             Clarabel => {
                 clarabel_tries += 1;
                 qp::solve_clarabel(&input)

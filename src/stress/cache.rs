@@ -37,6 +37,10 @@ pub struct StressCache {
     pub(super) coarse: bool,
     /// Whether the last step's answer was solved to coarse optimality.
     pub(super) last_coarse: bool,
+    /// The relative gap the next native QPs may stop at (see `StressCache::set_inexact`).
+    pub(super) inexact: Option<f64>,
+    /// Whether the last step's answer was solved to that gap only.
+    pub(super) last_inexact: bool,
     /// Physical vertical loads added to those the QP balances (the nearest-shape method's
     /// multiplier shift); the result's residuals are still those of the true loads.
     pub(super) load_offset: Option<Vec<f64>>,
@@ -71,9 +75,25 @@ impl StressCache {
     }
 
     /// Whether the last step's answer is a native QP's solved to coarse optimality: short of
-    /// its optimum by design, as one at the iteration limit is by necessity.
+    /// its optimum by design (coarse beyond 20k unknowns, or inexact: see
+    /// [`StressCache::set_inexact`]), as one at the iteration limit is by necessity.
     pub fn last_was_coarse(&self) -> bool {
-        self.last_coarse
+        self.last_coarse || self.last_inexact
+    }
+
+    /// A relative gap at which the next native QPs may stop where it is looser than their
+    /// tolerances' (`None`: their own). The dual residual's tolerance is relaxed with it
+    /// (by the square root of the ratio); bounds and horizontal balance are held as tightly.
+    /// Form finding loosens early QPs, whose answers it judges by its own merit (a step
+    /// that does worse than the forces at hand is not taken), and solves them exactly once
+    /// the shape nears balance.
+    pub(crate) fn set_inexact(&mut self, gap: Option<f64>) {
+        self.inexact = gap;
+    }
+
+    /// Whether the last step's answer was solved to the looser gap of `set_inexact` only.
+    pub(crate) fn last_was_inexact(&self) -> bool {
+        self.last_inexact
     }
 }
 

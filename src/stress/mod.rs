@@ -189,6 +189,7 @@ pub fn analyse_cached(
         regularisation,
     } = best;
     cache.last_coarse = out.coarse;
+    cache.last_inexact = out.inexact;
     let (map, _) = models[slot(formulation_used)]
         .take()
         .expect("model of the attempt");

@@ -56,6 +56,8 @@ pub struct QpOutput {
     pub iterations: u32,
     /// Solved to coarse optimality (`ipm::Tolerances::for_form_finding` beyond 20k unknowns).
     pub coarse: bool,
+    /// Solved to a looser relative gap than the tolerances' (`solve_native`'s `inexact`).
+    pub inexact: bool,
 }
 
 struct Triplets {
@@ -347,6 +349,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
                 status: StressStatus::NumericalError,
                 iterations: 0,
                 coarse: false,
+                inexact: false,
             }
         }
     };
@@ -363,6 +366,7 @@ pub fn solve_clarabel(inp: &QpInput) -> QpOutput {
         status: StressStatus::from_clarabel(solver.solution.status),
         iterations: solver.solution.iterations,
         coarse: false,
+        inexact: false,
     }
 }
 
@@ -485,8 +489,15 @@ fn native_bound_rows(
 /// The fast path: the structured interior-point method of `ipm.rs` on x = (y, τ), with the
 /// residuals eliminated (‖G S y − p‖² expands into rows of the Hessian) so that the Newton
 /// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
-/// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns).
-pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) -> QpOutput {
+/// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns);
+/// `inexact`: a relative gap to stop at where it is looser than the tolerances' (see
+/// `ipm::Tolerances::inexact`).
+pub fn solve_native(
+    inp: &QpInput,
+    cache: &mut ipm::PatternCache,
+    coarse: bool,
+    inexact: Option<f64>,
+) -> QpOutput {
     let n_y = inp.s.ncols;
     let (tau_col, n_tau) = tau_columns(inp, n_y);
     let n = n_y + n_tau;
@@ -496,6 +507,15 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
     let (ineq, h, lower_row) = native_bound_rows(inp, &tau_col, n);
     let groups = balanced_stars(inp, &incident, &lower_row);
     let positions = unknown_positions(inp, &tau_col, n);
+    let tol = if coarse {
+        ipm::Tolerances::for_form_finding(n)
+    } else {
+        ipm::Tolerances::for_size(n)
+    };
+    let (tol, loosened) = match inexact {
+        Some(gap) if gap > tol.gap_rel => (tol.inexact(gap), true),
+        _ => (tol, false),
+    };
     let out = ipm::solve(
         &ipm::Qp {
             quad: &objective.quad,
@@ -510,11 +530,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
             positions: Some(&positions),
             slack_unit: Some(slack_unit(inp)),
         },
-        &if coarse {
-            ipm::Tolerances::for_form_finding(n)
-        } else {
-            ipm::Tolerances::for_size(n)
-        },
+        &tol,
         cache,
     );
     let tau = tau_col
@@ -532,6 +548,7 @@ pub fn solve_native(inp: &QpInput, cache: &mut ipm::PatternCache, coarse: bool) 
         },
         iterations: out.iterations,
         coarse: coarse && ipm::fallback_is_costly(n),
+        inexact: loosened && out.status == ipm::IpmStatus::Solved,
     }
 }
 

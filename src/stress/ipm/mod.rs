@@ -41,7 +41,7 @@ use kkt::{Kkt, Progress};
 use newton::{FactorSpace, Newton, REGULARISATION};
 pub use pattern::PatternCache;
 use pattern::{relabel_columns, relabel_vector, stacked, Normal};
-use polish::{active_guess, polish, Corrections, Point, PolishFailure, INEXACT_RETRY};
+use polish::{active_guess, polish, Corrections, Point, PolishFailure, Polished, INEXACT_RETRY};
 pub use row_groups::RowGroups;
 
 /// A QP in the form above.
@@ -87,6 +87,35 @@ pub struct IpmOutput {
     pub iterations: u32,
     /// Per inequality row, whether it is active at `x` (empty unless solved).
     pub active: Vec<bool>,
+    /// The multipliers of the equality and of the inequality rows at `x` (empty unless
+    /// solved).
+    pub lambda: Vec<f64>,
+    pub z: Vec<f64>,
+}
+
+impl IpmOutput {
+    /// An answer without multipliers or active set (not solved).
+    fn unsolved(x: Vec<f64>, status: IpmStatus, iterations: u32) -> IpmOutput {
+        IpmOutput {
+            x,
+            status,
+            iterations,
+            active: Vec::new(),
+            lambda: Vec::new(),
+            z: Vec::new(),
+        }
+    }
+
+    fn polished(p: Polished, iterations: u32) -> IpmOutput {
+        IpmOutput {
+            x: p.x,
+            status: IpmStatus::Solved,
+            iterations,
+            active: p.active,
+            lambda: p.lambda,
+            z: p.z,
+        }
+    }
 }
 
 /// Tolerances: the gap sᵀz must fall below `gap_abs + gap_rel |objective|`, the primal
@@ -132,6 +161,18 @@ impl Tolerances {
     /// horizontally as an exact one. A relative gap g leaves the residual vector within √(2g)
     /// (4.5%) of the optimum's in norm. There exact QPs are most of the loop's cost and their
     /// dual residual is what stalls.
+    /// These tolerances with the relative gap `gap` (looser than theirs) and the dual
+    /// residual's tolerance relaxed by √(gap / gap_rel), the bounds and equality rows held as
+    /// tightly: an inexact early QP of a form finding (see `StressCache::set_inexact`). A
+    /// relative gap g leaves the residual vector within √(2g) of the optimum's in norm.
+    pub fn inexact(self, gap: f64) -> Tolerances {
+        Tolerances {
+            gap_rel: gap,
+            dual_feas: self.dual_feas * (gap / self.gap_rel).sqrt().max(1.0),
+            ..self
+        }
+    }
+
     pub fn for_form_finding(n: usize) -> Tolerances {
         let exact = Tolerances::for_size(n);
         if !fallback_is_costly(n) {
@@ -303,9 +344,12 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
     let ri = unit_rows(qp.ineq, &d);
     let start_units = caller_units(&ri, qp.slack_unit);
     let skip_last = cache.far_from_balance && fallback_is_costly(n);
-    let warm = cache.last.take().filter(|_| !skip_last).map(|(x, active)| {
-        let x: Vec<f64> = x.iter().zip(&d).map(|(x, d)| x / d).collect();
-        (x, active)
+    // The last answer in these scaled units: x / d, the multipliers over the row scales.
+    let warm = cache.last.take().filter(|_| !skip_last).map(|w| WarmPoint {
+        x: w.x.iter().zip(&d).map(|(x, d)| x / d).collect(),
+        active: w.active,
+        lambda: w.lambda.iter().zip(&re).map(|(l, r)| l / r).collect(),
+        z: w.z.iter().zip(&ri).map(|(z, r)| z / r).collect(),
     });
     let quad = scaled(qp.quad, &d, &ones_q);
     let eq = scaled(qp.eq, &d, &re);
@@ -334,8 +378,15 @@ pub fn solve(qp: &Qp, tol: &Tolerances, cache: &mut PatternCache) -> IpmOutput {
         warm,
     );
     out.x.iter_mut().zip(&d).for_each(|(x, d)| *x *= d);
+    out.lambda.iter_mut().zip(&re).for_each(|(l, r)| *l *= r);
+    out.z.iter_mut().zip(&ri).for_each(|(z, r)| *z *= r);
     if out.status == IpmStatus::Solved {
-        cache.last = Some((out.x.clone(), out.active.clone()));
+        cache.last = Some(WarmPoint {
+            x: out.x.clone(),
+            active: out.active.clone(),
+            lambda: out.lambda.clone(),
+            z: out.z.clone(),
+        });
     }
     out
 }
@@ -345,31 +396,27 @@ fn solve_scaled(
     start_units: &[f64],
     tol: &Tolerances,
     cache: &mut PatternCache,
-    warm: Option<(Vec<f64>, Vec<bool>)>,
+    warm: Option<WarmPoint>,
 ) -> IpmOutput {
     let n = qp.c.len();
     let cons = stacked(qp.eq, qp.ineq);
     let Some((pattern, reused)) = cache.pattern(qp.quad, &cons, qp.eq.nrows(), qp.positions) else {
-        return IpmOutput {
-            x: vec![0.0; n],
-            status: IpmStatus::NumericalError,
-            iterations: 0,
-            active: Vec::new(),
-        };
+        return IpmOutput::unsolved(vec![0.0; n], IpmStatus::NumericalError, 0);
     };
     let normal = Normal::new(pattern, qp.quad, qp.quad_weight, &cons);
     // The iterations work in the factor's labels: no vector is permuted per solve.
     let relabelled = Relabelled::new(qp, &normal.pattern.label);
-    let warm = warm
-        .filter(|_| reused)
-        .map(|(x, active)| (relabel_vector(&x, &normal.pattern.label), active));
+    let warm = warm.filter(|w| reused && w.fits(qp)).map(|w| WarmPoint {
+        x: relabel_vector(&w.x, &normal.pattern.label),
+        ..w
+    });
     let mut out = iterate(
         &relabelled.qp(qp),
         &normal,
         &relabelled.cons,
         start_units,
         tol,
-        warm.as_ref().map(|(x, a)| (&x[..], &a[..])),
+        warm.as_ref(),
     );
     out.x = normal.pattern.label.iter().map(|&l| out.x[l]).collect();
     out
@@ -412,14 +459,18 @@ const START_PENALTY: f64 = 100.0;
 
 /// The interior-point iterations on a QP whose unknowns are in `normal`'s labels; the
 /// starting point is built with inequality row i's slack multiplied by `start_units[i]` (see
-/// `caller_units`).
+/// `caller_units`). With the last answer of a form finding (`warm`), its active set is tried
+/// first (`warm_start`), then the iterations start from the blend of that answer with the
+/// cold starting point (`blend`); only if those do not solve the QP within their budget do
+/// the iterations run from the cold point. Whichever start answers, the answer meets the same
+/// tolerances.
 fn iterate(
     qp: &Qp,
     normal: &Normal,
     cons: &Csr,
     start_units: &[f64],
     tol: &Tolerances,
-    warm: Option<(&[f64], &[bool])>,
+    warm: Option<&WarmPoint>,
 ) -> IpmOutput {
     let n = qp.c.len();
     // The numeric factor's storage, shared by every Newton system of this QP (one at a time).
@@ -429,9 +480,62 @@ fn iterate(
     if let Some(out) = warm.and_then(|w| warm_start(qp, normal, cons, w, tol, &mut space)) {
         return out;
     }
-    let Some(mut it) = starting_point(qp, normal, cons, start_units, &mut space) else {
+    let Some(cold) = starting_point(qp, normal, cons, start_units, &mut space) else {
         return stopped(vec![0.0; n], 0, None);
     };
+    let mut spent = 0;
+    if let Some(w) = warm.filter(|w| !w.z.is_empty()) {
+        let start = blend(qp, w, &cold);
+        let budget = tol.max_iter.min(WARM_BUDGET);
+        let out = interior_point((qp, normal, cons), start, tol, budget, &mut space);
+        if out.status == IpmStatus::Solved {
+            return out;
+        }
+        spent = out.iterations;
+    }
+    let mut out = interior_point((qp, normal, cons), cold, tol, tol.max_iter, &mut space);
+    out.iterations += spent;
+    out
+}
+
+/// Iterations at most from a warm start (`blend`) before the cold start takes over.
+const WARM_BUDGET: u32 = 30;
+
+/// Weight of the last answer in the warm start, against the cold starting point's 1 − ω.
+const WARM_WEIGHT: f64 = 0.99;
+
+/// The last answer (`warm`) blended with the cold starting point, ω warm + (1 − ω) cold, as in
+/// Skajaa, Andersen and Ye's warm start of interior-point methods: the slacks of the new QP at
+/// the last x (clipped at 0) and the last multipliers are near the new optimum when the QP
+/// has changed little, and the cold point's share keeps every slack and multiplier strictly
+/// positive and the products s_i z_i away from 0, so that the iterations can move off the
+/// last active set where the new optimum leaves it.
+fn blend(qp: &Qp, warm: &WarmPoint, cold: &Iterate) -> Iterate {
+    let mix = |w: &[f64], c: &[f64]| -> Vec<f64> {
+        (w.iter().zip(c))
+            .map(|(w, c)| WARM_WEIGHT * w + (1.0 - WARM_WEIGHT) * c)
+            .collect()
+    };
+    let gx = qp.ineq.mul(&warm.x);
+    let s_warm: Vec<f64> = gx.iter().zip(qp.h).map(|(g, h)| (g - h).max(0.0)).collect();
+    let z_warm: Vec<f64> = warm.z.iter().map(|z| z.max(0.0)).collect();
+    Iterate {
+        x: mix(&warm.x, &cold.x),
+        lambda: mix(&warm.lambda, &cold.lambda),
+        s: mix(&s_warm, &cold.s),
+        z: mix(&z_warm, &cold.z),
+    }
+}
+
+/// The iterations from `it`, at most `budget`.
+fn interior_point(
+    (qp, normal, cons): (&Qp, &Normal, &Csr),
+    mut it: Iterate,
+    tol: &Tolerances,
+    budget: u32,
+    space: &mut FactorSpace,
+) -> IpmOutput {
+    let n = qp.c.len();
     // The last iterate that met the relaxed tolerances, returned if the method stops early.
     let mut almost: Option<Vec<f64>> = None;
     let mut polishing = Polishing {
@@ -439,8 +543,8 @@ fn iterate(
         failed_guess: None,
     };
     let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
-    let mut iterations = tol.max_iter;
-    for iteration in 0..tol.max_iter {
+    let mut iterations = budget;
+    for iteration in 0..budget {
         let kkt = Kkt::new(qp, normal, &it.x, &it.lambda, &it.s, &it.z);
         if !kkt.objective.is_finite() || inf_norm(&it.x) > 1e15 {
             return stopped(it.x, iteration, almost);
@@ -454,54 +558,55 @@ fn iterate(
                 x: it.x,
                 status: IpmStatus::Solved,
                 iterations: iteration,
+                lambda: it.lambda,
+                z: it.z,
             };
         }
         if progress.stalled(iteration, kkt.excess(tol)) && stall_exits {
             iterations = iteration;
             break;
         }
-        let polished = polishing.attempt((qp, normal, cons), &it, &kkt, tol, &mut space);
-        if let Some((x, active)) = polished {
-            return IpmOutput {
-                x,
-                status: IpmStatus::Solved,
-                iterations: iteration + 1,
-                active,
-            };
+        let polished = polishing.attempt((qp, normal, cons), &it, &kkt, tol, space);
+        if let Some(p) = polished {
+            return IpmOutput::polished(p, iteration + 1);
         }
-        let Some(dir) = direction(qp, normal, cons, &it, kkt, tol, &mut space) else {
+        let Some(dir) = direction(qp, normal, cons, &it, kkt, tol, space) else {
             return stopped(it.x, iteration, almost);
         };
         it.advance(&dir);
     }
-    IpmOutput {
-        status: if almost.is_some() {
-            IpmStatus::AlmostSolved
-        } else {
-            IpmStatus::MaxIterations
-        },
-        x: almost.unwrap_or(it.x),
-        iterations,
-        active: Vec::new(),
-    }
+    let status = if almost.is_some() {
+        IpmStatus::AlmostSolved
+    } else {
+        IpmStatus::MaxIterations
+    };
+    IpmOutput::unsolved(almost.unwrap_or(it.x), status, iterations)
 }
 
 /// The answer of iterations that stopped early: the last iterate that met the relaxed
 /// tolerances as `AlmostSolved`, else `x` as `NumericalError`.
 fn stopped(x: Vec<f64>, iterations: u32, almost: Option<Vec<f64>>) -> IpmOutput {
     match almost {
-        Some(x) => IpmOutput {
-            x,
-            status: IpmStatus::AlmostSolved,
-            iterations,
-            active: Vec::new(),
-        },
-        None => IpmOutput {
-            x,
-            status: IpmStatus::NumericalError,
-            iterations,
-            active: Vec::new(),
-        },
+        Some(x) => IpmOutput::unsolved(x, IpmStatus::AlmostSolved, iterations),
+        None => IpmOutput::unsolved(x, IpmStatus::NumericalError, iterations),
+    }
+}
+
+/// The last answer of a form finding on the same pattern: x, its active set and the
+/// multipliers of the equality and inequality rows (empty when unknown).
+pub struct WarmPoint {
+    pub(super) x: Vec<f64>,
+    pub(super) active: Vec<bool>,
+    pub(super) lambda: Vec<f64>,
+    pub(super) z: Vec<f64>,
+}
+
+impl WarmPoint {
+    /// Whether it has the sizes of `qp`'s unknowns and rows.
+    fn fits(&self, qp: &Qp) -> bool {
+        let rows = self.z.is_empty()
+            || (self.z.len() == qp.ineq.nrows() && self.lambda.len() == qp.eq.nrows());
+        self.x.len() == qp.c.len() && self.active.len() == qp.ineq.nrows() && rows
     }
 }
 
@@ -514,37 +619,31 @@ fn with_eq_zeros(m_eq: usize, d: &[f64]) -> Vec<f64> {
 
 /// A form-finding step first tries the previous step's active set: where it is nearly right,
 /// a few active-set corrections reach the optimum for a fraction of the iterations' cost.
-/// Only x and the active set are carried over: the step computes the multipliers afresh,
-/// from zero.
+/// Only x and the active set are used: the step computes the multipliers afresh, from zero.
 fn warm_start(
     qp: &Qp,
     normal: &Normal,
     cons: &Csr,
-    (x0, guess): (&[f64], &[bool]),
+    warm: &WarmPoint,
     tol: &Tolerances,
     space: &mut FactorSpace,
 ) -> Option<IpmOutput> {
     let (lambda0, z0) = (vec![0.0; qp.eq.nrows()], vec![0.0; qp.ineq.nrows()]);
     let point = Point {
-        x: x0,
+        x: &warm.x,
         lambda: &lambda0,
         z: &z0,
     };
-    let warm = polish(
+    let polished = polish(
         qp,
         normal,
         cons,
         &point,
-        (guess, Corrections::AllWhileFewer),
+        (&warm.active, Corrections::AllWhileFewer),
         tol,
         space,
     );
-    warm.ok().map(|(x, active)| IpmOutput {
-        x,
-        status: IpmStatus::Solved,
-        iterations: 0,
-        active,
-    })
+    polished.ok().map(|p| IpmOutput::polished(p, 0))
 }
 
 /// A primal–dual iterate: x, the equality multipliers λ, the slacks s and their multipliers z.
@@ -646,7 +745,7 @@ impl Polishing {
         kkt: &Kkt,
         tol: &Tolerances,
         space: &mut FactorSpace,
-    ) -> Option<(Vec<f64>, Vec<bool>)> {
+    ) -> Option<Polished> {
         let guess = (kkt.near(tol) && kkt.gap <= self.below).then(|| active_guess(&it.s, &it.z));
         let guess = guess.filter(|g| self.failed_guess.as_ref() != Some(g))?;
         let point = Point {

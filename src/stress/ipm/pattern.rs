@@ -50,8 +50,9 @@ pub(super) struct Pattern {
 #[derive(Default)]
 pub struct PatternCache {
     pub(super) pattern: Option<Pattern>,
-    /// The last answer on this pattern, in the caller's units, and its active set.
-    pub(super) last: Option<(Vec<f64>, Vec<bool>)>,
+    /// The last answer on this pattern, in the caller's units, with its active set and
+    /// multipliers.
+    pub(super) last: Option<super::WarmPoint>,
     /// The shape is far from balance: beyond 20k unknowns the next QP does not try the last
     /// answer's active set (see `PatternCache::far_from_balance`).
     pub(super) far_from_balance: bool,

@@ -36,6 +36,27 @@ pub(super) const POLISH_CORRECTABLE: usize = 200;
 pub(super) const MIN_CORRECTABLE: usize = 3;
 pub(super) const WARM_ROUNDS: usize = 8;
 
+/// The optimum `polish` reached: x, its active set, and the multipliers of the equality rows
+/// and of the inequality rows (0 on inactive ones), which a later QP may start from.
+pub(super) struct Polished {
+    pub(super) x: Vec<f64>,
+    pub(super) active: Vec<bool>,
+    pub(super) lambda: Vec<f64>,
+    pub(super) z: Vec<f64>,
+}
+
+impl Polished {
+    fn of(step: PolishStep, active: Vec<bool>) -> Polished {
+        let z = step.multiplier.iter().map(|v| v.max(0.0)).collect();
+        Polished {
+            x: step.x,
+            active,
+            lambda: step.lambda,
+            z,
+        }
+    }
+}
+
 /// Why `polish` did not reach the optimum, which decides when it is worth another attempt
 /// (each costs a factorisation and several solves).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,7 +102,7 @@ pub(super) fn polish(
     (guess, corrections): (&[bool], Corrections),
     tol: &Tolerances,
     space: &mut FactorSpace,
-) -> Result<(Vec<f64>, Vec<bool>), PolishFailure> {
+) -> Result<Polished, PolishFailure> {
     let m = guess.len();
     let mut active = guess.to_vec();
     let from = PolishFrom::new(qp, normal, point);
@@ -138,7 +159,7 @@ pub(super) fn polish(
         )?;
         let kkt = kkt_of(&step, &active);
         if kkt.within(tol, 1.0) {
-            return Ok((step.x, active));
+            return Ok(Polished::of(step, active));
         }
         let wrong = wrong_rows(&step, &kkt, &active);
         if wrong.is_empty() {
@@ -151,7 +172,7 @@ pub(super) fn polish(
                     polish_step(qp, normal, cons, &from, (&active, true, &never), tol, space)
                         .map_err(|_| PolishFailure::Inexact)?;
                 if kkt_of(&step, &active).within(tol, 1.0) {
-                    return Ok((step.x, active));
+                    return Ok(Polished::of(step, active));
                 }
             }
             return Err(PolishFailure::Inexact);

@@ -162,7 +162,7 @@ fn polish_at(
         z,
     };
     let guess = active_guess(s, z);
-    let (polished, _) = polish(
+    let polished = polish(
         &qp,
         &normal,
         cons,
@@ -171,7 +171,7 @@ fn polish_at(
         tol,
         &mut space,
     )?;
-    Ok(label.iter().map(|&l| polished[l]).collect())
+    Ok(label.iter().map(|&l| polished.x[l]).collect())
 }
 
 /// min (x0 − 2)² + (x1 + 10⁻⁶)² subject to x1 ≥ 0: the bound is active at the optimum
@@ -882,4 +882,71 @@ fn dissection_splits_a_grid_into_halves() {
     let mut seen = vec![false; n + 1];
     label.iter().for_each(|&l| seen[l] = true);
     assert!(seen.iter().all(|&s| s), "not a permutation");
+}
+
+/// A bound-constrained least-squares QP with coupled unknowns: min Σ (x_i − t_i)² +
+/// 100 Σ (x_i − x_{i+1})² subject to x ≥ 0.
+fn coupled_bound_qp_solve(
+    target: &[f64],
+    tol: &Tolerances,
+    cache: &mut PatternCache,
+) -> super::IpmOutput {
+    let n = target.len();
+    let mut rows: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+    rows.extend((0..n - 1).map(|i| vec![(i, 1.0), (i + 1, -1.0)]));
+    let quad = csr(n, &rows.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+    let mut weight = vec![2.0; n];
+    weight.extend(vec![200.0; n - 1]);
+    let bounds: Vec<Vec<(usize, f64)>> = (0..n).map(|i| vec![(i, 1.0)]).collect();
+    let ineq = csr(n, &bounds.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+    let c: Vec<f64> = target.iter().map(|t| -2.0 * t).collect();
+    let constant = target.iter().map(|t| t * t).sum();
+    solve(
+        &Qp {
+            quad: &quad,
+            quad_weight: &weight,
+            c: &c,
+            constant,
+            eq: &Csr::new(n),
+            f: &[],
+            ineq: &ineq,
+            h: &vec![0.0; n],
+            groups: &RowGroups::default(),
+            positions: None,
+            slack_unit: None,
+        },
+        tol,
+        cache,
+    )
+}
+
+/// After a QP, a changed one whose optimum the last answer's active set misses (the
+/// active-set attempt fails) runs the iterations from the last answer blended with the cold
+/// point, and reaches the cold start's optimum.
+#[test]
+fn a_changed_qp_starts_from_the_last_answer_and_reaches_the_same_optimum() {
+    let n = 600;
+    let first: Vec<f64> = (0..n).map(|i| (i as f64 * 0.05).sin()).collect();
+    let second: Vec<f64> = (0..n)
+        .map(|i| (i as f64 * 0.05 + 0.3).sin() + 0.2 * (i as f64 * 0.7).cos())
+        .collect();
+    let tol = Tolerances::for_size(n);
+    let mut cache = PatternCache::default();
+    let before = coupled_bound_qp_solve(&first, &tol, &mut cache);
+    assert_eq!(before.status, IpmStatus::Solved);
+    assert_eq!(before.z.len(), n, "the answer's multipliers are kept");
+    let warm = coupled_bound_qp_solve(&second, &tol, &mut cache);
+    let cold = coupled_bound_qp_solve(&second, &tol, &mut PatternCache::default());
+    assert_eq!(
+        (warm.status, cold.status),
+        (IpmStatus::Solved, IpmStatus::Solved)
+    );
+    assert!(
+        warm.iterations > 0,
+        "the active-set attempt alone solved it"
+    );
+    let gap = (warm.x.iter().zip(&cold.x))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-7, "warm and cold optima differ by {gap:e}");
 }
