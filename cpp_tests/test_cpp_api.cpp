@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -795,11 +796,15 @@ TEST(CppApi, AssessmentInputErrorsThrowTheCStatus) {
                   (void)voussoir::Envelope::from_thickness(mesh, std::vector<double>{0.1, 0.1});
               }),
               VSR_STATUS_INVALID_ARGUMENT);
-    EXPECT_EQ(status_of([&] {
-                  (void)voussoir::Envelope::from_surfaces(mesh, {0, 0, 0, 1}, kTriangles,
-                                                          kPositions, kTriangles);
-              }),
-              VSR_STATUS_INVALID_ARGUMENT);
+    try {
+        (void)voussoir::Envelope::from_surfaces(mesh, {0, 0, 0, 1}, kTriangles, kPositions,
+                                                kTriangles);
+        ADD_FAILURE() << "a ragged intrados was accepted";
+    } catch (const voussoir::Error &e) {
+        // Checked by the C++ layer before the C call: no last error of the C library.
+        EXPECT_EQ(e.status(), VSR_STATUS_INVALID_ARGUMENT);
+        EXPECT_NE(e.message().find("`intrados`"), std::string::npos);
+    }
     voussoir::AssessSettings settings;
     EXPECT_EQ(status_of([&] { settings.objective(static_cast<VsrObjective>(99)); }),
               VSR_STATUS_INVALID_ENUM);
@@ -853,6 +858,51 @@ TEST(CppApi, AssessmentProgressCancelsAndExceptionsPropagate) {
     voussoir::Assessment r;
     EXPECT_EQ(voussoir::try_assess(mesh, envelope, settings, r), VSR_STATUS_OK);
     EXPECT_EQ(r.outcome().termination, VSR_TERMINATION_CANCELLED);
+}
+
+TEST(CppApi, MinThicknessOfAFamilyFitsItsEnvelopeAndRethrows) {
+    const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
+    // Shells of radii R (1 -+ t/2) about the plan's centre read vertically, R the corners'
+    // distance, the springing plane below the intrados.
+    const double cx = 0.5, cy = 0.5, radius = std::sqrt(0.5);
+    std::size_t calls = 0;
+    const voussoir::FamilyBoundsFn shells = [&](double t, std::vector<double> &lower,
+                                                std::vector<double> &upper) {
+        ++calls;
+        for (std::size_t v = 0; v < lower.size(); ++v) {
+            const double r = std::hypot(kPositions[3 * v] - cx, kPositions[3 * v + 1] - cy);
+            auto at = [r, radius](double sphere) {
+                return std::sqrt(std::max(sphere * sphere * radius * radius - r * r, 0.0));
+            };
+            lower[v] = at(1 - 0.5 * t);
+            upper[v] = at(1 + 0.5 * t);
+        }
+    };
+    const voussoir::FamilyThickness f = voussoir::min_thickness_of_family(mesh, shells, 0.1);
+    EXPECT_GT(calls, 0u);
+    EXPECT_TRUE(std::isfinite(f.thickness) && f.thickness >= 0.0 && f.thickness <= 0.1);
+    EXPECT_TRUE(f.assessment.outcome().feasible);
+    EXPECT_EQ(f.assessment.objective(), VSR_OBJECTIVE_MIN_THICKNESS);
+    EXPECT_LT(f.assessment.certificate().eps_inf, 1e-6);
+    const std::vector<double> z = f.assessment.positions(), lo = f.assessment.lower(),
+                              hi = f.assessment.upper();
+    for (std::size_t v = 0; v < lo.size(); ++v) {
+        EXPECT_GE(z[3 * v + 2], lo[v] - 1e-9);
+        EXPECT_LE(z[3 * v + 2], hi[v] + 1e-9);
+    }
+    const voussoir::FamilyBoundsFn throwing = [](double, std::vector<double> &,
+                                                 std::vector<double> &) {
+        throw std::out_of_range("no such shell");
+    };
+    EXPECT_THROW((void)voussoir::min_thickness_of_family(mesh, throwing, 0.1), std::out_of_range);
+    const voussoir::FamilyBoundsFn resizing = [](double, std::vector<double> &lower,
+                                                 std::vector<double> &) { lower.pop_back(); };
+    try {
+        (void)voussoir::min_thickness_of_family(mesh, resizing, 0.1);
+        ADD_FAILURE() << "a resized vector was accepted";
+    } catch (const voussoir::Error &e) {
+        EXPECT_EQ(e.status(), VSR_STATUS_INVALID_ARGUMENT);
+    }
 }
 
 TEST(CppApi, Versions) {

@@ -47,6 +47,7 @@
 
 #include <voussoir.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -843,6 +844,62 @@ inline Assessment assess(const Mesh &mesh, const Envelope &envelope,
         std::rethrow_exception(thrown);
     check(status);
     return assessment;
+}
+
+/// The least thickness of a family of envelopes (vsr_min_thickness_of_family): `bounds(t,
+/// lower, upper)` fills the intrados and extrados heights of thickness t, one per vertex
+/// (both vectors come sized); the self-weight is area x t x the settings' unit weight.
+struct FamilyThickness {
+    double thickness = 0;
+    bool converged = false;
+    Assessment assessment;
+};
+using FamilyBoundsFn = std::function<void(double, std::vector<double> &, std::vector<double> &)>;
+
+namespace detail {
+struct FamilyCall {
+    const FamilyBoundsFn *bounds;
+    std::vector<double> lower, upper;
+};
+inline int family_trampoline(void *user, double t, double *lower, double *upper,
+                             std::size_t n) {
+    auto &call = *static_cast<FamilyCall *>(user);
+    try {
+        call.lower.assign(n, 0.0);
+        call.upper.assign(n, 0.0);
+        (*call.bounds)(t, call.lower, call.upper);
+        if (call.lower.size() != n || call.upper.size() != n)
+            throw Error(VSR_STATUS_INVALID_ARGUMENT,
+                        "`bounds` resized its vectors: give one value per vertex");
+        std::copy(call.lower.begin(), call.lower.end(), lower);
+        std::copy(call.upper.begin(), call.upper.end(), upper);
+        return 0;
+    } catch (...) {
+        // Nothing may unwind through the C library: keep the exception and stop.
+        progress_exception() = std::current_exception();
+        return 1;
+    }
+}
+}  // namespace detail
+
+/// Throws Error, or rethrows what `bounds` threw.
+inline FamilyThickness min_thickness_of_family(const Mesh &mesh, const FamilyBoundsFn &bounds,
+                                               double thickness, double scale_tolerance = 1e-3,
+                                               const AssessSettings &settings = AssessSettings()) {
+    detail::FamilyCall call{&bounds, {}, {}};
+    VsrAssessment *raw = nullptr;
+    FamilyThickness out;
+    int converged = 0;
+    detail::progress_exception() = nullptr;
+    const VsrStatus status = vsr_min_thickness_of_family(
+        mesh.get(), detail::family_trampoline, &call, thickness, scale_tolerance, settings.get(),
+        &raw, &out.thickness, &converged);
+    out.assessment = Assessment(raw);
+    if (std::exception_ptr thrown = std::exchange(detail::progress_exception(), nullptr))
+        std::rethrow_exception(thrown);
+    check(status);
+    out.converged = converged != 0;
+    return out;
 }
 
 }  // namespace voussoir

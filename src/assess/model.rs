@@ -353,7 +353,7 @@ fn check_lengths(problem: &Problem, envelope: &Envelope) -> Result<()> {
 fn live_pattern(problem: &Problem, settings: &AssessSettings) -> Result<Vec<f64>> {
     let n = problem.mesh.positions.len();
     match (&settings.load_pattern, settings.objective) {
-        (Some(p), _) if p.len() != n => Err(Error::InvalidArgument {
+        (Some(p), Objective::MaxLoad) if p.len() != n => Err(Error::InvalidArgument {
             name: "load_pattern",
             reason: format!("has {} entries, expected one per vertex ({n})", p.len()),
         }),
