@@ -735,7 +735,8 @@ CAssessment c_assess(const voussoir::Mesh &mesh, VsrObjective objective) {
 }
 
 TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
-    const voussoir::Mesh mesh = vsrt::make_mesh(vsrt::generated("disk_cap"));
+    // A small mesh: the comparison is of layers, not of the search.
+    const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
     for (VsrObjective objective : {VSR_OBJECTIVE_FIT, VSR_OBJECTIVE_MIN_THICKNESS}) {
         voussoir::AssessSettings settings;
         settings.objective(objective);
@@ -762,7 +763,7 @@ TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
                                                   f.thrust_horizontal, f.load_factor}));
         const voussoir::Certificate cert = a.certificate();
         EXPECT_LT(cert.eps_inf, 1e-6);
-        EXPECT_EQ(cert.worst_bound_vertex, VSR_NO_VERTEX);
+        EXPECT_LE(cert.worst_bound, 1e-9);  // inside its bounds to the certificate's slack
         EXPECT_FALSE(a.termination_message().empty());
         // The bounds the surface lies within, at the reported thickness.
         const std::vector<double> z = a.positions(), lo = a.lower(), hi = a.upper();
