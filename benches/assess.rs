@@ -4,6 +4,7 @@
 //!     cargo bench --bench assess -- --hemisphere   # hemispheres only
 //!     cargo bench --bench assess -- --models       # shared models only
 //!     cargo bench --bench assess -- --heyman       # least thickness on Heyman's terms
+//!     cargo bench --bench assess -- --heyman --barrels   # its barrels only
 //!
 //! Hemispheres: radius 1 on `generate::polar_disk` meshes, rim anchored, thickness 0.1 along
 //! the normal (docs/method.md §16.1), every analysis; t_min/R = s × 0.1. Shared models: each
@@ -188,7 +189,8 @@ fn heyman() {
     println!("\nLeast thickness over the shells R ± t/2 (R = 1) read vertically\n");
     println!("| model | V | t_min / R | classical | diff | rounds | converged | eps_inf | last round s |");
     println!("|---|---|---|---|---|---|---|---|---|");
-    for rings in [6, 10, 14] {
+    let only_barrels = std::env::args().any(|a| a == "--barrels");
+    for rings in [6, 10, 14].into_iter().filter(|_| !only_barrels) {
         let name = format!("hemisphere {rings} rings");
         heyman_row(
             &name,
@@ -197,7 +199,7 @@ fn heyman() {
             0.042,
         );
     }
-    for nx in [16, 32] {
+    for nx in [16, 32, 64] {
         let name = format!("semicircular barrel, {nx} segments");
         heyman_row(&name, &barrel(nx, 2), |p| p[0].abs(), 0.1075);
     }
