@@ -159,6 +159,9 @@ pub struct Report {
     pub rms_change: f64,
     /// Largest height change / plan diagonal.
     pub max_change: f64,
+    /// Whether the input hangs below its supports and the answer is the nearest standing shape
+    /// to its mirror image ([`crate::FormFindResult::mirrored`]; false for an analysis).
+    pub mirrored: bool,
     /// Wall times, seconds.
     pub timings_s: Timings,
     /// The mesh's counts.
@@ -243,6 +246,7 @@ impl Report {
             l2: distances[1],
             rms_change: distances[2],
             max_change: distances[3],
+            mirrored: matches!(run, Run::FormFinding(f) if f.mirrored),
             timings_s: Timings {
                 stress: timings[0],
                 shape: timings[1],

@@ -224,6 +224,11 @@ pub struct FormFindResult {
     pub rms_change: f64,
     /// The largest height change at any vertex, over the plan bounding-box diagonal.
     pub max_change: f64,
+    /// Whether the input hangs (it lies below the surface its supports span, on average over
+    /// the plan, so that it cannot stand as given) and the nearest method form-found the
+    /// nearest shape to its mirror image about that surface instead (docs/method.md §13.1).
+    /// The changes and distances above are measured from the input as given.
+    pub mirrored: bool,
     /// Seconds summed over iterations.
     pub stress_seconds: f64,
     /// Seconds in height steps.
@@ -279,6 +284,7 @@ struct Run {
     positions: Vec<[f64; 3]>,
     stress: StressResult,
     history: Vec<f64>,
+    mirrored: bool,
     stress_seconds: f64,
     shape_seconds: f64,
 }
@@ -299,6 +305,7 @@ fn finish(problem: &Problem, run: Run, start: Instant) -> FormFindResult {
         l2,
         rms_change,
         max_change,
+        mirrored: run.mirrored,
         stress_seconds: run.stress_seconds,
         shape_seconds: run.shape_seconds,
         total_seconds: start.elapsed().as_secs_f64(),

@@ -49,6 +49,9 @@ const RESIDUAL_FACTOR: f64 = 0.5;
 /// A state in equilibrium that is no nearer than the nearest one before it by this fraction
 /// of E ends the search.
 const SETTLED: f64 = 1e-3;
+/// The pull towards the input in the solve for the unloaded surface over the supports
+/// (`Nearest::hanging_mirror`), relative to the mean diagonal of KᵀK per vertex.
+const MEMBRANE_PULL: f64 = 1e-12;
 /// What blocks a loop whose heights reached the limit, where q_max does not.
 const LIMIT_HINT: &str = "the shape cannot stand within the height limit (raise max_height_change)";
 /// The loosest relative gap of an inexact stress QP (see `Nearest::inexact_gap`).
@@ -94,6 +97,7 @@ pub(super) fn nearest(
             positions,
             stress,
             history: state.history,
+            mirrored: state.mirrored,
             stress_seconds: state.stress_seconds,
             shape_seconds: state.shape_seconds,
         },
@@ -116,8 +120,13 @@ struct Nearest<'a, 'p> {
     settings: &'a FormFindSettings,
     progress: Option<&'a mut Progress<'p>>,
     shape: ShapeStep,
-    /// Input heights (after ODT, when asked for), the shape to stay near.
+    /// Input heights (after ODT, when asked for), the shape to stay near: their mirror image
+    /// where the input hangs (see [`Nearest::hanging_mirror`]).
     z0: Vec<f64>,
+    /// Input heights (after ODT, when asked for), from which the height limit is measured.
+    z_limit: Vec<f64>,
+    /// Whether `z0` is the input's mirror image.
+    mirrored: bool,
     /// Plan area share per row of `shape`.
     area: Vec<f64>,
     /// c_e per mesh edge when the fairness term is on.
@@ -181,6 +190,8 @@ impl<'a, 'p> Nearest<'a, 'p> {
             progress,
             shape,
             z0: positions.iter().map(|p| p[2]).collect(),
+            z_limit: positions.iter().map(|p| p[2]).collect(),
+            mirrored: false,
             area,
             fair,
             l0: frame.scale,
@@ -221,6 +232,9 @@ impl<'a, 'p> Nearest<'a, 'p> {
         }
         if settled {
             return Ok(Termination::Converged);
+        }
+        if let Some(t) = self.mirror_if_hanging()? {
+            return Ok(t);
         }
         self.w = match self.initial_weight() {
             Ok(w) => w,
@@ -271,6 +285,57 @@ impl<'a, 'p> Nearest<'a, 'p> {
         }
     }
 
+    /// Where the input hangs (see [`Nearest::hanging_mirror`]), moves the loop to its mirror
+    /// image, which becomes both the start and the shape to stay near, and takes a stress step
+    /// there; returns the termination where that step ends the loop.
+    fn mirror_if_hanging(&mut self) -> Result<Option<Termination>> {
+        let Some(mirror) = self.hanging_mirror()? else {
+            return Ok(None);
+        };
+        self.positions = self.with_heights(&mirror);
+        self.z0 = mirror;
+        self.mirrored = true;
+        self.held = self.stress_step(None)?;
+        let ended = self.after_stress_step();
+        let settled = self.record();
+        Ok(ended.or(settled.then_some(Termination::Converged)))
+    }
+
+    /// The mirror image of the input about the unloaded surface its supports span, where the
+    /// input hangs; None where it does not. With K = L_q[V_N, V_N] for the held force
+    /// densities (the input's stress step), the unloaded surface z̄ solves K z̄ = b with no
+    /// loads and the supports' heights (horizontal balance makes every plane such a surface, so
+    /// over coplanar supports it is their plane). A shape in equilibrium under downward loads
+    /// lies above z̄ of its own forces at every vertex (the discrete maximum principle), so no
+    /// standing shape is near one below it. The input hangs where its area-weighted mean height
+    /// above z̄ is negative; the mirror 2 z̄ − z is then brought within the height limit.
+    fn hanging_mirror(&self) -> Result<Option<Vec<f64>>> {
+        let rows = self.shape.vertices();
+        let q = &self.held.force_densities;
+        let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
+        // A pull small enough to leave K's solution (KᵀK's diagonal over its condition number)
+        // and to fix the heights of parts that K leaves free.
+        let rho = MEMBRANE_PULL * self.mean_ktk_diagonal(q) * rows.len() as f64;
+        if !(rho.is_finite() && rho > 0.0) {
+            return Ok(None);
+        }
+        let unloaded = vec![0.0; z.len()];
+        let surface = (self.shape).nearest(q, &unloaded, &z, &z, rho, &self.area, None, None)?;
+        let height_above: f64 = (rows.iter().zip(&self.area))
+            .map(|(&v, a)| a * (z[v as usize] - surface[v as usize]))
+            .sum();
+        if height_above.is_nan() || height_above >= 0.0 {
+            return Ok(None);
+        }
+        let mut mirror = z;
+        for &v in rows {
+            let v = v as usize;
+            let (lo, hi) = (self.z_limit[v] - self.limit, self.z_limit[v] + self.limit);
+            mirror[v] = (2.0 * surface[v] - mirror[v]).clamp(lo, hi);
+        }
+        Ok(Some(mirror))
+    }
+
     /// Stress steps the nearest method may take: all but a quarter of `max_iterations`, which
     /// [`Nearest::polish`] may need.
     fn budget(&self) -> usize {
@@ -299,7 +364,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         };
         let offset = self.iterations;
         let mut limit = HeightLimit {
-            z0: &self.z0,
+            z0: &self.z_limit,
             limit: self.limit,
             held: Vec::new(),
         };
@@ -694,7 +759,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let mut step = 1.0f64;
         for &v in self.shape.vertices() {
             let v = v as usize;
-            let (from, to) = (z[v] - self.z0[v], target[v] - self.z0[v]);
+            let (from, to) = (z[v] - self.z_limit[v], target[v] - self.z_limit[v]);
             if to.abs() > self.limit {
                 let edge = self.limit.copysign(to);
                 step = step.min(((edge - from) / (to - from)).clamp(0.0, 1.0));
@@ -708,7 +773,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         (self.shape.vertices().iter().copied())
             .filter(|&v| {
                 let v = v as usize;
-                (self.positions[v][2] - self.z0[v]).abs() >= self.limit * (1.0 - 1e-6)
+                (self.positions[v][2] - self.z_limit[v]).abs() >= self.limit * (1.0 - 1e-6)
             })
             .collect()
     }

@@ -166,6 +166,7 @@ pub(super) fn paper_within(
             positions,
             stress,
             history,
+            mirrored: false,
             stress_seconds: stress_s,
             shape_seconds: shape_s,
         },

@@ -109,3 +109,57 @@ pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
         .collect();
     Mesh::new(pos, mesh.faces.clone(), &anchored).expect("jiggled mesh stays valid")
 }
+
+/// ε∞ of a form-finding result recomputed here from its positions and force densities: loads
+/// a third of each 3-D triangle's area (the default load rule, unit density), vertical
+/// residuals Σ_j q_ij (z_i − z_j) − p_i at the non-anchored vertices, over their mean load.
+pub fn recomputed_eps_inf(mesh: &Mesh, r: &voussoir::FormFindResult) -> f64 {
+    let n = mesh.positions.len();
+    let mut load = vec![0.0; n];
+    for f in &mesh.faces {
+        let [a, b, c] = f.map(|v| r.positions[v as usize]);
+        let (u, w) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let cross = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        let area = (cross[0].powi(2) + cross[1].powi(2) + cross[2].powi(2)).sqrt() / 2.0;
+        f.iter().for_each(|&v| load[v as usize] += area / 3.0);
+    }
+    let mut residual = vec![0.0; n];
+    for (edge, q) in mesh.edges.iter().zip(&r.stress.force_densities) {
+        let [i, j] = edge.v.map(|v| v as usize);
+        let dz = r.positions[i][2] - r.positions[j][2];
+        (residual[i], residual[j]) = (residual[i] + q * dz, residual[j] - q * dz);
+    }
+    let free: Vec<usize> = (0..n).filter(|&v| mesh.is_non_anchored(v)).collect();
+    let p_bar = free.iter().map(|&v| load[v]).sum::<f64>() / free.len() as f64;
+    free.iter()
+        .map(|&v| (residual[v] - load[v]).abs())
+        .fold(0.0, f64::max)
+        / p_bar
+}
+
+/// The plan bounding-box diagonal of the referenced vertices of `mesh`.
+pub fn plan_diagonal(mesh: &Mesh) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for (p, _) in (mesh.positions.iter().zip(&mesh.referenced)).filter(|(_, r)| **r) {
+        for d in 0..2 {
+            (lo[d], hi[d]) = (lo[d].min(p[d]), hi[d].max(p[d]));
+        }
+    }
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+/// The largest height change between `mesh` and `positions` over the plan diagonal, measured
+/// here.
+pub fn largest_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
+    let diagonal = plan_diagonal(mesh);
+    (mesh.positions.iter().zip(positions))
+        .map(|(a, b)| (a[2] - b[2]).abs() / diagonal)
+        .fold(0.0, f64::max)
+}
