@@ -40,8 +40,10 @@ pub enum Termination {
     Cancelled,
     /// The shape cannot be balanced under the stress constraints within the height limit
     /// ([`FormFindSettings::max_height_change`]): `hint` names what blocks (q_max holding the
-    /// force densities down, or the height limit) and `vertices` lists where (the vertices at
-    /// the height limit, or those beside edges at q_max with the largest residuals).
+    /// force densities down, or the height limit) and `vertices` lists where: at the height
+    /// limit, the region that cannot stand within it (the vertices that reached the limit, with
+    /// those furthest from balance in the answer); where q_max blocks, the vertices beside
+    /// edges at q_max with the largest residuals.
     Blocked {
         /// Where it is blocked.
         vertices: Vec<u32>,
@@ -403,6 +405,25 @@ fn infeasibility_hint(mesh: &crate::mesh::Mesh, s: &StressSettings) -> String {
     }
     parts.push("prescribed horizontal forces or τ");
     parts.join(", or ")
+}
+
+/// The region a blocked loop names: `limited` (the vertices held at the height limit) with the
+/// non-anchored vertices furthest from balance in `s`, the state answered (residual above a
+/// tenth of the largest), sorted.
+fn blocked_region(problem: &Problem, limited: &[u32], s: &StressResult) -> Vec<u32> {
+    let mesh = &problem.mesh;
+    let r_max = (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .map(|v| s.residuals[v].abs())
+        .fold(0.0f64, f64::max);
+    let mut region: Vec<u32> = (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v) && s.residuals[v].abs() > 0.1 * r_max)
+        .map(|v| v as u32)
+        .chain(limited.iter().copied())
+        .collect();
+    region.sort_unstable();
+    region.dedup();
+    region
 }
 
 /// Non-anchored vertices with large residuals whose incident force densities are (almost) all

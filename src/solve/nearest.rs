@@ -16,8 +16,8 @@
 
 use super::paper::{paper_within, HeightLimit};
 use super::{
-    area_shares, blocking_vertices, finish, infeasibility_hint, FormFindResult, FormFindSettings,
-    Progress, Run, Termination, FAR_FROM_BALANCE,
+    area_shares, blocked_region, blocking_vertices, finish, infeasibility_hint, FormFindResult,
+    FormFindSettings, Progress, Run, Termination, FAR_FROM_BALANCE,
 };
 use crate::error::Result;
 use crate::geometry::Frame;
@@ -53,7 +53,9 @@ const SETTLED: f64 = 1e-3;
 /// (`Nearest::hanging_mirror`), relative to the mean diagonal of KᵀK per vertex.
 const MEMBRANE_PULL: f64 = 1e-12;
 /// What blocks a loop whose heights reached the limit, where q_max does not.
-const LIMIT_HINT: &str = "the shape cannot stand within the height limit (raise max_height_change)";
+const LIMIT_HINT: &str =
+    "the shape cannot stand within the height limit: the vertices that reached \
+    it, and those furthest from balance in the answer (raise max_height_change)";
 /// The loosest relative gap of an inexact stress QP (see `Nearest::inexact_gap`).
 const INEXACT_GAP_MAX: f64 = 1e-4;
 
@@ -308,7 +310,8 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// over coplanar supports it is their plane). A shape in equilibrium under downward loads
     /// lies above z̄ of its own forces at every vertex (the discrete maximum principle), so no
     /// standing shape is near one below it. The input hangs where its area-weighted mean height
-    /// above z̄ is negative; the mirror 2 z̄ − z is then brought within the height limit.
+    /// above z̄ is negative; its mirror 2 z̄ − z is the reading taken where it lies within the
+    /// height limit of the input.
     fn hanging_mirror(&self) -> Result<Option<Vec<f64>>> {
         let rows = self.shape.vertices();
         let q = &self.held.force_densities;
@@ -330,8 +333,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let mut mirror = z;
         for &v in rows {
             let v = v as usize;
-            let (lo, hi) = (self.z_limit[v] - self.limit, self.z_limit[v] + self.limit);
-            mirror[v] = (2.0 * surface[v] - mirror[v]).clamp(lo, hi);
+            mirror[v] = 2.0 * surface[v] - mirror[v];
+            if (mirror[v] - self.z_limit[v]).abs() > self.limit {
+                return Ok(None);
+            }
         }
         Ok(Some(mirror))
     }
@@ -381,18 +386,6 @@ impl<'a, 'p> Nearest<'a, 'p> {
         self.history.extend(&r.history);
         self.stress_seconds += r.stress_seconds;
         self.shape_seconds += r.shape_seconds;
-        // A loop that did not converge with heights held back at the limit was blocked there.
-        let mut held = limit.held;
-        held.sort_unstable();
-        let termination = match r.termination {
-            Termination::MaxIterations | Termination::Stalled { .. } if !held.is_empty() => {
-                Termination::Blocked {
-                    vertices: held,
-                    hint: LIMIT_HINT.into(),
-                }
-            }
-            t => t,
-        };
         if r.stress.eps_inf < self.best.eps {
             self.best = Best {
                 eps: r.stress.eps_inf,
@@ -401,6 +394,17 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 stress: r.stress,
             };
         }
+        // A loop that did not converge with heights held back at the limit was blocked there.
+        let held = limit.held;
+        let termination = match r.termination {
+            Termination::MaxIterations | Termination::Stalled { .. } if !held.is_empty() => {
+                Termination::Blocked {
+                    vertices: blocked_region(self.problem, &held, &self.best.stress),
+                    hint: LIMIT_HINT.into(),
+                }
+            }
+            t => t,
+        };
         Ok(termination)
     }
 
@@ -791,7 +795,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 format!("{q_max}, so standing needs heights beyond the limit (raise q_max)")
             };
             return Termination::Blocked {
-                vertices: at_limit,
+                vertices: blocked_region(self.problem, &at_limit, &self.best.stress),
                 hint,
             };
         }
