@@ -666,6 +666,29 @@ fn infeasible_bounds_write_outputs_and_exit_3() {
     assert!(dir.path("formfind-out/vault-formfound.obj").is_file());
 }
 
+/// The same cap with the default (nearest) method converges from its mirror image, and the
+/// report says so.
+#[test]
+fn a_hanging_cap_is_reported_mirrored() {
+    let dir = Scratch::new("hanging-nearest");
+    let mut cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
+    cap.positions.iter_mut().for_each(|p| p[2] = -p[2]);
+    voussoir::io::write_obj(&dir.path("hanging.obj"), &cap.positions, &cap.faces).unwrap();
+    let anchored: Vec<usize> = (0..cap.n_vertices()).filter(|&v| cap.anchored[v]).collect();
+    let supports = serde_json::json!({ "anchored": anchored }).to_string();
+    fs::write(dir.path("s.json"), supports).unwrap();
+    let out = run(&dir.0, &["hanging.obj", "--supports", "s.json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let r = read_json(&dir.path("formfind-out/report.json"));
+    assert_eq!(r["termination"], "converged");
+    assert_eq!(r["mirrored"], true);
+}
+
 /// A hanging cap (concave up) stalls the paper's loop without a vertex to blame: the summary
 /// says so in its one line, without an empty list of details.
 #[test]
