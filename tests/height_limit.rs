@@ -90,10 +90,6 @@ fn no_answer_moves_beyond_the_height_limit() {
                 assert!((r.max_change - moved).abs() <= 1e-12, "{case}");
                 let blocked = matches!(r.termination, Termination::Blocked { .. });
                 bound_hard += (blocked || moved >= 0.999 * limit) as usize;
-                eprintln!(
-                    "DBG {case}: {moved} {:?} eps {:e} it {}",
-                    r.termination, r.stress.eps_inf, r.iterations
-                );
             }
         }
     }
