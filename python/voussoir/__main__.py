@@ -124,7 +124,11 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--holes", choices=names["holes"], help=f"[{d['holes']}]")
     p.add_argument("--dual-smoothing", type=float, help=f"force-diagram smoothing weight [{d['dual_length_smoothing']}]")
     p.add_argument("--smoothing-decay", type=float, help=f"decay of --dual-smoothing per step [{d['smoothing_decay']}]")
-    p.add_argument("--odt", type=int, help=f"ODT sweeps of the plan [{d['odt_iterations']}]")
+    p.add_argument("--odt", type=int,
+                   help="at most N ODT sweeps of the plan: the nearest method runs them on the input "
+                   "first; the paper method one before each of its first N stress steps; the first "
+                   f"sweep that does not improve the plan's triangles is undone and ends them "
+                   f"[{d['odt_iterations']}]")
     p.add_argument("--density", type=float, default=1.0, help="weight per unit area of every face [1]")
     p.add_argument("--load", choices=names["load_rule"], help=f"[{d['load_rule']}]")
     a = p.add_argument_group("assessment (instead of form finding; MESH is the middle surface)")
