@@ -22,6 +22,7 @@ pub mod capi;
 mod error;
 pub mod generate;
 mod geometry;
+pub mod interrupt;
 pub mod io;
 mod mesh;
 mod names;

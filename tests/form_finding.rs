@@ -617,3 +617,63 @@ fn marked_polygon_diagonals_free_twisted_rings_from_q_min() {
         "{not_an_edge}"
     );
 }
+
+/// The plan's quality as docs/method.md §12 defines it: the harmonic mean over the plan
+/// triangles of 4√3·area / (sum of the squared edge lengths).
+fn plan_quality(faces: &[[u32; 3]], x: &[[f64; 3]]) -> f64 {
+    let inverse: f64 = (faces.iter())
+        .map(|f| {
+            let [a, b, c] = f.map(|v| [x[v as usize][0], x[v as usize][1]]);
+            let d = [
+                [b[0] - a[0], b[1] - a[1]],
+                [c[0] - b[0], c[1] - b[1]],
+                [a[0] - c[0], a[1] - c[1]],
+            ];
+            let area = (d[0][0] * -d[2][1] - d[0][1] * -d[2][0]) / 2.0;
+            let squares: f64 = d.iter().map(|e| e[0] * e[0] + e[1] * e[1]).sum();
+            squares / (4.0 * 3f64.sqrt() * area)
+        })
+        .sum();
+    faces.len() as f64 / inverse
+}
+
+#[test]
+fn many_odt_sweeps_are_never_worse_than_few() {
+    // Issue 48: `--odt 1000` ran every sweep though the sweeps had long stopped improving the
+    // plan: some triangles became slivers (lilium's plan quality fell from 0.82 to 0.005) and
+    // form finding ended blocked. The sweeps now end at the first that does not improve the
+    // plan, for both methods.
+    for (name, method) in [
+        ("lilium", FormMethod::Nearest),
+        ("neumunster", FormMethod::Paper),
+    ] {
+        let Some(mesh) = load_model(name) else { return };
+        let problem = Problem::new(mesh.clone());
+        let run = |n: usize| {
+            let settings = FormFindSettings::default()
+                .with_method(method)
+                .with_odt_iterations(n);
+            form_find(&problem, &settings, None).unwrap()
+        };
+        let input = plan_quality(&mesh.faces, &mesh.positions);
+        let many = run(1000);
+        let quality = plan_quality(&mesh.faces, &many.positions);
+        assert_eq!(
+            many.termination,
+            Termination::Converged,
+            "{name}: {:?}",
+            many.history
+        );
+        assert!(
+            quality >= input,
+            "{name}: plan quality {quality} below the input's {input}"
+        );
+        for few in [1, 2, 4] {
+            let q = plan_quality(&mesh.faces, &run(few).positions);
+            assert!(
+                quality >= q,
+                "{name}: 1000 sweeps give {quality}, {few} give {q}"
+            );
+        }
+    }
+}

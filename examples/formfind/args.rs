@@ -141,9 +141,11 @@ Solver:
                          lengths at each face (a smoother force diagram)   [{smooth}]
   --smoothing-decay D    form finding fades MU as MU D^k, 0 <= D < 1;
                          nearer 1: smoother, further from the input        [{decay}]
-  --odt N                ODT sweeps of the plan: the nearest method runs all N
-                         on the input first; the paper method one before
-                         each of its first N stress steps                  [0]
+  --odt N                at most N ODT sweeps of the plan: the nearest method
+                         runs them on the input first; the paper method one
+                         before each of its first N stress steps; the first
+                         sweep that does not improve the plan's triangles
+                         is undone and ends them                           [0]
   --density D            weight per unit area of every face                [1]
   --load R               {loads}: how a face's
                          weight is shared among its vertices               [{load}]

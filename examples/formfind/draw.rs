@@ -4,6 +4,7 @@
 use svg::node::element::{
     Definitions, Group, Line, LinearGradient, Rectangle, Stop, Text as SvgText,
 };
+use svg::node::Blob;
 use svg::Document;
 
 pub const FONT: &str = "DejaVu Sans, Helvetica, Arial, sans-serif";
@@ -176,6 +177,32 @@ pub fn colour_bar(
             .add(text(tx, y + h + 16.0, 11.0, label.clone()).set("text-anchor", "middle"));
     }
     g
+}
+
+/// The many elements of one group (a mesh's faces, edges or vertices), kept as their SVG text:
+/// a picture of a large mesh then holds tens of bytes per element, not an element tree with
+/// a map of attributes per element (about 1 GB for the pictures of a 100k-face mesh).
+#[derive(Default)]
+pub struct Bulk(String);
+
+impl Bulk {
+    pub fn add(mut self, node: impl svg::Node) -> Bulk {
+        use std::fmt::Write;
+        if !self.0.is_empty() {
+            self.0.push('\n');
+        }
+        write!(self.0, "{node}").expect("writing to a String");
+        self
+    }
+
+    /// `group` with the elements added after its children, written as `Group::add` would.
+    pub fn into_group(self, group: Group) -> Group {
+        if self.0.is_empty() {
+            group
+        } else {
+            group.add(Blob::new(self.0))
+        }
+    }
 }
 
 pub fn line(a: (f64, f64), b: (f64, f64), colour: &str, width: f64) -> Line {

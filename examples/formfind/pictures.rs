@@ -9,7 +9,7 @@ use svg::node::element::{Circle, Group, Polygon, Rectangle};
 use svg::Document;
 use voussoir::Mesh;
 
-use crate::draw::{self, bbox, colour_bar, fmt, line, page, text, View};
+use crate::draw::{self, bbox, colour_bar, fmt, line, page, text, Bulk, View};
 use crate::run::Outcome;
 
 const WIDTH: f64 = 900.0;
@@ -77,7 +77,7 @@ fn polygon(view: &View, points: impl IntoIterator<Item = [f64; 2]>) -> Polygon {
 
 /// Faces filled with `fill(face)`.
 fn faces(mesh: &Mesh, pos: &[[f64; 3]], view: &View, fill: impl Fn(usize) -> String) -> Group {
-    let mut g = Group::new();
+    let mut g = Bulk::default();
     for (t, f) in mesh.faces.iter().enumerate() {
         let c = fill(t);
         g = g.add(
@@ -87,7 +87,7 @@ fn faces(mesh: &Mesh, pos: &[[f64; 3]], view: &View, fill: impl Fn(usize) -> Str
                 .set("stroke-width", 0.4),
         );
     }
-    g
+    g.into_group(Group::new())
 }
 
 /// Boundary loops (outer and holes).
@@ -105,17 +105,17 @@ fn outline(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
 }
 
 fn wireframe(mesh: &Mesh, pos: &[[f64; 3]], view: &View, colour: &str) -> Group {
-    let mut g = Group::new();
+    let mut g = Bulk::default();
     for e in &mesh.edges {
         let [a, b] = e.v.map(|v| view.px(plan(&pos[v as usize])));
         g = g.add(line(a, b, colour, 0.5));
     }
-    g
+    g.into_group(Group::new())
 }
 
 /// Black squares at the anchored vertices.
 fn anchors(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
-    let mut g = Group::new();
+    let mut g = Bulk::default();
     for v in (0..mesh.n_vertices()).filter(|&v| mesh.anchored[v] && mesh.referenced[v]) {
         let (x, y) = view.px(plan(&pos[v]));
         g = g.add(
@@ -127,7 +127,7 @@ fn anchors(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
                 .set("fill", "#111"),
         );
     }
-    g
+    g.into_group(Group::new())
 }
 
 fn anchor_key(x: f64, y: f64) -> Group {
@@ -176,7 +176,7 @@ fn plan_forces_of(name: &str, mesh: &Mesh, pos: &[[f64; 3]], q: &[f64], tau: &[f
     .add(faces(mesh, pos, view, |_| "#f3efe6".into()));
     let mut order: Vec<usize> = (0..q.len()).collect();
     order.sort_by(|&a, &b| q[a].total_cmp(&q[b]));
-    let mut edges = Group::new();
+    let mut edges = Bulk::default();
     for e in order {
         let [a, b] = mesh.edges[e].v.map(|v| view.px(plan(&pos[v as usize])));
         let t = if q_top > 0.0 {
@@ -190,9 +190,11 @@ fn plan_forces_of(name: &str, mesh: &Mesh, pos: &[[f64; 3]], q: &[f64], tau: &[f
             line(a, b, &draw::viridis(t), 0.6 + 4.4 * t).set("stroke-linecap", "round")
         });
     }
-    doc = doc.add(edges).add(anchors(mesh, pos, view));
+    doc = doc
+        .add(edges.into_group(Group::new()))
+        .add(anchors(mesh, pos, view));
     let tau_max = tau.iter().copied().fold(0.0, f64::max);
-    let mut ties = Group::new();
+    let mut ties = Bulk::default();
     for v in (0..mesh.n_vertices()).filter(|&v| tau[v] > 1e-9 * tau_max.max(1e-300)) {
         let (x, y) = view.px(plan(&pos[v]));
         ties = ties.add(
@@ -206,7 +208,7 @@ fn plan_forces_of(name: &str, mesh: &Mesh, pos: &[[f64; 3]], q: &[f64], tau: &[f
         );
     }
     let y = height - LEGEND + 40.0;
-    doc.add(ties)
+    doc.add(ties.into_group(Group::new()))
         .add(colour_bar(
             "q",
             (30.0, y, 300.0),
@@ -251,7 +253,7 @@ fn force_diagram(o: &Outcome) -> Document {
         &format!("{}: force diagram", o.model.name),
         "one point per face, one segment per interior edge (perpendicular to it); length = horizontal force q × plan length",
     );
-    let mut g = Group::new();
+    let mut g = Bulk::default();
     for (e, [a, b]) in segments {
         let t = if q_top > 0.0 {
             (q[e] / q_top).min(1.0)
@@ -263,7 +265,7 @@ fn force_diagram(o: &Outcome) -> Document {
         );
     }
     let y = height - LEGEND + 40.0;
-    doc = doc.add(g);
+    doc = doc.add(g.into_group(Group::new()));
     doc.add(colour_bar(
         "qd",
         (30.0, y, 300.0),
@@ -311,7 +313,7 @@ fn residuals(o: &Outcome) -> Document {
     );
     for (((label, pos, s), rel), view) in panels.iter().zip(&rel).zip(&views) {
         let (x, _) = view.px(lo);
-        let mut g = Group::new()
+        let g = Group::new()
             .add(text(
                 x,
                 TOP + 14.0,
@@ -320,10 +322,11 @@ fn residuals(o: &Outcome) -> Document {
             ))
             .add(wireframe(mesh, pos, view, "#d8d8d8"))
             .add(outline(mesh, pos, view));
+        let mut dots = Bulk::default();
         for v in (0..mesh.n_vertices()).filter(|&v| mesh.is_non_anchored(v)) {
             let t = ((rel[v].log10() - floor) / (top - floor)).max(0.0);
             let (cx, cy) = view.px(plan(&pos[v]));
-            g = g.add(
+            dots = dots.add(
                 Circle::new()
                     .set("cx", cx)
                     .set("cy", cy)
@@ -333,7 +336,7 @@ fn residuals(o: &Outcome) -> Document {
                     .set("stroke-width", 0.3),
             );
         }
-        doc = doc.add(g).add(anchors(mesh, pos, view));
+        doc = doc.add(dots.into_group(g)).add(anchors(mesh, pos, view));
     }
     let y = height - LEGEND + 40.0;
     let decades = (top - floor) as usize;
@@ -417,11 +420,10 @@ pub fn names(stress_only: bool) -> Vec<&'static str> {
 
 /// The pictures of a run as (file name, SVG text), in the order of [`names`].
 pub fn all(o: &Outcome) -> Vec<(&'static str, String)> {
-    let mut out = vec![
-        plan_forces(o).to_string(),
-        force_diagram(o).to_string(),
-        residuals(o).to_string(),
-    ];
+    // One picture's element tree at a time.
+    let mut out = vec![plan_forces(o).to_string()];
+    out.push(force_diagram(o).to_string());
+    out.push(residuals(o).to_string());
     if o.termination.is_some() {
         out.push(height_change(o).to_string());
     }
@@ -442,17 +444,16 @@ pub fn assessment(
 ) -> Vec<(&'static str, String)> {
     let r = &a.result;
     let no_tau = vec![0.0; r.positions.len()];
-    let out = [
-        plan_forces_of(
-            &a.model.name,
-            a.model.mesh(),
-            &r.positions,
-            &r.force_densities,
-            &no_tau,
-        )
-        .to_string(),
-        section::section(a, at).to_string(),
-        envelope::shape_3d(a).to_string(),
-    ];
+    // One picture's element tree at a time.
+    let plan = plan_forces_of(
+        &a.model.name,
+        a.model.mesh(),
+        &r.positions,
+        &r.force_densities,
+        &no_tau,
+    )
+    .to_string();
+    let section = section::section(a, at).to_string();
+    let out = [plan, section, envelope::shape_3d(a).to_string()];
     ASSESSMENT.into_iter().zip(out).collect()
 }

@@ -231,7 +231,7 @@ pub fn assess<'py>(
     }
     let callback: Option<Py<PyAny>> = progress.filter(|p| !p.is_none()).map(Bound::unbind);
     let mut raised: Option<PyErr> = None;
-    let result = py.detach(|| {
+    let result = crate::solve::interruptible(py, || {
         let mut hook = |k: usize, infeasibility: f64| {
             Python::attach(|py| {
                 let step = || -> PyResult<bool> {
@@ -250,7 +250,7 @@ pub fn assess<'py>(
             })
         };
         voussoir::assess(m.problem(), &env, &s, Some(&mut hook))
-    });
+    })?;
     if let Some(e) = raised {
         return Err(e);
     }
@@ -359,7 +359,7 @@ pub fn min_thickness_of_family<'py>(
     let callback = envelope_at.unbind();
     let callback = &callback;
     let mut raised: Option<PyErr> = None;
-    let found = py.detach(|| {
+    let found = crate::solve::interruptible(py, || {
         let member = |t: f64| {
             Python::attach(|py| {
                 py.check_signals()
@@ -374,7 +374,7 @@ pub fn min_thickness_of_family<'py>(
             })
         };
         voussoir::min_thickness_of_family(m.problem(), member, thickness, scale_tolerance, &s)
-    });
+    })?;
     if let Some(e) = raised {
         return Err(e);
     }

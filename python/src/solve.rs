@@ -1,5 +1,7 @@
 //! The solves, with the GIL released; the progress hook re-attaches once per iteration to
-//! check for Ctrl-C and to call the user's callback, either of which may cancel.
+//! check for Ctrl-C and to call the user's callback, either of which may cancel. Within an
+//! iteration, the library's interrupt check (see [`interruptible`]) re-attaches every 50 ms or so
+//! to check for Ctrl-C, so that a long step is interrupted too.
 
 use crate::errors::{from_error, invalid};
 use crate::mesh::Mesh;
@@ -9,7 +11,33 @@ use numpy::{PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 use voussoir::report::Report;
+
+/// Runs `work` with the GIL released, interrupted by Ctrl-C: the library's interrupt check
+/// (called between its inner iterations, at most every `voussoir::interrupt::CHECK_INTERVAL`)
+/// re-attaches to run Python's signal handlers; the exception one raises (KeyboardInterrupt for
+/// Ctrl-C) abandons `work` and is returned.
+pub fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    let raised: Arc<Mutex<Option<PyErr>>> = Arc::default();
+    let seen = Arc::clone(&raised);
+    let done = py.detach(move || {
+        let check = move || match Python::attach(|py| py.check_signals()) {
+            Ok(()) => false,
+            Err(e) => {
+                *seen.lock().unwrap_or_else(|p| p.into_inner()) = Some(e);
+                true
+            }
+        };
+        voussoir::interrupt::interruptible(check, work)
+    });
+    let error = raised.lock().unwrap_or_else(|p| p.into_inner()).take();
+    match (done, error) {
+        (Some(r), _) => Ok(r),
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(())),
+    }
+}
 
 fn settings_of(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<voussoir::FormFindSettings> {
     match kwargs {
@@ -30,8 +58,7 @@ pub fn analyse<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let form = settings_of(settings)?;
     let m: &Mesh = mesh.get();
-    let stress = py
-        .detach(|| voussoir::analyse(m.problem(), &form.stress))
+    let stress = interruptible(py, || voussoir::analyse(m.problem(), &form.stress))?
         .map_err(|e| from_error("mesh", e))?;
     // A Ctrl-C during the solve is a KeyboardInterrupt now, not somewhere after.
     py.check_signals()?;
@@ -80,7 +107,7 @@ pub fn form_find<'py>(
     let callback: Option<Py<PyAny>> = progress.filter(|p| !p.is_none()).map(Bound::unbind);
     let m: &Mesh = mesh.get();
     let mut raised: Option<PyErr> = None;
-    let found = py.detach(|| {
+    let found = interruptible(py, || {
         let mut hook = |k: usize, eps: f64| {
             Python::attach(|py| match progress_step(py, callback.as_ref(), k, eps) {
                 Ok(go_on) => go_on,
@@ -91,7 +118,7 @@ pub fn form_find<'py>(
             })
         };
         voussoir::form_find(m.problem(), &form, Some(&mut hook))
-    });
+    })?;
     if let Some(e) = raised {
         return Err(e);
     }

@@ -214,6 +214,23 @@ def test_command_line_outputs_go_through_links_and_spare_inputs_and_fifos(tmp_pa
     assert json.loads((tmp_path / "real.json").read_text())["anchored"] == [0, 1, 2, 3]
 
 
+def test_command_line_refuses_a_repeated_option(tmp_path):
+    # Issue 48: a repeated option silently kept its last value; formfind refuses it (exit 2,
+    # naming the option) and so does the Python command line, with formfind's words.
+    square().write(tmp_path / "sq.obj")
+    for args, message in [
+        (["--max-iter", "3", "--max-iter", "4"], "--max-iter is given twice; give it once"),
+        (["--max-it", "3", "--max-iter=4"], "--max-iter is given twice; give it once"),
+        (["--stress-only", "--stress-only"], "--stress-only is given twice; give it once"),
+        (["--out", "a.obj", "--out", "b.obj"], "--out is given twice; give it once"),
+        (["--weld", "0.1", "--no-weld"], "--weld and --no-weld are both given; give one of them"),
+    ]:
+        done = run_cli("sq.obj", "--anchor-boundary", *args, cwd=tmp_path)
+        assert done.returncode == 2, done.stderr
+        assert done.stderr == f"voussoir: error: {message}\n"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["sq.obj"]
+
+
 def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):
     # An STL file repeats every vertex per triangle: the boundary is the welded mesh's.
     square().write(tmp_path / "square.stl")

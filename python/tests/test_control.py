@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import _thread
 import dataclasses
+import signal
 import subprocess
 import sys
 import threading
@@ -105,6 +106,46 @@ except KeyboardInterrupt:
                          timeout=300)
     assert out.stdout.strip() == "KeyboardInterrupt", out.stderr
     assert "PanicException" not in out.stderr, out.stderr
+
+
+LONG_SOLVE = """
+import sys, numpy as np, voussoir
+n = 400
+i, j = np.meshgrid(np.arange(n + 1) / n, np.arange(n + 1) / n)
+pos = np.stack([i.ravel(), j.ravel(), (0.3 - (i - 0.5) ** 2 - (j - 0.5) ** 2).ravel()], 1)
+k = (np.arange(n)[None, :] + (n + 1) * np.arange(n)[:, None]).ravel()
+faces = np.concatenate([np.stack([k, k + 1, k + n + 2], 1), np.stack([k, k + n + 2, k + n + 1], 1)])
+v = np.arange((n + 1) ** 2)
+rim = v[(v % (n + 1) == 0) | (v % (n + 1) == n) | (v // (n + 1) == 0) | (v // (n + 1) == n)]
+mesh = voussoir.Mesh(pos, faces, rim)
+print("solving", flush=True)
+try:
+    getattr(voussoir, sys.argv[1])(mesh)
+    print("finished")
+except KeyboardInterrupt:
+    print("KeyboardInterrupt")
+"""
+
+
+def test_ctrl_c_interrupts_a_long_stress_solve_within_it():
+    # Issue 48: Ctrl-C was seen between form-finding steps only, and by analyse once it had
+    # returned, so that one long stress solve (here a 400 x 400 grid's: minutes in a debug
+    # build) ran to its end first. The library now calls back every 50 ms or so from within a
+    # solve, and the callback runs Python's signal handlers.
+    child = subprocess.Popen([sys.executable, "-c", LONG_SOLVE, "analyse"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout.readline().strip() == "solving"
+        time.sleep(0.5)
+        child.send_signal(signal.SIGINT)
+        sent = time.perf_counter()
+        out, err = child.communicate(timeout=60)
+        waited = time.perf_counter() - sent
+    finally:
+        child.kill()
+    assert out.strip() == "KeyboardInterrupt", err
+    assert "PanicException" not in err, err
+    assert waited < 5, f"{waited:.1f} s from Ctrl-C to KeyboardInterrupt"
 
 
 def test_the_gil_is_released_while_solving(lilium):

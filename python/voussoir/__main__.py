@@ -50,6 +50,35 @@ def _bound(flag: str, text: str) -> Tuple[float, str]:
     return number, kind
 
 
+class _Once:
+    """An option's action that refuses a second use of the option (or of the other spelling of
+    the same setting: `--weld` and `--no-weld`), which would otherwise keep the last value
+    unseen; the formfind example's rule and messages."""
+
+    SAME = {"no_weld": "weld"}
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: Any, option_string: Optional[str] = None) -> None:
+        if self.option_strings:
+            flag = self.option_strings[0]
+            given: Dict[str, str] = namespace.__dict__.setdefault("_given", {})
+            first = given.setdefault(self.SAME.get(self.dest, self.dest), flag)
+            if first == flag and getattr(namespace, "_seen_" + self.dest, False):
+                raise Failure(f"{flag} is given twice; give it once")
+            if first != flag:
+                raise Failure(f"{first} and {flag} are both given; give one of them")
+            setattr(namespace, "_seen_" + self.dest, True)
+        super().__call__(parser, namespace, values, option_string)  # type: ignore[misc]
+
+
+class _OnceStore(_Once, argparse._StoreAction):
+    pass
+
+
+class _OnceStoreTrue(_Once, argparse._StoreTrueAction):
+    pass
+
+
 def parser() -> argparse.ArgumentParser:
     d = voussoir.defaults()
     # The library's names of each choice (those of the formfind example and the report);
@@ -61,6 +90,10 @@ def parser() -> argparse.ArgumentParser:
         description="The nearest self-supporting (compression-only) shape to a triangulated "
         "vault. Defaults in brackets are the library's.",
     )
+    # Every option at most once (argument groups share the parser's registry).
+    p.register("action", None, _OnceStore)
+    p.register("action", "store", _OnceStore)
+    p.register("action", "store_true", _OnceStoreTrue)
     p.add_argument("mesh", type=Path, help=".obj, .off, .stl or .ply (x, y plan; z up)")
     anchors = p.add_mutually_exclusive_group(required=True)
     anchors.add_argument("--supports", type=Path, help="JSON file of anchored vertex ids")
@@ -91,7 +124,11 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--holes", choices=names["holes"], help=f"[{d['holes']}]")
     p.add_argument("--dual-smoothing", type=float, help=f"force-diagram smoothing weight [{d['dual_length_smoothing']}]")
     p.add_argument("--smoothing-decay", type=float, help=f"decay of --dual-smoothing per step [{d['smoothing_decay']}]")
-    p.add_argument("--odt", type=int, help=f"ODT sweeps of the plan [{d['odt_iterations']}]")
+    p.add_argument("--odt", type=int,
+                   help="at most N ODT sweeps of the plan: the nearest method runs them on the input "
+                   "first; the paper method one before each of its first N stress steps; the first "
+                   f"sweep that does not improve the plan's triangles is undone and ends them "
+                   f"[{d['odt_iterations']}]")
     p.add_argument("--density", type=float, default=1.0, help="weight per unit area of every face [1]")
     p.add_argument("--load", choices=names["load_rule"], help=f"[{d['load_rule']}]")
     a = p.add_argument_group("assessment (instead of form finding; MESH is the middle surface)")

@@ -190,6 +190,7 @@ impl<'m, 'a> Search<'m, 'a> {
 
     /// One accepted step, or a larger ρ.
     fn iterate(&mut self, layout: &Layout) -> Outcome {
+        crate::interrupt::poll();
         let Some(step) = self.steered_step(layout) else {
             return self.reject();
         };

@@ -4,6 +4,9 @@
 //! the area of the 3-D triangle), one vertex at a time; its height is resampled from the
 //! surface as it was before the sweep. A move that would flip a plan triangle or leave the
 //! vertex's old fan is halved, up to six times, then abandoned: a plan triangle never flips.
+//! A sweep is kept only if it raises the plan's [`quality`]; the first that does not ends
+//! the smoothing ([`Odt`]), so any number of sweeps leaves the plan at least as good as
+//! fewer would.
 
 use crate::geometry::{cross, sub};
 use crate::mesh::Mesh;
@@ -49,6 +52,62 @@ fn height_in(positions: &[[f64; 3]], f: [u32; 3], u: [f64; 2]) -> Option<f64> {
     let lc = 1.0 - la - lb;
     let tol = -1e-12;
     (la >= tol && lb >= tol && lc >= tol).then(|| la * a[2] + lb * b[2] + lc * c[2])
+}
+
+/// The harmonic mean over the plan triangles of their quality 4√3·area / (sum of the squared
+/// edge lengths): 1 when every triangle is equilateral, towards 0 as any one becomes a sliver
+/// (the harmonic mean is dominated by the worst triangles).
+pub fn quality(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
+    let inverse: f64 = (mesh.faces.iter())
+        .map(|f| {
+            let [a, b, c] = f.map(|v| plan(positions[v as usize]));
+            let twice_area = cross(sub(b, a), sub(c, a));
+            let squares: f64 = [sub(b, a), sub(c, b), sub(a, c)]
+                .iter()
+                .map(|d| d[0] * d[0] + d[1] * d[1])
+                .sum();
+            squares / (2.0 * 3f64.sqrt() * twice_area.max(0.0))
+        })
+        .sum();
+    mesh.faces.len() as f64 / inverse
+}
+
+/// ODT smoothing in sweeps that each must raise the plan's [`quality`]: the first sweep that
+/// does not is undone and ends the smoothing.
+pub struct Odt {
+    fans: Vec<Vec<u32>>,
+    quality: f64,
+    move_free_boundary: bool,
+    done: bool,
+}
+
+impl Odt {
+    pub fn new(mesh: &Mesh, positions: &[[f64; 3]], move_free_boundary: bool) -> Odt {
+        Odt {
+            fans: vertex_faces(mesh),
+            quality: quality(mesh, positions),
+            move_free_boundary,
+            done: false,
+        }
+    }
+
+    /// One sweep of `positions`, kept if it raises the plan's quality (true); otherwise
+    /// `positions` are left as they were and every later call does nothing (false).
+    pub fn sweep(&mut self, mesh: &Mesh, positions: &mut [[f64; 3]]) -> bool {
+        if self.done {
+            return false;
+        }
+        let mut trial = positions.to_vec();
+        odt_sweep(mesh, &self.fans, &mut trial, self.move_free_boundary);
+        let q = quality(mesh, &trial);
+        if q > self.quality {
+            self.quality = q;
+            positions.copy_from_slice(&trial);
+        } else {
+            self.done = true;
+        }
+        !self.done
+    }
 }
 
 /// Faces around each vertex.

@@ -23,6 +23,7 @@ use crate::error::Result;
 use crate::geometry::Frame;
 use crate::problem::Problem;
 use crate::shape::ShapeStep;
+use crate::smooth::Odt;
 use crate::stress::{
     analyse_cached, EdgeScope, Prior, QpSolver, StressCache, StressResult, StressSettings,
     StressStatus,
@@ -169,9 +170,11 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let mut positions = mesh.positions.clone();
         let t = Instant::now();
         if settings.odt_iterations > 0 {
-            let fans = crate::smooth::vertex_faces(mesh);
+            let mut odt = Odt::new(mesh, &positions, settings.odt_free_boundary);
             for _ in 0..settings.odt_iterations {
-                crate::smooth::odt_sweep(mesh, &fans, &mut positions, settings.odt_free_boundary);
+                if !odt.sweep(mesh, &mut positions) {
+                    break;
+                }
             }
         }
         let shape = ShapeStep::new(mesh)?;

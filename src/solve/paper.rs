@@ -9,6 +9,7 @@ use super::{
 use crate::error::Result;
 use crate::problem::Problem;
 use crate::shape::ShapeStep;
+use crate::smooth::Odt;
 use crate::stress::{
     analyse_cached, Prior, StressCache, StressResult, StressSettings, StressStatus,
 };
@@ -71,7 +72,7 @@ pub(super) fn paper_within(
     let mut best_at = 0;
     let mut last: Option<StressResult> = None;
     let mut termination = Termination::MaxIterations;
-    let fans = crate::smooth::vertex_faces(mesh);
+    let mut odt = Odt::new(mesh, &positions, settings.odt_free_boundary);
     // The mesh keeps its connectivity: the steps share one ordering and symbolic analysis.
     // Large QPs are solved to coarse optimality: the loop's answer is certified by its own
     // residuals, not by the QPs' optimality (see `StressCache::for_form_finding`).
@@ -79,9 +80,11 @@ pub(super) fn paper_within(
     let (mut solvers, mut qp_iterations) = (Vec::new(), Vec::new());
     let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
+        // The plan moves only while sweeps raise its quality (docs/method.md §12).
+        let mut plan_settled = true;
         if k < settings.odt_iterations {
             let t = Instant::now();
-            crate::smooth::odt_sweep(mesh, &fans, &mut positions, settings.odt_free_boundary);
+            plan_settled = !odt.sweep(mesh, &mut positions);
             shape_s += t.elapsed().as_secs_f64();
         }
         let t = Instant::now();
@@ -91,13 +94,7 @@ pub(super) fn paper_within(
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         solvers.push(stress.solver);
         qp_iterations.push(stress.iterations);
-        let stress = keep_better(
-            stress,
-            last.take(),
-            &cache,
-            stress_settings,
-            k >= settings.odt_iterations,
-        );
+        let stress = keep_better(stress, last.take(), &cache, stress_settings, plan_settled);
         stress_s += t.elapsed().as_secs_f64();
         history.push(stress.eps_inf);
         let status = stress.status;

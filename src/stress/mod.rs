@@ -170,10 +170,12 @@ pub fn analyse_cached(
     cache: &mut StressCache,
 ) -> Result<StressResult> {
     settings.validate()?;
+    crate::interrupt::poll();
     let start = Instant::now();
     let mesh = &problem.mesh;
     let n = positions.len();
     let step = FramedStep::new(problem, positions, settings, cache.load_offset.as_deref())?;
+    crate::interrupt::poll();
     let (frame, plan, p_bar, unit) = (&step.frame, &step.plan, step.p_bar, step.unit);
     let l0 = frame.scale;
     let Attempts {

@@ -465,6 +465,7 @@ fn native_bound_rows(
     tau_col: &[Option<usize>],
     n: usize,
 ) -> (Csr, Vec<f64>, Vec<usize>) {
+    crate::interrupt::poll();
     let mut ineq = Csr::new(n);
     let mut h = Vec::new();
     let mut lower_row = vec![usize::MAX; inp.edges.len()];
@@ -498,6 +499,7 @@ pub fn solve_native(
     coarse: bool,
     inexact: Option<f64>,
 ) -> QpOutput {
+    crate::interrupt::poll();
     let n_y = inp.s.ncols;
     let (tau_col, n_tau) = tau_columns(inp, n_y);
     let n = n_y + n_tau;

@@ -84,10 +84,12 @@ pub(crate) fn bucketed<I: Iterator<Item = (usize, usize)>>(
     nnz: usize,
     entries: impl Fn() -> I,
 ) -> (Vec<usize>, Vec<usize>) {
+    crate::interrupt::poll();
     let mut ptr = vec![0; n + 1];
     for (col, _) in entries() {
         ptr[col + 1] += 1;
     }
+    crate::interrupt::poll();
     for c in 0..n {
         ptr[c + 1] += ptr[c];
     }

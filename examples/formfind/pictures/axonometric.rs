@@ -125,12 +125,7 @@ pub(super) fn shaded_faces(
     base: &[[f64; 3]],
     id: &str,
 ) -> Group {
-    let mut g = Group::new()
-        .set("id", id)
-        .set("fill", "currentColor")
-        .set("stroke", "currentColor")
-        .set("stroke-width", 0.5)
-        .set("stroke-linejoin", "round");
+    let mut g = draw::Bulk::default();
     for t in back_to_front(mesh, pos, projection) {
         let corners = mesh.faces[t].map(|v| pos[v as usize]);
         let points: Vec<String> = corners
@@ -147,7 +142,14 @@ pub(super) fn shaded_faces(
                 .set("color", draw::hex(base[t].map(|c| c * k))),
         );
     }
-    g
+    g.into_group(
+        Group::new()
+            .set("id", id)
+            .set("fill", "currentColor")
+            .set("stroke", "currentColor")
+            .set("stroke-width", 0.5)
+            .set("stroke-linejoin", "round"),
+    )
 }
 
 /// Per face: the mean height change of its vertices.

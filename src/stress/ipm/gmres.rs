@@ -27,6 +27,7 @@ pub(super) fn cycle(
     let mut g = vec![beta];
     let mut residual = beta;
     for j in 0..k {
+        crate::interrupt::poll();
         let mut w = op(&basis[j]);
         let w_norm = norm(&w);
         // Modified Gram–Schmidt, twice: the basis must stay orthogonal to the last digits

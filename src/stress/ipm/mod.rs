@@ -545,6 +545,7 @@ fn interior_point(
     let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
     let mut iterations = budget;
     for iteration in 0..budget {
+        crate::interrupt::poll();
         let kkt = Kkt::new(qp, normal, &it.x, &it.lambda, &it.s, &it.z);
         if !kkt.objective.is_finite() || inf_norm(&it.x) > 1e15 {
             return stopped(it.x, iteration, almost);

@@ -159,6 +159,7 @@ impl<'a> Dissection<'a> {
     /// Appends `part` to the order: both sides first, recursively, then the separator.
     /// `level` counts the cuts above it.
     fn dissect(&mut self, part: Vec<usize>, level: usize) {
+        crate::interrupt::poll();
         if part.len() <= LEAF {
             return self.order_leaf(&part);
         }

@@ -178,6 +178,9 @@ pub(super) fn product_slots(
     // The row's entries in label order, and the k × k table of their products' slots.
     let (mut by_label, mut table) = (Vec::new(), Vec::new());
     for r in 0..m.nrows() {
+        if r % 1024 == 0 {
+            crate::interrupt::poll();
+        }
         let cols = &m.col[m.start[r]..m.start[r + 1]];
         let k = cols.len();
         by_label.clear();
@@ -288,6 +291,7 @@ impl Pattern {
             dense.kept(cons, Source::Cons),
         ];
         let (col_ptr, row_idx) = product_pattern([&kept[0], &kept[1]], n);
+        crate::interrupt::poll();
         // One symbolic analysis in the new labels: the ordering alone comes from AMD or the
         // dissection, so that the pattern is not analysed twice.
         let label = match positions {
