@@ -284,7 +284,7 @@ fn fields<'py>(
     d.set_item("termination_detail", detail)?;
     d.set_item("iterations", r.iterations)?;
     d.set_item("positions", matrix(py, &r.positions))?;
-    let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
+    let edges: Vec<[u32; 2]> = mesh.edges().iter().map(|e| e.v).collect();
     d.set_item("edges", matrix(py, &edges))?;
     d.set_item(
         "force_densities",

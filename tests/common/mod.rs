@@ -88,16 +88,18 @@ pub fn holed_disk(seed: u64, max_area: f64, anchor: impl Fn([f64; 2], bool) -> b
 /// keeping the plan valid (Mesh::new validates), so the mesh is no longer Delaunay.
 pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
     let mut rng = Rng::new(seed);
-    let mut pos = mesh.positions.clone();
+    let mut pos = mesh.positions().to_vec();
     for (v, p) in pos.iter_mut().enumerate() {
-        if mesh.on_boundary[v] || !mesh.referenced[v] {
+        if mesh.on_boundary()[v] || !mesh.referenced()[v] {
             continue;
         }
         let h = mesh
             .edges_at(v)
             .iter()
             .map(|&e| {
-                let [a, b] = mesh.edges[e as usize].v.map(|x| mesh.positions[x as usize]);
+                let [a, b] = mesh.edges()[e as usize]
+                    .v
+                    .map(|x| mesh.positions()[x as usize]);
                 (a[0] - b[0]).hypot(a[1] - b[1])
             })
             .fold(f64::INFINITY, f64::min);
@@ -105,7 +107,7 @@ pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
         p[1] += amount * h * rng.uniform(-1.0, 1.0);
     }
     let anchored: Vec<u32> = (0..pos.len() as u32)
-        .filter(|&v| mesh.anchored[v as usize])
+        .filter(|&v| mesh.anchored()[v as usize])
         .collect();
-    Mesh::new(pos, mesh.faces.clone(), &anchored).expect("jiggled mesh stays valid")
+    Mesh::new(pos, mesh.faces().to_vec(), &anchored).expect("jiggled mesh stays valid")
 }
