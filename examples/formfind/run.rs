@@ -53,7 +53,7 @@ impl Outcome {
             None => Run::Analysis(&self.before),
         };
         let mut report = Report::new(&self.model.read, settings, run);
-        report.settings.supports = self.model.supports.clone();
+        report.settings.read.supports = self.model.supports.clone();
         report
     }
 }
