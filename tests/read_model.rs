@@ -29,17 +29,28 @@ const MODELS: [&str; 9] = [
     "three_pillar",
     "vault_pq",
 ];
-const FORMATS: [&str; 4] = ["obj", "off", "ply", "stl"];
+/// Every format `read_mesh` reads: its extension, and `-ascii` for the text variant of a
+/// binary one (3MF is written only).
+const FORMATS: [&str; 6] = ["obj", "off", "ply", "ply-ascii", "stl", "stl-ascii"];
 
 fn c(path: &Path) -> CString {
     CString::new(path.to_str().unwrap()).unwrap()
 }
 
-/// The model `name` written in `format` into `dir`, and its supports file.
+/// The model `name` written in `format` (one of [`FORMATS`]) into `dir`.
 fn model_file(models: &Path, dir: &Scratch, name: &str, format: &str) -> std::path::PathBuf {
     let (positions, faces) = io::read_mesh(&models.join(format!("{name}.obj"))).unwrap();
-    let path = dir.path(&format!("{name}.{format}"));
-    io::write_mesh(&path, &positions, &faces).unwrap();
+    let (extension, ascii) = match format.strip_suffix("-ascii") {
+        Some(e) => (e, true),
+        None => (format, false),
+    };
+    let path = dir.path(&format!("{name}-{format}.{extension}"));
+    let kind = io::MeshFormat::from_path(&path).unwrap();
+    let kind = if ascii { kind.ascii() } else { kind };
+    io::write_mesh_as(&path, kind, &positions, &faces).unwrap();
+    if format != "obj" && format != "off" {
+        assert_eq!(fs::read(&path).unwrap().is_ascii(), ascii, "{format}");
+    }
     path
 }
 
