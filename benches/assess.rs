@@ -34,7 +34,7 @@ fn row(name: &str, mesh: &Mesh, thickness: f64, objective: Objective) {
     let end = format!("{:?}", r.termination);
     println!(
         "| {name} | {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.1e} | {:.2} |",
-        mesh.positions.len(),
+        mesh.positions().len(),
         objective.as_str(),
         end.split([' ', '{']).next().unwrap_or(""),
         r.feasible,
@@ -89,7 +89,7 @@ fn models() {
         .unwrap()
         .mesh;
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in &mesh.positions {
+        for p in mesh.positions() {
             for d in 0..2 {
                 lo[d] = lo[d].min(p[d]);
                 hi[d] = hi[d].max(p[d]);
@@ -115,7 +115,7 @@ fn shell_family(
     t: f64,
 ) -> voussoir::Result<Envelope> {
     let (lower, upper) = mesh
-        .positions
+        .positions()
         .iter()
         .map(|&p| shell_bounds(radius(p), t))
         .unzip();
@@ -154,7 +154,7 @@ fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classic
     match min_thickness_of_family(&problem, family, 0.1, 1e-3, &settings) {
         Ok(f) => println!(
             "| {name} | {} | {:.4} | {classical} | {:+.1}% | {} | {} | {:.1e} | {:.1} |",
-            mesh.positions.len(),
+            mesh.positions().len(),
             f.thickness,
             100.0 * (f.thickness / classical - 1.0),
             f.rounds,
@@ -162,7 +162,7 @@ fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classic
             f.result.eps_inf,
             f.result.seconds
         ),
-        Err(e) => println!("| {name} | {} | error: {e} |", mesh.positions.len()),
+        Err(e) => println!("| {name} | {} | error: {e} |", mesh.positions().len()),
     }
 }
 

@@ -21,8 +21,8 @@ use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Pr
 /// the library.
 fn height_difference(mesh: &Mesh, a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
     let mut share = vec![0.0; a.len()];
-    for f in &mesh.faces {
-        let [p, q, r] = f.map(|v| mesh.positions[v as usize]);
+    for f in mesh.faces() {
+        let [p, q, r] = f.map(|v| mesh.positions()[v as usize]);
         let area = ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs() / 6.0;
         f.iter().for_each(|&v| share[v as usize] += area);
     }
@@ -71,7 +71,7 @@ fn known(seeds: u64, sizes: &[usize]) {
                 for seed in 0..seeds {
                     let input = generate::perturb(&truth, kind, seed);
                     let (truth_rms, truth_max) =
-                        height_difference(&input, &truth.positions, &input.positions);
+                        height_difference(&input, truth.positions(), input.positions());
                     for (k, method) in [FormMethod::Nearest, FormMethod::Paper]
                         .into_iter()
                         .enumerate()
@@ -81,14 +81,14 @@ fn known(seeds: u64, sizes: &[usize]) {
                         let problem = Problem::new(input.clone());
                         let r = form_find(&problem, &s, None).expect("form finding");
                         let secs = t.elapsed().as_secs_f64();
-                        let (rms, max) = height_difference(&input, &r.positions, &input.positions);
+                        let (rms, max) = height_difference(&input, &r.positions, input.positions());
                         let (ra, rm) = (rms / truth_rms, max / truth_max);
                         if outcome(&r) == "Converged" {
                             worst[k] = (worst[k].0.max(ra), worst[k].1.max(rm));
                         }
                         println!(
                             "| {plan:?} | {} | {kind:?} | {seed} | {} | {} | {} | {secs:.2} | {ra:.3} | {rm:.3} | {:.4} |",
-                            input.positions.len(),
+                            input.positions().len(),
                             method_name(method),
                             outcome(&r),
                             r.iterations,
@@ -108,9 +108,9 @@ fn known(seeds: u64, sizes: &[usize]) {
 fn plan_diagonal(mesh: &Mesh) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for (p, _) in mesh
-        .positions
+        .positions()
         .iter()
-        .zip(&mesh.referenced)
+        .zip(mesh.referenced())
         .filter(|(_, r)| **r)
     {
         for d in 0..2 {
@@ -178,7 +178,7 @@ fn model_list(large: bool) -> Vec<(String, Problem)> {
     }
     for n in generated {
         let mesh = generate::dome_with_hole(n).expect("dome");
-        let name = format!("gen. dome_with_hole {}", mesh.positions.len());
+        let name = format!("gen. dome_with_hole {}", mesh.positions().len());
         list.push((name, Problem::new(mesh)));
     }
     list
@@ -211,7 +211,7 @@ fn models(large: bool) {
             let warm = r.qp_iterations.iter().filter(|&&k| k == 0).count();
             println!(
                 "| {name} | {} | {cold:.4} ({cold_its}) | {} | {} | {} | {its} | {warm} | {} | {secs:.2} | {:.1} | {:.4} | {:.4} | {:.4} | {:.4} |",
-                problem.mesh.positions.len(),
+                problem.mesh.positions().len(),
                 method_name(method),
                 outcome(&r),
                 r.iterations,

@@ -36,7 +36,7 @@ fn certificate(problem: &Problem, x: &[[f64; 3]], s: &StressResult) -> (f64, f64
     let q = &s.force_densities;
     let n = x.len();
     let (mut rv, mut rh) = (vec![0.0; n], vec![[0.0; 2]; n]);
-    for (e, edge) in mesh.edges.iter().enumerate() {
+    for (e, edge) in mesh.edges().iter().enumerate() {
         let [i, j] = edge.v.map(|v| v as usize);
         for (a, b) in [(i, j), (j, i)] {
             rv[a] += q[e] * (x[a][2] - x[b][2]);
@@ -45,7 +45,7 @@ fn certificate(problem: &Problem, x: &[[f64; 3]], s: &StressResult) -> (f64, f64
         }
     }
     let free: Vec<usize> = (0..n)
-        .filter(|&v| mesh.referenced[v] && !mesh.anchored[v])
+        .filter(|&v| mesh.referenced()[v] && !mesh.anchored()[v])
         .collect();
     let p_bar = free.iter().map(|&v| s.loads[v]).sum::<f64>() / free.len() as f64;
     let (mut eps, mut h, mut sum) = (0.0f64, 0.0f64, 0.0);
@@ -106,9 +106,9 @@ fn main() {
         );
         row(name, &how, &problem, &r.positions, &r.stress);
         let path = out.join(format!("{name}.obj"));
-        io::write_obj(&path, &r.positions, &problem.mesh.faces).expect("written");
+        io::write_obj(&path, &r.positions, problem.mesh.faces()).expect("written");
         let back = io::load_model(Path::new(&path), &supports).expect("read back");
-        let x = &back.mesh.positions;
+        let x = &back.mesh.positions();
         for (how, solver, formulation) in [
             ("afresh, default", QpSolver::Native, Formulation::Reduced),
             (

@@ -85,9 +85,9 @@ fn variable_load_dome(n: usize) -> Problem {
     )
     .expect("dome");
     let mut problem = Problem::new(mesh);
-    for (f, face) in problem.mesh.faces.iter().enumerate() {
+    for (f, face) in problem.mesh.faces().iter().enumerate() {
         let c = face.iter().fold([0.0, 0.0], |c, &v| {
-            let p = problem.mesh.positions[v as usize];
+            let p = problem.mesh.positions()[v as usize];
             [c[0] + p[0] / 3.0, c[1] + p[1] / 3.0]
         });
         if c[0].hypot(c[1]) < 0.5 {
@@ -283,7 +283,12 @@ fn paper_table(dir: Option<&Path>) {
             continue;
         };
         let m = &problem.mesh;
-        let size = format!("{};{};{}", m.positions.len(), m.edges.len(), m.faces.len());
+        let size = format!(
+            "{};{};{}",
+            m.positions().len(),
+            m.edges().len(),
+            m.faces().len()
+        );
         let rn = step(&problem, Formulation::Reduced, QpSolver::Native);
         let rc = step(&problem, Formulation::Reduced, QpSolver::Clarabel);
         let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
@@ -342,9 +347,9 @@ fn shared_models_table(dir: &Path) {
         let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
         println!(
             "| {name} | {};{};{} | {} | {} | {} | {} |",
-            m.positions.len(),
-            m.edges.len(),
-            m.faces.len(),
+            m.positions().len(),
+            m.edges().len(),
+            m.faces().len(),
             m.holes().count(),
             cell(rn, true),
             cell(en, true),
@@ -381,7 +386,7 @@ fn scaling(large: bool, large_ff: bool) {
     let mut reduced = Vec::new();
     for &n in sizes {
         let problem = Problem::new(dome_with_hole(n));
-        let v = problem.mesh.positions.len();
+        let v = problem.mesh.positions().len();
         let rn = step(&problem, Formulation::Reduced, QpSolver::Native);
         let rss = peak_rss_mib();
         points.push((v as f64, rn.seconds));
@@ -401,7 +406,7 @@ fn scaling(large: bool, large_ff: bool) {
         };
         println!(
             "| {v} | {} | {} | {:?} | {rss:.0} | {ff} |",
-            problem.mesh.edges.len(),
+            problem.mesh.edges().len(),
             cell(rn, true),
             rn.solver,
         );
@@ -423,7 +428,7 @@ fn scaling(large: bool, large_ff: bool) {
         let en = step(&problem, Formulation::EdgeBased, QpSolver::Native);
         println!(
             "| {} | {} | {} | {} | {:.0} |",
-            problem.mesh.positions.len(),
+            problem.mesh.positions().len(),
             cell(rn, true),
             cell(en, true),
             if_solved(en.seconds / rn.seconds, 1, &[en, rn]),

@@ -1,6 +1,7 @@
 //! The one set of names of the enumerated settings and outcomes, used by the command lines,
 //! Python's keyword settings and results, and the report: `as_str`, `Display`, `FromStr`
-//! (which takes `-` for `_`, so `edge-based` is `edge_based`) and `Serialize` as the name.
+//! (which takes `-` and `_` alike, so `edge-based` is `edge_based` and `min_thickness` is
+//! `min-thickness`) and `Serialize` as the name.
 
 use crate::error::{Error, Result};
 
@@ -12,8 +13,7 @@ macro_rules! names {
             /// Every value, in the order of their names in error messages.
             pub const ALL: &'static [$ty] = &[$(<$ty>::$variant),*];
 
-            /// The value's name (snake_case), as the command lines, Python and the report
-            /// spell it.
+            /// The value's name, as the command lines, Python and the report spell it.
             pub fn as_str(self) -> &'static str {
                 match self {
                     $(Self::$variant => $name),*
@@ -52,10 +52,10 @@ fn parse<T: Copy>(
     all: &[T],
     name: impl Fn(T) -> &'static str,
 ) -> Result<T> {
-    let key = text.replace('-', "_");
+    let key = |name: &str| name.replace('-', "_");
     all.iter()
         .copied()
-        .find(|&v| name(v) == key)
+        .find(|&v| key(name(v)) == key(text))
         .ok_or_else(|| {
             let names: Vec<String> = all.iter().map(|&v| format!("'{}'", name(v))).collect();
             Error::InvalidArgument {
@@ -88,6 +88,13 @@ names!(crate::StressStatus, "status" {
     NumericalError => "numerical_error",
 });
 names!(crate::io::UpAxis, "up" { Z => "z", Y => "y" });
+names!(crate::Objective, "objective" {
+    Fit => "fit",
+    MinThickness => "min-thickness",
+    MinThrust => "min-thrust",
+    MaxThrust => "max-thrust",
+    MaxLoad => "max-load",
+});
 
 impl crate::Termination {
     /// The termination's name (snake_case), as Python and the report spell it; its
@@ -108,7 +115,7 @@ impl crate::Termination {
 
 #[cfg(test)]
 mod tests {
-    use crate::{EdgeScope, Error, Formulation, LoadRule, QpSolver, TauMode};
+    use crate::{EdgeScope, Error, Formulation, LoadRule, Objective, QpSolver, TauMode};
 
     #[test]
     fn names_read_back_and_list_the_choices() {
@@ -133,5 +140,40 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert!("All".parse::<EdgeScope>().is_err());
+    }
+
+    /// The assessment's objectives keep their hyphens, and read back either way.
+    #[test]
+    fn objectives_are_hyphenated() {
+        let names: Vec<&str> = Objective::ALL.iter().map(|o| o.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "fit",
+                "min-thickness",
+                "min-thrust",
+                "max-thrust",
+                "max-load"
+            ]
+        );
+        for &o in Objective::ALL {
+            assert_eq!(o.as_str().parse::<Objective>(), Ok(o));
+        }
+        assert_eq!("min_thickness".parse(), Ok(Objective::MinThickness));
+        assert_eq!(
+            serde_json::to_string(&Objective::MaxLoad).unwrap(),
+            r#""max-load""#
+        );
+        match "least".parse::<Objective>() {
+            Err(Error::InvalidArgument { name, reason }) => {
+                assert_eq!(name, "objective");
+                assert_eq!(
+                    reason,
+                    "'least' is not one of 'fit', 'min-thickness', 'min-thrust', 'max-thrust', \
+                     'max-load'"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -71,11 +71,11 @@ fn anchored(mesh: &crate::Mesh) -> Vec<u32> {
         .collect()
 }
 
-/// How the input was read and solved: the read options and what they did, then every solver
-/// setting under its Python keyword name (`q_min`, `qp_solver`, `schedule`, ...).
+/// How the input was read, the first settings of every report: the read options and what
+/// they did.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
-pub struct ReportSettings {
+pub struct ReadSettings {
     /// Where the mesh came from (its path).
     pub mesh: String,
     /// How the supports were chosen.
@@ -89,6 +89,79 @@ pub struct ReportSettings {
     pub up: UpAxis,
     /// The number of polygon diagonals, which q_min does not bind.
     pub polygon_diagonals: usize,
+}
+
+impl ReadSettings {
+    /// The read settings of `model`.
+    pub(crate) fn of(model: &Model) -> ReadSettings {
+        ReadSettings {
+            mesh: model.source.clone(),
+            supports: model.options.supports.to_string(),
+            weld: model.weld.clone(),
+            repair_tolerance: model.options.repair_tolerance,
+            up: model.options.up,
+            polygon_diagonals: model.diagonals.len(),
+        }
+    }
+}
+
+/// How a run ended, in every report.
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct Ending {
+    /// The termination's name ([`crate::Termination::name`]), or `stress_only`.
+    pub termination: &'static str,
+    /// The termination as a sentence.
+    pub termination_message: String,
+    /// The vertices a `stalled` or `blocked` termination lists.
+    pub termination_vertices: Vec<u32>,
+    /// The constraint to relax (`infeasible`), the failure (`numerical_error`) or what blocks
+    /// (`blocked`).
+    pub termination_detail: Option<String>,
+}
+
+impl Ending {
+    /// The ending of a form finding or an assessment: the vertices a `stalled` or `blocked`
+    /// termination lists, the constraint to relax, the failure or what blocks.
+    pub(crate) fn of(t: &crate::Termination) -> Ending {
+        use crate::Termination::*;
+        let (vertices, detail) = match t {
+            Stalled { vertices } => (vertices.clone(), None),
+            Blocked { vertices, hint } => (vertices.clone(), Some(hint.clone())),
+            Infeasible { constraint } => (vec![], Some(constraint.clone())),
+            NumericalError { what } => (vec![], Some(what.clone())),
+            _ => (vec![], None),
+        };
+        Ending {
+            termination: t.name(),
+            termination_message: t.to_string(),
+            termination_vertices: vertices,
+            termination_detail: detail,
+        }
+    }
+
+    /// The ending of `run`: `stress_only` for an analysis.
+    fn of_run(run: Run<'_>) -> Ending {
+        match run {
+            Run::Analysis(s) => Ending {
+                termination: "stress_only",
+                termination_message: format!("stress analysis: {}", s.status),
+                termination_vertices: vec![],
+                termination_detail: None,
+            },
+            Run::FormFinding(f) => Ending::of(&f.termination),
+        }
+    }
+}
+
+/// How the input was read and solved: the read options and what they did, then every solver
+/// setting under its Python keyword name (`q_min`, `qp_solver`, `schedule`, ...).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct ReportSettings {
+    /// How the input was read.
+    #[serde(flatten)]
+    pub read: ReadSettings,
     /// Whether only the stress of the input shape was computed.
     pub stress_only: bool,
     /// The face density, when it is the same on every face (null otherwise).
@@ -108,15 +181,9 @@ pub struct ReportSettings {
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct Report {
-    /// The termination's name ([`crate::Termination::name`]), or `stress_only`.
-    pub termination: &'static str,
-    /// The termination as a sentence.
-    pub termination_message: String,
-    /// The vertices a `stalled` or `blocked` termination lists.
-    pub termination_vertices: Vec<u32>,
-    /// The constraint to relax (`infeasible`), the failure (`numerical_error`) or what blocks
-    /// (`blocked`).
-    pub termination_detail: Option<String>,
+    /// How the run ended.
+    #[serde(flatten)]
+    pub ending: Ending,
     /// How the final stress step ended.
     pub stress_status: StressStatus,
     /// The QP solver that produced the final forces.
@@ -189,7 +256,6 @@ impl Report {
             Run::Analysis(s) => (s, &mesh.positions),
             Run::FormFinding(f) => (&f.stress, &f.positions),
         };
-        let (termination, message, vertices, detail) = termination(run);
         let (history, iterations, solvers) = match run {
             Run::Analysis(s) => (vec![s.eps_inf], 1, vec![s.solver]),
             Run::FormFinding(f) => (f.history.clone(), f.iterations, f.solvers.clone()),
@@ -204,12 +270,7 @@ impl Report {
         let density = p.face_density.first().copied();
         let uniform = p.face_density.iter().all(|d| Some(*d) == density);
         let report_settings = ReportSettings {
-            mesh: model.source.clone(),
-            supports: model.options.supports.to_string(),
-            weld: model.weld.clone(),
-            repair_tolerance: model.options.repair_tolerance,
-            up: model.options.up,
-            polygon_diagonals: model.diagonals.len(),
+            read: ReadSettings::of(model),
             stress_only: matches!(run, Run::Analysis(_)),
             density: density.filter(|_| uniform),
             solver: settings.clone(),
@@ -217,10 +278,7 @@ impl Report {
             regularisation_used: stress.regularisation,
         };
         Report {
-            termination,
-            termination_message: message,
-            termination_vertices: vertices,
-            termination_detail: detail,
+            ending: Ending::of_run(run),
             stress_status: stress.status,
             qp_solver_used: stress.solver,
             iterations,
@@ -268,33 +326,6 @@ impl Report {
     pub fn to_json(&self) -> String {
         json_text(self)
     }
-}
-
-/// (name, sentence, vertices, detail) of a run's ending.
-fn termination(run: Run<'_>) -> (&'static str, String, Vec<u32>, Option<String>) {
-    match run {
-        Run::Analysis(s) => (
-            "stress_only",
-            format!("stress analysis: {}", s.status),
-            vec![],
-            None,
-        ),
-        Run::FormFinding(f) => termination_fields(&f.termination),
-    }
-}
-
-/// (name, sentence, vertices, detail) of a termination: the vertices a `stalled` or `blocked`
-/// one lists, the constraint to relax, the failure or what blocks.
-fn termination_fields(t: &crate::Termination) -> (&'static str, String, Vec<u32>, Option<String>) {
-    use crate::Termination::*;
-    let (vertices, detail) = match t {
-        Stalled { vertices } => (vertices.clone(), None),
-        Blocked { vertices, hint } => (vertices.clone(), Some(hint.clone())),
-        Infeasible { constraint } => (vec![], Some(constraint.clone())),
-        NumericalError { what } => (vec![], Some(what.clone())),
-        _ => (vec![], None),
-    };
-    (t.name(), t.to_string(), vertices, detail)
 }
 
 /// JSON text with one top-level key per line: objects indented, arrays on one line, numbers

@@ -8,12 +8,12 @@ use voussoir::internals::{edge_normal, power_centre, AiryOperator, Frame, Plan};
 use voussoir::{HoleMode, Mesh};
 
 fn setup(mesh: &Mesh) -> Plan {
-    Plan::new(mesh, &mesh.positions, &Frame::of(mesh, &mesh.positions))
+    Plan::new(mesh, mesh.positions(), &Frame::of(mesh, mesh.positions()))
 }
 
 /// (W) written out per edge from the cotangents of both faces.
 fn closed_form_w(mesh: &Mesh, plan: &Plan, w: &[f64], e: usize) -> f64 {
-    let edge = &mesh.edges[e];
+    let edge = &mesh.edges()[e];
     let (t1, t2) = (edge.left.unwrap(), edge.right.unwrap());
     let [i, j] = edge.v;
     let l2 = plan.length[e].powi(2);
@@ -44,12 +44,12 @@ fn closed_forms_equal_power_centre_dual_lengths_on_non_delaunay_meshes() {
             .collect();
         let scale = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut negative = 0;
-        for (e, edge) in mesh.edges.iter().enumerate() {
+        for (e, edge) in mesh.edges().iter().enumerate() {
             let (Some(t1), Some(t2)) = (edge.left, edge.right) else {
                 continue;
             };
             let centre = |t: u32| {
-                let f = mesh.faces[t as usize];
+                let f = mesh.faces()[t as usize];
                 power_centre(f.map(|v| plan.u[v as usize]), f.map(|v| w[v as usize]))
             };
             let (c1, c2) = (centre(t1.face), centre(t2.face));
@@ -98,13 +98,13 @@ fn interior_vertices_balance_exactly_for_random_airy_values_and_hole_jumps() {
                 .collect();
             let q = op.s.mul(&y);
             let mut worst = 0.0f64;
-            for v in 0..mesh.positions.len() {
-                if mesh.on_boundary[v] || !mesh.referenced[v] {
+            for v in 0..mesh.positions().len() {
+                if mesh.on_boundary()[v] || !mesh.referenced()[v] {
                     continue;
                 }
                 let (mut f, mut size) = ([0.0; 2], 0.0);
                 for &e in mesh.edges_at(v) {
-                    let edge = &mesh.edges[e as usize];
+                    let edge = &mesh.edges()[e as usize];
                     let other = if edge.v[0] as usize == v {
                         edge.v[1]
                     } else {

@@ -28,12 +28,12 @@ fn fan(n: usize, r: f64, rise: f64) -> Mesh {
 /// bounds are exactly z − below and z + above at every vertex.
 fn shifted_envelope(mesh: &Mesh, below: f64, above: f64) -> Envelope {
     let shift = |d: f64| -> Vec<[f64; 3]> {
-        (mesh.positions.iter())
+        (mesh.positions().iter())
             .map(|p| [p[0], p[1], p[2] + d])
             .collect()
     };
     let (lo, hi) = (shift(-below), shift(above));
-    Envelope::from_surfaces(mesh, (&lo, &mesh.faces), (&hi, &mesh.faces)).unwrap()
+    Envelope::from_surfaces(mesh, (&lo, mesh.faces()), (&hi, mesh.faces())).unwrap()
 }
 
 fn run(mesh: Mesh, envelope: &Envelope, settings: AssessSettings) -> AssessResult {
@@ -45,9 +45,9 @@ fn run(mesh: Mesh, envelope: &Envelope, settings: AssessSettings) -> AssessResul
 /// which are the envelope's scaled about its middle by the reported scale.
 fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, tolerance: f64) {
     assert!(r.feasible, "not certified: {:?}", r.termination);
-    let n = mesh.positions.len();
+    let n = mesh.positions().len();
     let mut residual = vec![0.0; n];
-    for (e, edge) in mesh.edges.iter().enumerate() {
+    for (e, edge) in mesh.edges().iter().enumerate() {
         let [i, j] = edge.v.map(|v| v as usize);
         let q = r.force_densities[e];
         assert!(q >= 0.0, "edge {e} in tension: q = {q}");
@@ -55,7 +55,7 @@ fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, toleran
         residual[i] += q * dz;
         residual[j] -= q * dz;
     }
-    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored[v]).collect();
+    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored()[v]).collect();
     let mean = free.iter().map(|&v| r.loads[v]).sum::<f64>() / free.len() as f64;
     let eps = free
         .iter()
@@ -81,13 +81,17 @@ fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, toleran
             z >= lo - 1e-9 * diag && z <= hi + 1e-9 * diag,
             "vertex {v} at {z} outside [{lo}, {hi}]"
         );
-        assert_eq!(&r.positions[v][..2], &mesh.positions[v][..2], "plan moved");
+        assert_eq!(
+            &r.positions[v][..2],
+            &mesh.positions()[v][..2],
+            "plan moved"
+        );
     }
 }
 
 fn plan_diagonal(mesh: &Mesh) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &mesh.positions {
+    for p in mesh.positions() {
         for d in 0..2 {
             lo[d] = lo[d].min(p[d]);
             hi[d] = hi[d].max(p[d]);
@@ -141,7 +145,7 @@ fn a_self_supporting_middle_surface_is_its_own_nearest_thrust_surface() {
     let envelope = Envelope::from_thickness(&truth, &Thickness::Uniform(0.05)).unwrap();
     let result = run(truth.clone(), &envelope, AssessSettings::default());
     check_certificate(&truth, &envelope, &result, 1e-6);
-    let moved = (truth.positions.iter().zip(&result.positions))
+    let moved = (truth.positions().iter().zip(&result.positions))
         .map(|(a, b)| (a[2] - b[2]).abs())
         .fold(0.0, f64::max);
     assert!(moved < 1e-4, "moved {moved}");
@@ -220,12 +224,12 @@ fn unit_weight_scales_forces_not_the_surface() {
 fn max_load_is_certified_with_its_factor() {
     let mesh = generate::cap_dome(0.9, 120).unwrap();
     let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.15)).unwrap();
-    let n = mesh.positions.len();
+    let n = mesh.positions().len();
     // A point load on the free vertex nearest (0.4, 0).
     let target = (0..n)
-        .filter(|&v| !mesh.anchored[v])
+        .filter(|&v| !mesh.anchored()[v])
         .min_by(|&a, &b| {
-            let d = |v: usize| (mesh.positions[v][0] - 0.4).hypot(mesh.positions[v][1]);
+            let d = |v: usize| (mesh.positions()[v][0] - 0.4).hypot(mesh.positions()[v][1]);
             d(a).total_cmp(&d(b))
         })
         .unwrap();
@@ -255,24 +259,24 @@ fn bad_envelopes_and_settings_are_named() {
         let e = Envelope::from_thickness(&mesh, &Thickness::Uniform(t)).unwrap_err();
         assert!(message(e).contains("thickness"), "{t}");
     }
-    let wrong = Thickness::PerFace(vec![0.1; mesh.faces.len() - 1]);
+    let wrong = Thickness::PerFace(vec![0.1; mesh.faces().len() - 1]);
     assert!(message(Envelope::from_thickness(&mesh, &wrong).unwrap_err()).contains("per face"));
     // Intrados above extrados at every vertex.
-    let up: Vec<[f64; 3]> = (mesh.positions.iter())
+    let up: Vec<[f64; 3]> = (mesh.positions().iter())
         .map(|p| [p[0], p[1], p[2] + 1.0])
         .collect();
-    let e = Envelope::from_surfaces(&mesh, (&up, &mesh.faces), (&mesh.positions, &mesh.faces));
+    let e = Envelope::from_surfaces(&mesh, (&up, mesh.faces()), (mesh.positions(), mesh.faces()));
     let text = message(e.unwrap_err());
     assert!(
         text.contains("intrados") && text.contains("vertex"),
         "{text}"
     );
     // An extrados over half the plan does not cover the other half.
-    let half: Vec<[u32; 3]> = (mesh.faces.iter())
-        .filter(|f| f.iter().all(|&v| mesh.positions[v as usize][0] < 0.0))
+    let half: Vec<[u32; 3]> = (mesh.faces().iter())
+        .filter(|f| f.iter().all(|&v| mesh.positions()[v as usize][0] < 0.0))
         .copied()
         .collect();
-    let e = Envelope::from_surfaces(&mesh, (&mesh.positions, &mesh.faces), (&up, &half));
+    let e = Envelope::from_surfaces(&mesh, (mesh.positions(), mesh.faces()), (&up, &half));
     let text = message(e.unwrap_err());
     assert!(
         text.contains("extrados") && text.contains("does not cover vertex"),
@@ -314,9 +318,11 @@ fn bad_envelopes_and_settings_are_named() {
 /// scale.
 #[test]
 fn fixed_supports_outside_the_envelope_are_named() {
-    let mut mesh = fan(8, 1.0, 0.5);
+    let mesh = fan(8, 1.0, 0.5);
     let envelope = shifted_envelope(&mesh, 0.05, 0.05);
-    mesh.positions[3][2] = 0.2;
+    let mut z: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
+    z[3] = 0.2;
+    let mesh = mesh.with_heights(&z).unwrap();
     let settings = AssessSettings::default().with_fixed_supports(true);
     let text = message(assess(&Problem::new(mesh), &envelope, &settings, None).unwrap_err());
     assert!(text.contains("support vertex 3"), "{text}");
@@ -337,7 +343,7 @@ fn cancelling_returns_a_state_with_its_termination() {
     let result = assess(&problem, &envelope, &settings, Some(&mut cancel)).unwrap();
     assert_eq!(result.termination, Termination::Cancelled);
     assert_eq!(calls, 3);
-    assert_eq!(result.positions.len(), problem.mesh.positions.len());
+    assert_eq!(result.positions.len(), problem.mesh.positions().len());
 }
 
 /// A hemisphere far too thin: no surface fits, and the answer says how much thicker and
@@ -359,7 +365,7 @@ fn a_vault_too_thin_says_how_much_thicker() {
     let (scale, at) = result.needed_scale.expect("a least thickness");
     assert!(scale > 1.0, "scale {scale}");
     let v = at.expect("where the thinnest surface leaves the envelope") as usize;
-    assert!(!mesh.anchored[v] || mesh.on_boundary[v]);
+    assert!(!mesh.anchored()[v] || mesh.on_boundary()[v]);
 }
 
 /// Bounds and loads given per vertex (compas_tno's zlb, zub and pz): the fan's closed form.
@@ -367,8 +373,8 @@ fn a_vault_too_thin_says_how_much_thicker() {
 fn bounds_and_loads_given_per_vertex() {
     let (n, r, rise) = (10, 1.5, 0.8);
     let mesh = fan(n, r, rise);
-    let lower: Vec<f64> = mesh.positions.iter().map(|p| p[2] - 0.1).collect();
-    let upper: Vec<f64> = mesh.positions.iter().map(|p| p[2] + 0.2).collect();
+    let lower: Vec<f64> = mesh.positions().iter().map(|p| p[2] - 0.1).collect();
+    let upper: Vec<f64> = mesh.positions().iter().map(|p| p[2] + 0.2).collect();
     let envelope =
         Envelope::from_bounds(&mesh, lower.clone(), upper, &Thickness::Uniform(1.0)).unwrap();
     let mut loads = vec![0.0; n + 1];
@@ -445,7 +451,7 @@ fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
 /// intrados' footprint the springing plane z = 0 bounds it.
 fn shell(mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, t: f64) -> voussoir::Result<Envelope> {
     let at = |rho: f64, r: f64| (rho * rho - r * r).max(0.0).sqrt();
-    let (lower, upper) = (mesh.positions.iter())
+    let (lower, upper) = (mesh.positions().iter())
         .map(|&p| (at(1.0 - 0.5 * t, radius(p)), at(1.0 + 0.5 * t, radius(p))))
         .unzip();
     Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))

@@ -19,13 +19,15 @@ fn check(problem: &Problem, r: &voussoir::FormFindResult, case: &str) {
         assert_eq!(r.stress.eps_inf, lowest, "{case}: {:?}", r.history);
     }
     let mesh = &problem.mesh;
-    let mut residual = vec![0.0; mesh.positions.len()];
-    for (edge, q) in mesh.edges.iter().zip(&r.stress.force_densities) {
+    let mut residual = vec![0.0; mesh.positions().len()];
+    for (edge, q) in mesh.edges().iter().zip(&r.stress.force_densities) {
         let [a, b] = edge.v.map(|v| v as usize);
         let dz = r.positions[a][2] - r.positions[b][2];
         (residual[a], residual[b]) = (residual[a] + q * dz, residual[b] - q * dz);
     }
-    let free: Vec<usize> = (0..residual.len()).filter(|&v| !mesh.anchored[v]).collect();
+    let free: Vec<usize> = (0..residual.len())
+        .filter(|&v| !mesh.anchored()[v])
+        .collect();
     let p_bar = free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64;
     let eps = free
         .iter()

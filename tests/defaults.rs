@@ -13,12 +13,12 @@ use voussoir::*;
 /// Force densities, residuals and hole coefficients of `mesh` analysed through the C API with
 /// default settings.
 fn analysed_through_c(mesh: &Mesh) -> [Vec<f64>; 3] {
-    let anchored = (0..mesh.positions.len() as u32)
-        .filter(|&v| mesh.anchored[v as usize])
+    let anchored = (0..mesh.positions().len() as u32)
+        .filter(|&v| mesh.anchored()[v as usize])
         .collect();
     let flat = Dome {
-        positions: mesh.positions.iter().flatten().copied().collect(),
-        triangles: mesh.faces.iter().flatten().copied().collect(),
+        positions: mesh.positions().iter().flatten().copied().collect(),
+        triangles: mesh.faces().iter().flatten().copied().collect(),
         anchored,
     };
     let (c_mesh, s) = (flat.create(), settings());

@@ -9,11 +9,11 @@ use voussoir::*;
 /// The 45° polar cap (rim anchored) with every coordinate multiplied by `s`.
 fn scaled_cap(s: f64) -> Result<Mesh> {
     let cap = polar_cap(4, 45f64.to_radians());
-    let positions = cap.positions.iter().map(|p| p.map(|c| c * s)).collect();
+    let positions = cap.positions().iter().map(|p| p.map(|c| c * s)).collect();
     let anchored: Vec<u32> = (0..cap.n_vertices() as u32)
-        .filter(|&v| cap.anchored[v as usize])
+        .filter(|&v| cap.anchored()[v as usize])
         .collect();
-    Mesh::new(positions, cap.faces.clone(), &anchored)
+    Mesh::new(positions, cap.faces().to_vec(), &anchored)
 }
 
 fn analysed(s: f64) -> Result<StressResult> {

@@ -27,7 +27,7 @@ fn recomputed_eps(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
     let q = &r.stress.force_densities;
     let n = x.len();
     let mut load = problem.extra_loads.clone();
-    for (t, f) in mesh.faces.iter().enumerate() {
+    for (t, f) in mesh.faces().iter().enumerate() {
         let [a, b, c] = f.map(|v| x[v as usize]);
         let (u, w) = (
             [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
@@ -44,7 +44,7 @@ fn recomputed_eps(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
     }
     let mut r_vert = vec![0.0; n];
     let mut r_hor = vec![[0.0; 2]; n];
-    for (e, edge) in mesh.edges.iter().enumerate() {
+    for (e, edge) in mesh.edges().iter().enumerate() {
         let [i, j] = edge.v.map(|v| v as usize);
         for (a, b) in [(i, j), (j, i)] {
             r_vert[a] += q[e] * (x[a][2] - x[b][2]);
@@ -53,7 +53,7 @@ fn recomputed_eps(label: &str, problem: &Problem, r: &FormFindResult) -> f64 {
         }
     }
     let free: Vec<usize> = (0..n)
-        .filter(|&v| mesh.referenced[v] && !mesh.anchored[v])
+        .filter(|&v| mesh.referenced()[v] && !mesh.anchored()[v])
         .collect();
     let p_bar = free.iter().map(|&v| load[v]).sum::<f64>() / free.len() as f64;
     let q_max = q.iter().fold(0.0f64, |m, v| m.max(*v));
@@ -98,7 +98,7 @@ fn run(label: &str, problem: &Problem) -> FormFindResult {
     assert!(r.iterations < limit, "{label}: {} iterations", r.iterations);
     println!(
         "{label}: V={} {} iterations, eps_inf {eps:.2e}, hausdorff {:.4}, l2 {:.4}, {:.2}s",
-        problem.mesh.positions.len(),
+        problem.mesh.positions().len(),
         r.iterations,
         r.hausdorff,
         r.l2,
@@ -175,7 +175,7 @@ fn a_dent_in_a_cap_is_repaired_locally() {
     let problem = Problem::new(mesh);
     let r = run("dented cap", &problem);
     let (mut near, mut all) = (0.0, 0.0);
-    for (v, p) in problem.mesh.positions.iter().enumerate() {
+    for (v, p) in problem.mesh.positions().iter().enumerate() {
         let dz = (r.positions[v][2] - p[2]).abs();
         all += dz;
         if (p[0] - centre[0]).hypot(p[1] - centre[1]) < 2.0 * radius {
@@ -264,11 +264,12 @@ fn a_light_or_heavy_cap_changes_the_shape() {
     )
     .unwrap();
     let cap: Vec<bool> = mesh
-        .faces
+        .faces()
         .iter()
         .map(|f| {
-            f.iter()
-                .all(|&v| mesh.positions[v as usize][0].hypot(mesh.positions[v as usize][1]) < 0.35)
+            f.iter().all(|&v| {
+                mesh.positions()[v as usize][0].hypot(mesh.positions()[v as usize][1]) < 0.35
+            })
         })
         .collect();
     let (mut crowns, mut nearest) = (Vec::new(), Vec::new());
@@ -331,12 +332,12 @@ fn infeasible_bounds_are_reported_not_hidden() {
         );
         // The answer is the input with the forces of its analysis, not an empty state.
         let mesh = &problem.mesh;
-        assert_eq!(r.positions, mesh.positions, "{method:?}");
+        assert_eq!(r.positions, mesh.positions(), "{method:?}");
         assert_eq!(r.stress.loads.len(), mesh.n_vertices(), "{method:?}");
         assert_eq!(r.stress.residuals.len(), mesh.n_vertices(), "{method:?}");
         assert_eq!(
             r.stress.force_densities.len(),
-            mesh.edges.len(),
+            mesh.edges().len(),
             "{method:?}"
         );
     }
@@ -351,12 +352,12 @@ fn odt_smoothing_improves_the_plan_and_never_flips_a_triangle() {
     assert_eq!(r.termination, Termination::Converged, "{:?}", r.history);
     certify("odt", &problem, &r);
     // The plan moved, stays a valid triangulation, and its worst triangles got better.
-    let anchored: Vec<u32> = (0..base.positions.len() as u32)
-        .filter(|&v| base.anchored[v as usize])
+    let anchored: Vec<u32> = (0..base.positions().len() as u32)
+        .filter(|&v| base.anchored()[v as usize])
         .collect();
-    Mesh::new(r.positions.clone(), base.faces.clone(), &anchored).expect("plan still valid");
+    Mesh::new(r.positions.clone(), base.faces().to_vec(), &anchored).expect("plan still valid");
     let min_angle = |x: &[[f64; 3]]| {
-        base.faces
+        base.faces()
             .iter()
             .map(|f| {
                 let p = f.map(|v| x[v as usize]);
@@ -370,21 +371,21 @@ fn odt_smoothing_improves_the_plan_and_never_flips_a_triangle() {
             })
             .fold(f64::INFINITY, f64::min)
     };
-    let moved = (0..base.positions.len())
+    let moved = (0..base.positions().len())
         .filter(|&v| {
-            (r.positions[v][0] - base.positions[v][0])
-                .hypot(r.positions[v][1] - base.positions[v][1])
+            (r.positions[v][0] - base.positions()[v][0])
+                .hypot(r.positions[v][1] - base.positions()[v][1])
                 > 1e-9
         })
         .count();
     assert!(moved > 0);
     assert!(
-        min_angle(&r.positions) > min_angle(&base.positions),
+        min_angle(&r.positions) > min_angle(base.positions()),
         "ODT did not improve the worst angle"
     );
     // Anchored vertices never move.
     for &v in &anchored {
-        assert_eq!(r.positions[v as usize], base.positions[v as usize]);
+        assert_eq!(r.positions[v as usize], base.positions()[v as usize]);
     }
 }
 
@@ -394,14 +395,14 @@ fn dual_length_bounds_shape_the_force_diagram() {
     let free_run = form_find(&problem, &FormFindSettings::default(), None).unwrap();
     let mesh = &problem.mesh;
     let p_bar = |r: &FormFindResult| {
-        let free: Vec<usize> = (0..mesh.positions.len())
+        let free: Vec<usize> = (0..mesh.positions().len())
             .filter(|&v| mesh.is_non_anchored(v))
             .collect();
         free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64
     };
     let dual = |r: &FormFindResult| -> Vec<f64> {
         let pb = p_bar(r);
-        mesh.edges
+        mesh.edges()
             .iter()
             .enumerate()
             .filter(|(_, e)| !e.is_boundary())
@@ -438,12 +439,12 @@ fn relative_dual_variation(problem: &Problem, r: &FormFindResult) -> f64 {
     let mesh = &problem.mesh;
     let x = &r.positions;
     let dual = |e: usize| {
-        let [a, b] = mesh.edges[e].v.map(|v| x[v as usize]);
+        let [a, b] = mesh.edges()[e].v.map(|v| x[v as usize]);
         r.stress.force_densities[e] * (a[0] - b[0]).hypot(a[1] - b[1])
     };
-    let interior = |e: usize| !mesh.edges[e].is_boundary();
+    let interior = |e: usize| !mesh.edges()[e].is_boundary();
     let (mut variation, mut size) = (0.0, 0.0);
-    for f in &mesh.faces {
+    for f in mesh.faces() {
         for k in 0..3 {
             let e1 = mesh.edge_between(f[k], f[(k + 1) % 3]).unwrap();
             let e2 = mesh.edge_between(f[(k + 1) % 3], f[(k + 2) % 3]).unwrap();
@@ -495,8 +496,9 @@ fn dual_length_smoothing_gives_lilium_a_smoother_force_diagram() {
 /// reached, certified as such.
 #[test]
 fn a_loop_that_stalls_returns_its_lowest_residual_state() {
-    let mut mesh = generate::cap_dome(0.8, 300).unwrap();
-    mesh.positions.iter_mut().for_each(|p| p[2] = -p[2]);
+    let mesh = generate::cap_dome(0.8, 300).unwrap();
+    let hanging: Vec<f64> = mesh.positions().iter().map(|p| -p[2]).collect();
+    let mesh = mesh.with_heights(&hanging).unwrap();
     let problem = Problem::new(mesh);
     let mut settings = FormFindSettings::default();
     settings.method = FormMethod::Paper;
@@ -576,12 +578,13 @@ fn twisted_rings_of_split_quads_are_named_when_infeasible() {
 #[test]
 fn marked_polygon_diagonals_free_twisted_rings_from_q_min() {
     let (rings, sectors) = (5, 24);
-    let mut mesh = lat_long_dome(rings, sectors, false);
+    let mesh = lat_long_dome(rings, sectors, false);
     // A cone, not the paraboloid: its straight meridians carry no load, form finding has
     // to move it.
-    for p in mesh.positions.iter_mut() {
-        p[2] = 0.6 * (1.0 - p[0].hypot(p[1]));
-    }
+    let cone: Vec<f64> = (mesh.positions().iter())
+        .map(|p| 0.6 * (1.0 - p[0].hypot(p[1])))
+        .collect();
+    let mesh = mesh.with_heights(&cone).unwrap();
     let id = |r: usize, s: usize| (1 + (r - 1) * sectors + s % sectors) as u32;
     let diagonals: Vec<[u32; 2]> = (1..rings)
         .flat_map(|r| (0..sectors).map(move |s| [id(r, s), id(r + 1, s + 1)]))
@@ -596,11 +599,11 @@ fn marked_polygon_diagonals_free_twisted_rings_from_q_min() {
     let mesh = &problem.mesh;
     // q_min = 0.05 p̄ / L₀, L₀ half the plan diagonal of [−1, 1]².
     let free: Vec<usize> = (0..mesh.n_vertices())
-        .filter(|&v| !mesh.anchored[v])
+        .filter(|&v| !mesh.anchored()[v])
         .collect();
     let p_bar = free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64;
     let q_min = 0.05 * p_bar / std::f64::consts::SQRT_2;
-    let on_quad_edges = (mesh.edges.iter().enumerate())
+    let on_quad_edges = (mesh.edges().iter().enumerate())
         .filter(|(e, edge)| !edge.is_boundary() && !problem.polygon_diagonal[*e])
         .map(|(e, _)| r.stress.force_densities[e])
         .fold(f64::INFINITY, f64::min);
@@ -655,9 +658,9 @@ fn many_odt_sweeps_are_never_worse_than_few() {
                 .with_odt_iterations(n);
             form_find(&problem, &settings, None).unwrap()
         };
-        let input = plan_quality(&mesh.faces, &mesh.positions);
+        let input = plan_quality(mesh.faces(), mesh.positions());
         let many = run(1000);
-        let quality = plan_quality(&mesh.faces, &many.positions);
+        let quality = plan_quality(mesh.faces(), &many.positions);
         assert_eq!(
             many.termination,
             Termination::Converged,
@@ -669,7 +672,7 @@ fn many_odt_sweeps_are_never_worse_than_few() {
             "{name}: plan quality {quality} below the input's {input}"
         );
         for few in [1, 2, 4] {
-            let q = plan_quality(&mesh.faces, &run(few).positions);
+            let q = plan_quality(mesh.faces(), &run(few).positions);
             assert!(
                 quality >= q,
                 "{name}: 1000 sweeps give {quality}, {few} give {q}"

@@ -671,10 +671,11 @@ fn infeasible_bounds_write_outputs_and_exit_3() {
 #[test]
 fn a_hanging_cap_is_reported_mirrored() {
     let dir = Scratch::new("hanging-nearest");
-    let mut cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
-    cap.positions.iter_mut().for_each(|p| p[2] = -p[2]);
-    voussoir::io::write_obj(&dir.path("hanging.obj"), &cap.positions, &cap.faces).unwrap();
-    let anchored: Vec<usize> = (0..cap.n_vertices()).filter(|&v| cap.anchored[v]).collect();
+    let cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
+    let heights: Vec<f64> = cap.positions().iter().map(|p| -p[2]).collect();
+    let cap = cap.with_heights(&heights).unwrap();
+    voussoir::io::write_obj(&dir.path("hanging.obj"), cap.positions(), cap.faces()).unwrap();
+    let anchored = cap.anchored_ids();
     let supports = serde_json::json!({ "anchored": anchored }).to_string();
     fs::write(dir.path("s.json"), supports).unwrap();
     let out = run(&dir.0, &["hanging.obj", "--supports", "s.json"]);
@@ -694,10 +695,13 @@ fn a_hanging_cap_is_reported_mirrored() {
 #[test]
 fn a_stall_without_vertices_prints_no_empty_details() {
     let dir = Scratch::new("hanging");
-    let mut cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
-    cap.positions.iter_mut().for_each(|p| p[2] = -p[2]);
-    voussoir::io::write_obj(&dir.path("hanging.obj"), &cap.positions, &cap.faces).unwrap();
-    let anchored: Vec<usize> = (0..cap.n_vertices()).filter(|&v| cap.anchored[v]).collect();
+    let cap = voussoir::generate::cap_dome(0.8, 300).unwrap();
+    let hanging: Vec<f64> = cap.positions().iter().map(|p| -p[2]).collect();
+    let cap = cap.with_heights(&hanging).unwrap();
+    voussoir::io::write_obj(&dir.path("hanging.obj"), cap.positions(), cap.faces()).unwrap();
+    let anchored: Vec<usize> = (0..cap.n_vertices())
+        .filter(|&v| cap.anchored()[v])
+        .collect();
     let supports = serde_json::json!({ "anchored": anchored }).to_string();
     fs::write(dir.path("s.json"), supports).unwrap();
     let out = run(

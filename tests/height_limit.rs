@@ -55,13 +55,13 @@ fn walled_vault(seed: u64, noise: f64) -> Mesh {
 /// The largest height change over the plan bounding-box diagonal, measured here.
 fn largest_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in &mesh.positions {
+    for p in mesh.positions() {
         for d in 0..2 {
             (lo[d], hi[d]) = (lo[d].min(p[d]), hi[d].max(p[d]));
         }
     }
     let diagonal = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
-    (mesh.positions.iter().zip(positions))
+    (mesh.positions().iter().zip(positions))
         .map(|(a, b)| (a[2] - b[2]).abs() / diagonal)
         .fold(0.0, f64::max)
 }

@@ -108,19 +108,19 @@ fn native_is_optimal(
         .with_formulation(Formulation::EdgeBased);
     let clarabel = analyse(problem, &reference).expect("clarabel analysis");
     let mesh = &problem.mesh;
-    let free: Vec<usize> = (0..mesh.positions.len())
-        .filter(|&v| !mesh.anchored[v])
+    let free: Vec<usize> = (0..mesh.positions().len())
+        .filter(|&v| !mesh.anchored()[v])
         .collect();
     let loads: f64 = free.iter().map(|&v| native.loads[v].powi(2)).sum();
     let mut objectives = Vec::new();
     for result in [&native, &clarabel] {
         // r_i = Σ_j q_ij (z_i − z_j) − p_i, h_i = Σ_j q_ij (u_i − u_j) and its terms' size.
-        let n = mesh.positions.len();
+        let n = mesh.positions().len();
         let (mut r, mut h, mut size) = (vec![0.0; n], vec![[0.0; 2]; n], vec![0.0; n]);
-        for (edge, q) in mesh.edges.iter().zip(&result.force_densities) {
+        for (edge, q) in mesh.edges().iter().zip(&result.force_densities) {
             let [a, b] = edge.v.map(|v| v as usize);
             let d: Vec<f64> = (0..3)
-                .map(|k| mesh.positions[a][k] - mesh.positions[b][k])
+                .map(|k| mesh.positions()[a][k] - mesh.positions()[b][k])
                 .collect();
             (r[a], r[b]) = (r[a] + q * d[2], r[b] - q * d[2]);
             for k in 0..2 {
@@ -136,7 +136,7 @@ fn native_is_optimal(
             "{name}: recomputed Σ r² {objective:e}, reported {reported:e}"
         );
         if std::ptr::eq(result, &native) {
-            for &v in free.iter().filter(|&&v| !mesh.on_boundary[v]) {
+            for &v in free.iter().filter(|&&v| !mesh.on_boundary()[v]) {
                 let imbalance = h[v][0].hypot(h[v][1]);
                 assert!(
                     imbalance <= 1e-8 * size[v],
@@ -147,12 +147,12 @@ fn native_is_optimal(
         objectives.push(objective);
     }
     let p_bar = free.iter().map(|&v| native.loads[v]).sum::<f64>() / free.len() as f64;
-    let frame = voussoir::internals::Frame::of(mesh, &mesh.positions);
+    let frame = voussoir::internals::Frame::of(mesh, mesh.positions());
     let lower = q_min * p_bar / frame.scale;
     let diagonal = &problem.polygon_diagonal;
     let q_max = native.force_densities.iter().fold(lower, |a, &q| a.max(q));
-    for (e, (edge, q)) in mesh.edges.iter().zip(&native.force_densities).enumerate() {
-        let carries = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
+    for (e, (edge, q)) in mesh.edges().iter().zip(&native.force_densities).enumerate() {
+        let carries = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored()[v as usize]);
         let bound = if carries && !diagonal[e] { lower } else { 0.0 };
         assert!(
             *q >= bound * (1.0 - 1e-6) - 1e-12 * q_max,

@@ -118,7 +118,7 @@ fn tall_walls_converge_or_end_blocked_at_the_wall() {
                 // The region named runs along the wall, not one vertex of it.
                 let at_wall = vertices
                     .iter()
-                    .filter(|&&v| (mesh.positions[v as usize][0] - x0).abs() < 0.1)
+                    .filter(|&&v| (mesh.positions()[v as usize][0] - x0).abs() < 0.1)
                     .count();
                 assert!(at_wall >= 5, "{case}: {vertices:?}");
             }

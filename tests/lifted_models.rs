@@ -9,9 +9,8 @@ use voussoir::{form_find, FormFindSettings, Mesh, Problem, Termination};
 const LIFT: f64 = 1e7;
 
 fn lifted(mesh: &Mesh) -> Mesh {
-    let mut up = mesh.clone();
-    up.positions.iter_mut().for_each(|p| p[2] += LIFT);
-    up
+    let z: Vec<f64> = mesh.positions().iter().map(|p| p[2] + LIFT).collect();
+    mesh.clone().with_heights(&z).unwrap()
 }
 
 /// hex and vault_pq lifted by 10⁷ converge (they stalled at ε∞ 7e-6 and 1.4e-6) to the shape
@@ -25,7 +24,7 @@ fn shared_models_lifted_by_ten_million_converge_to_the_same_shape() {
         let up = form_find(&Problem::new(lifted(&mesh)), &settings, None).unwrap();
         assert_eq!(here.termination, Termination::Converged, "{name}");
         assert_eq!(up.termination, Termination::Converged, "{name}: lifted");
-        let (lo, hi) = mesh.positions.iter().fold(
+        let (lo, hi) = mesh.positions().iter().fold(
             ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
             |(lo, hi), p| {
                 (

@@ -48,29 +48,29 @@ fn models_load_with_expected_counts() {
     for (name, v, e, f) in MODELS {
         let mesh = load(&dir, name);
         assert_eq!(
-            (mesh.n_vertices(), mesh.edges.len(), mesh.faces.len()),
+            (mesh.n_vertices(), mesh.edges().len(), mesh.faces().len()),
             (v, e, f),
             "{name}: V/E/F"
         );
         let n = mesh.n_vertices();
         // Anchored and referenced: hex.json also anchors its two unreferenced vertices.
         let anchored = (0..n)
-            .filter(|&i| mesh.anchored[i] && mesh.referenced[i])
+            .filter(|&i| mesh.anchored()[i] && mesh.referenced()[i])
             .count();
         let interior_anchored = (0..n)
-            .filter(|&i| mesh.anchored[i] && mesh.referenced[i] && !mesh.on_boundary[i])
+            .filter(|&i| mesh.anchored()[i] && mesh.referenced()[i] && !mesh.on_boundary()[i])
             .count();
         let on_holes: usize = mesh
             .holes()
             .map(|h| {
-                let vertices = &mesh.loops[h].vertices;
+                let vertices = &mesh.loops()[h].vertices;
                 vertices
                     .iter()
-                    .filter(|&&i| mesh.anchored[i as usize])
+                    .filter(|&&i| mesh.anchored()[i as usize])
                     .count()
             })
             .sum();
-        for l in &mesh.loops {
+        for l in mesh.loops() {
             assert_eq!(l.is_outer, l.signed_area > 0.0, "{name}: loop orientation");
         }
         let free = (0..n).filter(|&i| mesh.is_free_boundary(i)).count();
@@ -78,21 +78,21 @@ fn models_load_with_expected_counts() {
             "{:<16} {:>5} {:>5} {:>5} {:>3} {:>5} {:>5} {:>8} {:>8} {:>9} {:>8} {:>6}",
             name,
             n,
-            mesh.edges.len(),
-            mesh.faces.len(),
-            if mesh.reversed { "yes" } else { "no" },
-            mesh.loops.len(),
+            mesh.edges().len(),
+            mesh.faces().len(),
+            if mesh.reversed() { "yes" } else { "no" },
+            mesh.loops().len(),
             mesh.holes().count(),
             anchored,
             interior_anchored,
             on_holes,
             free,
-            mesh.unreferenced.len()
+            mesh.unreferenced().len()
         );
         if name == "hex" {
-            assert_eq!(mesh.unreferenced.len(), 2, "hex: unreferenced vertices");
+            assert_eq!(mesh.unreferenced().len(), 2, "hex: unreferenced vertices");
             assert!(mesh
-                .unreferenced
+                .unreferenced()
                 .iter()
                 .all(|&i| !mesh.is_non_anchored(i as usize)));
         }

@@ -20,8 +20,8 @@ fn seeds(default: u64) -> u64 {
 /// position sets of `mesh` (plan area shares as weights).
 fn difference(mesh: &Mesh, a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
     let mut share = vec![0.0; a.len()];
-    for f in &mesh.faces {
-        let [p, q, r] = f.map(|v| mesh.positions[v as usize]);
+    for f in mesh.faces() {
+        let [p, q, r] = f.map(|v| mesh.positions()[v as usize]);
         let area = ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs() / 6.0;
         f.iter().for_each(|&v| share[v as usize] += area);
     }
@@ -38,9 +38,9 @@ fn difference(mesh: &Mesh, a: &[[f64; 3]], b: &[[f64; 3]]) -> (f64, f64) {
 /// ε∞ recomputed from the result: loads from the 3-D triangle areas, vertical residuals.
 fn eps_inf(problem: &Problem, r: &FormFindResult) -> f64 {
     let mesh = &problem.mesh;
-    let n = mesh.positions.len();
+    let n = mesh.positions().len();
     let mut load = vec![0.0; n];
-    for f in &mesh.faces {
+    for f in mesh.faces() {
         let [a, b, c] = f.map(|v| r.positions[v as usize]);
         let (u, w) = (
             [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
@@ -55,7 +55,7 @@ fn eps_inf(problem: &Problem, r: &FormFindResult) -> f64 {
         f.iter().for_each(|&v| load[v as usize] += area / 3.0);
     }
     let mut residual = vec![0.0; n];
-    for (e, edge) in mesh.edges.iter().enumerate() {
+    for (e, edge) in mesh.edges().iter().enumerate() {
         let [i, j] = edge.v.map(|v| v as usize);
         let q = r.stress.force_densities[e];
         residual[i] += q * (r.positions[i][2] - r.positions[j][2]);
@@ -72,9 +72,9 @@ fn eps_inf(problem: &Problem, r: &FormFindResult) -> f64 {
 fn plan_diagonal(mesh: &Mesh) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for (p, _) in mesh
-        .positions
+        .positions()
         .iter()
-        .zip(&mesh.referenced)
+        .zip(mesh.referenced())
         .filter(|(_, r)| **r)
     {
         for d in 0..2 {
@@ -101,8 +101,9 @@ fn known_answer_cases_end_at_least_as_near_as_their_truth() {
                 let label = format!("{plan:?} {kind:?} seed {seed}");
                 assert_eq!(r.termination, Termination::Converged, "{label}");
                 assert!(eps_inf(&problem, &r) < 1e-6, "{label}: not in equilibrium");
-                let (truth_rms, truth_max) = difference(&input, &truth.positions, &input.positions);
-                let (rms, max) = difference(&input, &r.positions, &input.positions);
+                let (truth_rms, truth_max) =
+                    difference(&input, truth.positions(), input.positions());
+                let (rms, max) = difference(&input, &r.positions, input.positions());
                 let (rms_ratio, max_ratio) = (rms / truth_rms, max / truth_max);
                 println!(
                     "{label}: {} steps, RMS ratio {rms_ratio:.3}, max ratio {max_ratio:.3}",
@@ -135,8 +136,8 @@ fn a_dent_in_a_large_disk_is_filled_no_further_than_the_truth() {
     let r = form_find(&problem, &settings, None).unwrap();
     assert_eq!(r.termination, Termination::Converged);
     assert!(eps_inf(&problem, &r) < 1e-6);
-    let (truth_rms, _) = difference(&input, &truth.positions, &input.positions);
-    let (rms, _) = difference(&input, &r.positions, &input.positions);
+    let (truth_rms, _) = difference(&input, truth.positions(), input.positions());
+    let (rms, _) = difference(&input, &r.positions, input.positions());
     assert!(
         rms <= truth_rms,
         "RMS {rms:e} against the truth's {truth_rms:e}"
@@ -155,12 +156,12 @@ fn perturbed_shared_models_never_blow_up() {
         let Some(mesh) = load_model(name) else { return };
         let diag = plan_diagonal(&mesh);
         let rise = mesh
-            .positions
+            .positions()
             .iter()
             .map(|p| p[2])
             .fold(f64::NEG_INFINITY, f64::max)
             - mesh
-                .positions
+                .positions()
                 .iter()
                 .map(|p| p[2])
                 .fold(f64::INFINITY, f64::min);
@@ -168,24 +169,25 @@ fn perturbed_shared_models_never_blow_up() {
             let mut rng = Rng::new(seed * 31 + name.len() as u64);
             let bumps: Vec<([f64; 3], f64)> = (0..6)
                 .map(|_| {
-                    let v =
-                        &mesh.positions[(rng.next_u64() % mesh.positions.len() as u64) as usize];
+                    let v = &mesh.positions()
+                        [(rng.next_u64() % mesh.positions().len() as u64) as usize];
                     (*v, rng.uniform(-0.15, 0.15) * rise)
                 })
                 .collect();
-            let mut input = mesh.clone();
-            for (v, p) in input.positions.iter_mut().enumerate() {
+            let mut z: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
+            for (v, p) in mesh.positions().iter().enumerate() {
                 if mesh.is_non_anchored(v) {
                     for (c, a) in &bumps {
                         let d2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-                        p[2] += a * (-d2 / (2.0 * (0.1 * diag).powi(2))).exp();
+                        z[v] += a * (-d2 / (2.0 * (0.1 * diag).powi(2))).exp();
                     }
                 }
             }
+            let input = mesh.clone().with_heights(&z).unwrap();
             let problem = Problem::new(input.clone());
             let before = analyse(&problem, &FormFindSettings::default().stress).unwrap();
             let r = form_find(&problem, &FormFindSettings::default(), None).unwrap();
-            let (_, max) = difference(&input, &r.positions, &input.positions);
+            let (_, max) = difference(&input, &r.positions, input.positions());
             let label = format!("{name} seed {seed}");
             println!(
                 "{label}: {:?} in {} steps, largest change {:.4} diagonals",
@@ -228,7 +230,7 @@ fn a_blocking_q_max_is_named_and_the_shape_stays_within_the_limit() {
     settings.stress.q_max = Some(QBound::Absolute(1e-2));
     let before = analyse(&problem, &settings.stress).unwrap();
     let r = form_find(&problem, &settings, None).unwrap();
-    let (_, max) = difference(&mesh, &r.positions, &mesh.positions);
+    let (_, max) = difference(&mesh, &r.positions, mesh.positions());
     assert!(max <= diag * (1.0 + 1e-9), "moved {max}");
     assert!(r.stress.eps_inf <= before.eps_inf);
     match &r.termination {

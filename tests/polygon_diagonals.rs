@@ -57,10 +57,10 @@ fn dome_model(test: &str) -> voussoir::io::Model {
 /// The dome's arrays as `vsr_mesh_create` takes them.
 fn create(model: &voussoir::io::Model) -> *mut VsrMesh {
     let m = &model.problem.mesh;
-    let positions: Vec<f64> = m.positions.iter().flatten().copied().collect();
+    let positions: Vec<f64> = m.positions().iter().flatten().copied().collect();
     let triangles: Vec<u32> = m.input_faces().into_iter().flatten().collect();
     let anchored: Vec<u32> = (0..m.n_vertices() as u32)
-        .filter(|&v| m.anchored[v as usize])
+        .filter(|&v| m.anchored()[v as usize])
         .collect();
     let mut mesh = null_mut();
     assert_ok(unsafe {

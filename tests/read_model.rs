@@ -29,17 +29,28 @@ const MODELS: [&str; 9] = [
     "three_pillar",
     "vault_pq",
 ];
-const FORMATS: [&str; 4] = ["obj", "off", "ply", "stl"];
+/// Every format `read_mesh` reads: its extension, and `-ascii` for the text variant of a
+/// binary one (3MF is written only).
+const FORMATS: [&str; 6] = ["obj", "off", "ply", "ply-ascii", "stl", "stl-ascii"];
 
 fn c(path: &Path) -> CString {
     CString::new(path.to_str().unwrap()).unwrap()
 }
 
-/// The model `name` written in `format` into `dir`, and its supports file.
+/// The model `name` written in `format` (one of [`FORMATS`]) into `dir`.
 fn model_file(models: &Path, dir: &Scratch, name: &str, format: &str) -> std::path::PathBuf {
     let (positions, faces) = io::read_mesh(&models.join(format!("{name}.obj"))).unwrap();
-    let path = dir.path(&format!("{name}.{format}"));
-    io::write_mesh(&path, &positions, &faces).unwrap();
+    let (extension, ascii) = match format.strip_suffix("-ascii") {
+        Some(e) => (e, true),
+        None => (format, false),
+    };
+    let path = dir.path(&format!("{name}-{format}.{extension}"));
+    let kind = io::MeshFormat::from_path(&path).unwrap();
+    let kind = if ascii { kind.ascii() } else { kind };
+    io::write_mesh_as(&path, kind, &positions, &faces).unwrap();
+    if format != "obj" && format != "off" {
+        assert_eq!(fs::read(&path).unwrap().is_ascii(), ascii, "{format}");
+    }
     path
 }
 
@@ -81,7 +92,7 @@ fn through_c(path: &Path, json: &Path) -> (Snapshot, Vec<u32>) {
 fn rust_snapshot(problem: &Problem, s: &StressResult) -> Vec<Vec<u64>> {
     let flat2 = |rows: &[[f64; 2]]| rows.iter().flatten().map(|x| x.to_bits()).collect();
     let flat = |xs: &[f64]| xs.iter().map(|x| x.to_bits()).collect();
-    let positions: Vec<u64> = (problem.mesh.positions.iter())
+    let positions: Vec<u64> = (problem.mesh.positions().iter())
         .flatten()
         .map(|x| x.to_bits())
         .collect();
@@ -139,18 +150,23 @@ fn load_model_is_read_model_with_a_supports_file() {
         let problem = io::load_model(&obj, &json).unwrap();
         let model = read_model(&obj, &ReadOptions::new(Supports::File(json))).unwrap();
         assert_eq!(
-            problem.mesh.positions, model.problem.mesh.positions,
+            problem.mesh.positions(),
+            model.problem.mesh.positions(),
             "{name}"
         );
-        assert_eq!(problem.mesh.faces, model.problem.mesh.faces, "{name}");
-        assert_eq!(problem.mesh.anchored, model.problem.mesh.anchored, "{name}");
+        assert_eq!(problem.mesh.faces(), model.problem.mesh.faces(), "{name}");
+        assert_eq!(
+            problem.mesh.anchored(),
+            model.problem.mesh.anchored(),
+            "{name}"
+        );
         // The shared models are clean triangle meshes: nothing is welded or mended, so the
         // problem is the file's mesh as it is.
         let (positions, faces) = io::read_mesh(&obj).unwrap();
         assert_eq!(model.weld.as_ref().unwrap().merged, 0, "{name}");
         assert!(model.repairs.is_empty(), "{name}");
         assert!(model.diagonals.is_empty(), "{name}");
-        assert_eq!(problem.mesh.positions, positions, "{name}");
+        assert_eq!(problem.mesh.positions(), positions, "{name}");
         assert_eq!(problem.mesh.input_faces(), faces, "{name}");
     }
 }
@@ -188,9 +204,9 @@ fn assert_report_is(report: &Value, model: &io::Model, what: &str) {
     let p = &model.problem;
     let s = analyse(p, &StressSettings::default()).unwrap();
     let anchored: Vec<usize> = (0..p.mesh.n_vertices())
-        .filter(|&v| p.mesh.anchored[v])
+        .filter(|&v| p.mesh.anchored()[v])
         .collect();
-    let edges: Vec<[u32; 2]> = p.mesh.edges.iter().map(|e| e.v).collect();
+    let edges: Vec<[u32; 2]> = p.mesh.edges().iter().map(|e| e.v).collect();
     let q: Vec<f64> = s.force_densities.iter().map(|q| q + 0.0).collect();
     assert_eq!(report["anchored"], as_report(&anchored), "{what}");
     assert_eq!(report["edges"], as_report(&edges), "{what}");
@@ -211,7 +227,7 @@ fn the_command_line_reads_every_format_as_the_library_does() {
         assert_report_is(&report, &model, format);
         // The input positions come back as read (the form-found mesh of --stress-only).
         let (out, _) = io::read_mesh(&dir.path("out.obj")).unwrap();
-        assert_eq!(out, model.problem.mesh.positions, "{format}");
+        assert_eq!(out, model.problem.mesh.positions(), "{format}");
     }
     // Supports chosen by the library: the boundary, the lowest vertices.
     let obj = models.join("free_vault.obj");
@@ -263,7 +279,7 @@ fn read_model_chooses_supports_turns_y_up_and_marks_diagonals() {
     let boundary = ReadOptions::new(Supports::Boundary);
     let model = read_model(&z, &boundary).unwrap();
     let mesh = &model.problem.mesh;
-    let anchored: Vec<u32> = (0..16).filter(|&v| mesh.anchored[v as usize]).collect();
+    let anchored: Vec<u32> = (0..16).filter(|&v| mesh.anchored()[v as usize]).collect();
     assert_eq!(anchored, [0, 1, 2, 3, 4, 7, 8, 11, 12, 13, 14, 15]);
     // Nine quads, nine diagonals, all interior edges, all marked.
     assert_eq!(model.diagonals.len(), 9);
@@ -279,13 +295,12 @@ fn read_model_chooses_supports_turns_y_up_and_marks_diagonals() {
         tolerance: 1e-9,
         absolute: true,
     });
-    let corners = read_model(&z, &lowest).unwrap().problem.mesh.anchored;
-    let corners: Vec<u32> = (0..16).filter(|&v| corners[v as usize]).collect();
+    let corners = read_model(&z, &lowest).unwrap().problem.mesh.anchored_ids();
     assert_eq!(corners, [0, 3, 12, 15]);
     // Y-up: refused as it stands (a vertical plan), the same mesh with `up` y.
     assert!(read_model(&y, &boundary).is_err());
     let turned = read_model(&y, &boundary.clone().with_up(UpAxis::Y)).unwrap();
-    for (a, b) in turned.problem.mesh.positions.iter().zip(&mesh.positions) {
+    for (a, b) in turned.problem.mesh.positions().iter().zip(mesh.positions()) {
         for k in 0..3 {
             assert!((a[k] - b[k]).abs() < 1e-15, "{a:?} {b:?}");
         }
@@ -309,7 +324,7 @@ fn read_model_welds_unless_told_not_to_and_checks_its_options() {
     let weld = welded.weld.as_ref().unwrap();
     assert_eq!((weld.input_vertices, weld.merged), (17, 1));
     assert_eq!(welded.welded_ids[16], 5);
-    assert!(welded.problem.mesh.unreferenced.is_empty());
+    assert!(welded.problem.mesh.unreferenced().is_empty());
     // Unwelded, the copy is a vertex of its own and vertex 5 a boundary vertex.
     let kept = ReadOptions::new(Supports::Boundary).with_weld_tolerance(None);
     let unwelded = read_model(&path, &kept);

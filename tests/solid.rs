@@ -45,7 +45,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn area(mesh: &Mesh, f: usize) -> f64 {
-    let [a, b, c] = mesh.faces[f].map(|v| mesh.positions[v as usize]);
+    let [a, b, c] = mesh.faces()[f].map(|v| mesh.positions()[v as usize]);
     dot(cross(sub(b, a), sub(c, a)), cross(sub(b, a), sub(c, a))).sqrt() / 2.0
 }
 
@@ -107,9 +107,9 @@ fn crossing_pairs(solid: &Solid) -> Vec<(usize, usize)> {
 fn dome_solid_is_closed_outward_and_of_volume_area_times_thickness() {
     let mesh = cap_dome(0.9, 300).unwrap();
     let t = 0.05;
-    let solid = thicken(&mesh, &mesh.positions, &Thickness::Uniform(t)).unwrap();
+    let solid = thicken(&mesh, mesh.positions(), &Thickness::Uniform(t)).unwrap();
     assert_eq!(solid.positions.len(), 2 * mesh.n_vertices());
-    let boundary_edges = mesh.edges.iter().filter(|e| e.is_boundary()).count();
+    let boundary_edges = mesh.edges().iter().filter(|e| e.is_boundary()).count();
     assert_eq!(solid.faces.len(), 2 * mesh.n_faces() + 2 * boundary_edges);
     assert_watertight(&solid.faces);
     let v = volume(&solid.positions, &solid.faces);
@@ -127,7 +127,7 @@ fn dome_solid_is_closed_outward_and_of_volume_area_times_thickness() {
 fn holes_get_walls_too() {
     let mesh = dome_with_hole(300).unwrap();
     assert_eq!(mesh.holes().count(), 1);
-    let solid = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.03)).unwrap();
+    let solid = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.03)).unwrap();
     assert_watertight(&solid.faces);
     let expected = surface_area(&mesh) * 0.03;
     let v = volume(&solid.positions, &solid.faces);
@@ -141,14 +141,14 @@ fn thickness_from_density_varies_per_face() {
     // Heavier (thicker) faces towards the rim.
     let density: Vec<f64> = (0..mesh.n_faces())
         .map(|f| {
-            let c = mesh.faces[f].map(|v| mesh.positions[v as usize]);
+            let c = mesh.faces()[f].map(|v| mesh.positions()[v as usize]);
             let r =
                 ((c[0][0] + c[1][0] + c[2][0]) / 3.0).hypot((c[0][1] + c[1][1] + c[2][1]) / 3.0);
             2.0 * (0.02 + 0.04 * r)
         })
         .collect();
     let thickness = Thickness::from_density(&density, 2.0).unwrap();
-    let solid = thicken(&mesh, &mesh.positions, &thickness).unwrap();
+    let solid = thicken(&mesh, mesh.positions(), &thickness).unwrap();
     assert_watertight(&solid.faces);
     let expected: f64 = (0..mesh.n_faces())
         .map(|f| area(&mesh, f) * density[f] / 2.0)
@@ -174,7 +174,7 @@ fn thickness_from_density_varies_per_face() {
 #[test]
 fn too_thick_is_refused_naming_the_face_and_what_fits() {
     let mesh = cap_dome(0.9, 200).unwrap();
-    let err = thicken(&mesh, &mesh.positions, &Thickness::Uniform(3.0))
+    let err = thicken(&mesh, mesh.positions(), &Thickness::Uniform(3.0))
         .unwrap_err()
         .to_string();
     assert!(err.contains("turns over"), "{err}");
@@ -200,7 +200,7 @@ fn too_thick_is_refused_naming_the_face_and_what_fits() {
         .unwrap();
     assert!(fits > 1.0 && fits < 3.0, "{err}");
     // The limit is for that face; the thinnest spot of the whole dome may be lower still.
-    let smaller = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.5 * fits));
+    let smaller = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.5 * fits));
     assert!(smaller.is_ok(), "{:?}", smaller.err());
 }
 
@@ -210,7 +210,7 @@ fn too_thick_is_refused_naming_the_face_and_what_fits() {
 #[test]
 fn extreme_thicknesses_get_what_fits_or_the_range() {
     let mesh = cap_dome(0.9, 200).unwrap();
-    let p = &mesh.positions;
+    let p = mesh.positions();
     let fits = |t: f64| {
         let err = thicken(&mesh, p, &Thickness::Uniform(t))
             .unwrap_err()
@@ -242,11 +242,11 @@ fn extreme_thicknesses_get_what_fits_or_the_range() {
         assert!(least > 1e-12 && least < 1e-11, "{err}");
     }
     // A flat plate folds at no thickness: beyond the range, the range is the answer.
-    let mut flat = p.clone();
+    let mut flat = p.to_vec();
     for q in &mut flat {
         q[2] = 0.0;
     }
-    let plate = Mesh::new(flat.clone(), mesh.faces.clone(), &[0]).unwrap();
+    let plate = Mesh::new(flat.clone(), mesh.faces().to_vec(), &[0]).unwrap();
     let err = thicken(&plate, &flat, &Thickness::Uniform(1e154))
         .unwrap_err()
         .to_string();
@@ -259,7 +259,7 @@ fn extreme_thicknesses_get_what_fits_or_the_range() {
 #[test]
 fn bad_thickness_and_positions_are_refused() {
     let mesh = cap_dome(0.9, 100).unwrap();
-    let p = &mesh.positions;
+    let p = mesh.positions();
     for (t, needle) in [
         (
             Thickness::Uniform(0.0),
@@ -275,7 +275,7 @@ fn bad_thickness_and_positions_are_refused() {
         let err = thicken(&mesh, p, &t).unwrap_err().to_string();
         assert!(err.contains(needle), "{err}");
     }
-    let mut bad = p.clone();
+    let mut bad = p.to_vec();
     bad[4][2] = f64::INFINITY;
     let err = thicken(&mesh, &bad, &Thickness::Uniform(0.1)).unwrap_err();
     assert!(err.to_string().contains("vertex 4"), "{err}");
@@ -322,7 +322,7 @@ fn read_3mf(path: &Path) -> io::RawMesh {
 #[test]
 fn every_format_keeps_the_solid() {
     let mesh = dome_with_hole(200).unwrap();
-    let solid = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.04)).unwrap();
+    let solid = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.04)).unwrap();
     let dir = scratch("formats");
     let bits = |p: &[[f64; 3]]| p.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
     for name in ["s.off", "s.obj", "s.ply", "s-ascii.ply", "s.3mf"] {
@@ -364,7 +364,7 @@ fn three_mf_refuses_an_open_mesh() {
     let mesh = cap_dome(0.9, 50).unwrap();
     let dir = scratch("open-3mf");
     let path = dir.join("shell.3mf");
-    let err = io::write_mesh(&path, &mesh.positions, &mesh.faces).unwrap_err();
+    let err = io::write_mesh(&path, mesh.positions(), mesh.faces()).unwrap_err();
     assert!(err.to_string().contains("3MF holds closed solids"), "{err}");
     assert!(!path.exists());
     let err = io::read_mesh(&path).unwrap_err();
@@ -397,9 +397,9 @@ fn slit_roof(gap: f64) -> Mesh {
 #[test]
 fn parts_that_meet_across_a_slit_are_refused() {
     let mesh = slit_roof(0.005);
-    let thin = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.002)).unwrap();
+    let thin = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.002)).unwrap();
     assert_watertight(&thin.faces);
-    let err = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.0075))
+    let err = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.0075))
         .unwrap_err()
         .to_string();
     assert!(err.contains("would intersect itself where"), "{err}");
@@ -410,14 +410,14 @@ fn parts_that_meet_across_a_slit_are_refused() {
 fn clockwise_input_and_unreferenced_vertices_still_give_an_outward_closed_solid() {
     let dome = cap_dome(0.9, 100).unwrap();
     let anchored: Vec<u32> = (0..dome.n_vertices() as u32)
-        .filter(|&v| dome.anchored[v as usize])
+        .filter(|&v| dome.anchored()[v as usize])
         .collect();
-    let mut positions = dome.positions.clone();
+    let mut positions = dome.positions().to_vec();
     positions.push([5.0, 5.0, 5.0]);
-    let clockwise: Vec<[u32; 3]> = dome.faces.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let clockwise: Vec<[u32; 3]> = dome.faces().iter().map(|&[a, b, c]| [a, c, b]).collect();
     let mesh = Mesh::new(positions, clockwise, &anchored).unwrap();
-    assert!(mesh.reversed);
-    let solid = thicken(&mesh, &mesh.positions, &Thickness::Uniform(0.05)).unwrap();
+    assert!(mesh.reversed());
+    let solid = thicken(&mesh, mesh.positions(), &Thickness::Uniform(0.05)).unwrap();
     assert_eq!(
         solid.positions.len(),
         2 * dome.n_vertices(),

@@ -46,7 +46,7 @@ fn assert_same_results(
         edge.status
     );
     let mesh = &problem.mesh;
-    let free: Vec<usize> = (0..mesh.positions.len())
+    let free: Vec<usize> = (0..mesh.positions().len())
         .filter(|&v| mesh.is_non_anchored(v))
         .collect();
     let p_bar = free.iter().map(|&v| red.loads[v]).sum::<f64>() / free.len() as f64;
@@ -70,7 +70,7 @@ fn assert_same_results(
         edge.objective
     );
     let (lo, hi) = mesh
-        .positions
+        .positions()
         .iter()
         .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
             (
@@ -108,7 +108,7 @@ fn assert_same_results(
     }
     println!(
         "{label}: V={} objective {:.6e} / {:.6e}, eps_inf {:.3e} / {:.3e}, {:.3}s / {:.3}s",
-        mesh.positions.len(),
+        mesh.positions().len(),
         red.objective,
         edge.objective,
         red.eps_inf,
@@ -168,7 +168,7 @@ fn reduced_equals_edge_based_on_generated_meshes() {
     );
     // Prescribed τ on the free arc, and an upper bound.
     let tau = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3))
-        .with_prescribed_tau(vec![0.002; arc.mesh.positions.len()])
+        .with_prescribed_tau(vec![0.002; arc.mesh.positions().len()])
         .unwrap();
     assert_same_optimum(
         "prescribed tau",
@@ -280,14 +280,14 @@ fn native_solver_equals_clarabel_on_generated_meshes() {
 /// recomputed here from the returned force densities.
 fn dual_variation(problem: &Problem, q: &[f64]) -> f64 {
     let mesh = &problem.mesh;
-    let x = &mesh.positions;
+    let x = mesh.positions();
     let dual = |e: u32| {
-        let [a, b] = mesh.edges[e as usize].v.map(|v| x[v as usize]);
+        let [a, b] = mesh.edges()[e as usize].v.map(|v| x[v as usize]);
         q[e as usize] * (a[0] - b[0]).hypot(a[1] - b[1])
     };
-    let interior = |e: u32| !mesh.edges[e as usize].is_boundary();
+    let interior = |e: u32| !mesh.edges()[e as usize].is_boundary();
     let mut sum = 0.0;
-    for f in &mesh.faces {
+    for f in mesh.faces() {
         for k in 0..3 {
             let (a, b) = (f[k], f[(k + 1) % 3]);
             let (c, d) = (b, f[(k + 2) % 3]);
@@ -345,7 +345,7 @@ fn dual_length_smoothing_trades_residual_for_a_smoother_diagram() {
             ),
         ];
         let mesh = &problem.mesh;
-        let free: Vec<usize> = (0..mesh.positions.len())
+        let free: Vec<usize> = (0..mesh.positions().len())
             .filter(|&v| mesh.is_non_anchored(v))
             .collect();
         let p_bar = free.iter().map(|&v| plain.loads[v]).sum::<f64>() / free.len() as f64;
@@ -386,7 +386,7 @@ fn rigid_motions_and_uniform_scaling_give_the_scaled_answer() {
     let reference = analyse(&base, &plain_compression()).unwrap();
     let (angle, scale, shift) = (0.7f64, 3.5, [12.0, -4.0, 2.5]);
     let moved: Vec<[f64; 3]> = mesh
-        .positions
+        .positions()
         .iter()
         .map(|p| {
             let (c, s) = (angle.cos(), angle.sin());
@@ -397,14 +397,14 @@ fn rigid_motions_and_uniform_scaling_give_the_scaled_answer() {
             ]
         })
         .collect();
-    let anchored: Vec<u32> = (0..mesh.positions.len() as u32)
-        .filter(|&v| mesh.anchored[v as usize])
+    let anchored: Vec<u32> = (0..mesh.positions().len() as u32)
+        .filter(|&v| mesh.anchored()[v as usize])
         .collect();
-    let moved = Problem::new(Mesh::new(moved, mesh.faces.clone(), &anchored).unwrap());
+    let moved = Problem::new(Mesh::new(moved, mesh.faces().to_vec(), &anchored).unwrap());
     let r = analyse(&moved, &plain_compression()).unwrap();
     // Loads scale with area (s²), force densities with s, residuals with s², ε∞ not at all.
     let p_scale = reference.loads.iter().fold(0.0f64, |m, x| m.max(*x));
-    for v in 0..mesh.positions.len() {
+    for v in 0..mesh.positions().len() {
         assert!(
             (r.loads[v] - scale * scale * reference.loads[v]).abs()
                 <= 1e-12 * scale * scale * p_scale
@@ -509,10 +509,10 @@ fn the_edge_based_step_solves_a_seven_thousand_vertex_dome() {
     let mesh = generate::dome_with_hole(7200).unwrap();
     // The edge-based unknowns: a force density per edge that can carry one, a τ per free rim
     // vertex.
-    let forces = (mesh.edges.iter())
-        .filter(|e| !e.is_boundary() || e.v.iter().any(|&v| !mesh.anchored[v as usize]))
+    let forces = (mesh.edges().iter())
+        .filter(|e| !e.is_boundary() || e.v.iter().any(|&v| !mesh.anchored()[v as usize]))
         .count();
-    let taus = (0..mesh.positions.len())
+    let taus = (0..mesh.positions().len())
         .filter(|&v| mesh.is_free_boundary(v))
         .count();
     assert!(forces + taus > 20_000, "{forces} + {taus} unknowns");
@@ -536,7 +536,7 @@ fn assert_same_native_optimum(label: &str, problem: &Problem) -> (StressResult, 
 
 /// The mesh's positions with every height multiplied by `factor`.
 fn heights_scaled(mesh: &Mesh, factor: f64) -> Vec<[f64; 3]> {
-    mesh.positions
+    mesh.positions()
         .iter()
         .map(|p| [p[0], p[1], factor * p[2]])
         .collect()
@@ -551,29 +551,29 @@ fn heights_scaled(mesh: &Mesh, factor: f64) -> Vec<[f64; 3]> {
 fn a_stress_cache_reused_or_replaced_gives_the_same_answers() {
     let dome = Problem::new(polar_cap(10, 1.3));
     let lowered = heights_scaled(&dome.mesh, 0.8);
-    let stretched: Vec<[f64; 3]> = (dome.mesh.positions.iter())
+    let stretched: Vec<[f64; 3]> = (dome.mesh.positions().iter())
         .map(|p| [1.3 * p[0], p[1] - 0.2 * p[0] * p[0], p[2]])
         .collect();
     let arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[1] < -0.3));
     let other_arc = Problem::new(holed_disk(3, 0.01, |u, outer| outer && u[0] < 0.3));
-    assert_eq!(arc.mesh.faces, other_arc.mesh.faces);
-    assert_ne!(arc.mesh.anchored, other_arc.mesh.anchored);
+    assert_eq!(arc.mesh.faces(), other_arc.mesh.faces());
+    assert_ne!(arc.mesh.anchored(), other_arc.mesh.anchored());
     let plain = plain_compression()
         .with_solver(QpSolver::Native)
         .with_q_min(QBound::Relative(0.05));
     let bounded = plain.clone().with_q_max(Some(QBound::Relative(1.0)));
     let constant = plain.clone().with_holes(HoleMode::Constant);
     let steps = [
-        (&dome, &dome.mesh.positions, &plain),
-        (&dome, &lowered, &plain),
+        (&dome, dome.mesh.positions(), &plain),
+        (&dome, &lowered[..], &plain),
         (&dome, &lowered, &bounded),
-        (&arc, &arc.mesh.positions, &plain),
-        (&dome, &dome.mesh.positions, &plain),
+        (&arc, arc.mesh.positions(), &plain),
+        (&dome, dome.mesh.positions(), &plain),
         (&dome, &lowered, &plain),
         (&dome, &stretched, &plain),
-        (&arc, &arc.mesh.positions, &plain),
-        (&other_arc, &other_arc.mesh.positions, &plain),
-        (&other_arc, &other_arc.mesh.positions, &constant),
+        (&arc, arc.mesh.positions(), &plain),
+        (&other_arc, other_arc.mesh.positions(), &plain),
+        (&other_arc, other_arc.mesh.positions(), &constant),
     ];
     let mut cache = internals::StressCache::default();
     for (k, &(problem, positions, settings)) in steps.iter().enumerate() {
@@ -597,8 +597,9 @@ fn a_slightly_moved_shape_is_solved_from_the_previous_active_set() {
         .with_solver(QpSolver::Native)
         .with_q_min(QBound::Relative(0.05));
     let mut cache = internals::StressCache::default();
-    let first = internals::analyse_cached(&dome, &dome.mesh.positions, &settings, None, &mut cache)
-        .unwrap();
+    let first =
+        internals::analyse_cached(&dome, dome.mesh.positions(), &settings, None, &mut cache)
+            .unwrap();
     assert!(first.iterations > 0);
     let raised = heights_scaled(&dome.mesh, 1.01);
     let warm = internals::analyse_cached(&dome, &raised, &settings, None, &mut cache).unwrap();
@@ -619,7 +620,7 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
     let small = Problem::new(polar_cap(10, 1.3));
     let mut cache = internals::StressCache::for_form_finding();
     let cached =
-        internals::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache)
+        internals::analyse_cached(&small, small.mesh.positions(), &settings, None, &mut cache)
             .unwrap();
     let fresh = analyse(&small, &settings).unwrap();
     assert_eq!(cached.iterations, fresh.iterations);
@@ -628,15 +629,15 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
     // from it, without interior-point iterations.
     cache.far_from_balance(true);
     let again =
-        internals::analyse_cached(&small, &small.mesh.positions, &settings, None, &mut cache)
+        internals::analyse_cached(&small, small.mesh.positions(), &settings, None, &mut cache)
             .unwrap();
     assert_eq!((again.status, again.iterations), (StressStatus::Solved, 0));
 
     let large = Problem::new(generate::cap_dome(0.8, 13_500).unwrap());
-    assert!(large.mesh.positions.len() > 20_000);
+    assert!(large.mesh.positions().len() > 20_000);
     let mut cache = internals::StressCache::for_form_finding();
     let coarse =
-        internals::analyse_cached(&large, &large.mesh.positions, &settings, None, &mut cache)
+        internals::analyse_cached(&large, large.mesh.positions(), &settings, None, &mut cache)
             .unwrap();
     let exact = analyse(&large, &settings).unwrap();
     for r in [&coarse, &exact] {
@@ -662,8 +663,13 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
     // The same compression: each answer's least force density (q_min binds), relative to the
     // median, over the edges with a bound (not both ends anchored).
     let mesh = &large.mesh;
-    let bounded: Vec<usize> = (0..mesh.edges.len())
-        .filter(|&e| mesh.edges[e].v.iter().any(|&v| !mesh.anchored[v as usize]))
+    let bounded: Vec<usize> = (0..mesh.edges().len())
+        .filter(|&e| {
+            mesh.edges()[e]
+                .v
+                .iter()
+                .any(|&v| !mesh.anchored()[v as usize])
+        })
         .collect();
     let lowest = |r: &StressResult| {
         let mut q: Vec<f64> = bounded.iter().map(|&e| r.force_densities[e]).collect();
@@ -672,7 +678,7 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
     };
     eprintln!(
         "V={}: coarse {} iterations, objective {:e}, lowest q/median {:e}; exact {}, {:e}, {:e}",
-        large.mesh.positions.len(),
+        large.mesh.positions().len(),
         coarse.iterations,
         coarse.objective,
         lowest(&coarse),
@@ -694,19 +700,19 @@ fn form_findings_cache_solves_only_large_qps_coarsely() {
 /// with M(u) = c + a·u, counter-clockwise around the hole. Independent of the solver's cuts.
 fn airy_periods(mesh: &Mesh, q: &[f64]) -> Vec<[f64; 3]> {
     let u = |v: u32| {
-        let p = mesh.positions[v as usize];
+        let p = mesh.positions()[v as usize];
         [p[0], p[1]]
     };
     let face_of_boundary_edge = |a: u32, b: u32| {
-        let e = &mesh.edges[mesh.edge_between(a, b).expect("loop edge")];
+        let e = &mesh.edges()[mesh.edge_between(a, b).expect("loop edge")];
         e.left.or(e.right).expect("boundary edge has a face").face
     };
     let centroid = |t: u32| {
-        let f = mesh.faces[t as usize].map(u);
+        let f = mesh.faces()[t as usize].map(u);
         [0, 1].map(|d| (f[0][d] + f[1][d] + f[2][d]) / 3.0)
     };
     let mut periods = Vec::new();
-    for lp in mesh.loops.iter().filter(|l| !l.is_outer) {
+    for lp in mesh.loops().iter().filter(|l| !l.is_outer) {
         let vs = &lp.vertices;
         let k = vs.len();
         let mut face = face_of_boundary_edge(vs[k - 1], vs[0]);
@@ -720,13 +726,13 @@ fn airy_periods(mesh: &Mesh, q: &[f64]) -> Vec<[f64; 3]> {
                 .edge_between(vs[(i + k - 1) % k], v)
                 .expect("loop edge");
             while face != last {
-                let e = mesh.faces[face as usize]
+                let e = mesh.faces()[face as usize]
                     .iter()
                     .filter(|&&x| x != v)
                     .map(|&x| mesh.edge_between(v, x).expect("face edge"))
                     .find(|&e| e != came)
                     .expect("fan edge");
-                let edge = &mesh.edges[e];
+                let edge = &mesh.edges()[e];
                 let [a, b] = edge.v.map(u);
                 let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
                 phi += grad[0] * (m[0] - point[0]) + grad[1] * (m[1] - point[1]);
@@ -801,7 +807,7 @@ fn hole_coefficients_are_the_airy_jumps_integrated_from_the_force_densities() {
         // q = S y holds exactly, so the integrated jumps equal the returned ones to rounding:
         // c scales as q L², a as q L (L the mesh's plan diameter).
         let q_max = r.force_densities.iter().fold(0.0f64, |m, q| m.max(q.abs()));
-        let (lo, hi) = problem.mesh.positions.iter().fold(
+        let (lo, hi) = problem.mesh.positions().iter().fold(
             ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
             |(lo, hi), p| {
                 (
@@ -911,15 +917,15 @@ fn ringed_hole() -> Mesh {
 #[test]
 fn a_hole_ringed_by_holes_is_cut_through_the_ring() {
     let mesh = ringed_hole();
-    assert_eq!(mesh.loops.iter().filter(|l| !l.is_outer).count(), 8);
+    assert_eq!(mesh.loops().iter().filter(|l| !l.is_outer).count(), 8);
     let centre_loop = mesh
-        .loops
+        .loops()
         .iter()
         .position(|l| l.vertices.contains(&(3 * 8 + 3)))
         .unwrap();
     // No interior vertex next to the central hole: a cut to the outer loop alone would fail.
-    for &v in &mesh.loops[centre_loop].vertices {
-        assert!(mesh.neighbours(v).all(|w| mesh.on_boundary[w as usize]));
+    for &v in &mesh.loops()[centre_loop].vertices {
+        assert!(mesh.neighbours(v).all(|w| mesh.on_boundary()[w as usize]));
     }
     let cuts = voussoir::internals::cut_holes(&mesh).unwrap();
     let centre = cuts

@@ -256,11 +256,11 @@ fn write_outputs(
     }
     if let Some((obj, json)) = &paths.input_copy {
         let anchored: Vec<usize> = (0..mesh.n_vertices())
-            .filter(|&v| mesh.anchored[v])
+            .filter(|&v| mesh.anchored()[v])
             .collect();
         let supports = serde_json::json!({ "anchored": anchored }).to_string() + "\n";
         staging
-            .write_obj(obj, &mesh.positions, &model.faces)
+            .write_obj(obj, mesh.positions(), &model.faces)
             .map_err(failed)?;
         staging.write(json, supports.as_bytes()).map_err(failed)?;
     }
@@ -337,7 +337,7 @@ fn print_model(m: &model::Model) {
         count(mesh.n_faces(), "face", "faces"),
         count(mesh.n_edges(), "edge", "edges"),
         count(mesh.holes().count(), "hole", "holes"),
-        mesh.anchored.iter().filter(|a| **a).count()
+        mesh.anchored().iter().filter(|a| **a).count()
     );
     if let Some(w) = m.read.weld.as_ref().filter(|w| w.merged > 0) {
         say!(

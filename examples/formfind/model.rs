@@ -76,7 +76,7 @@ pub fn embedded_default() -> Model {
     };
     let mesh = generate::lift(&points, &triangles, height, pillar)
         .expect("the embedded vault is a valid mesh");
-    let faces = mesh.faces.clone();
+    let faces = mesh.faces().to_vec();
     let source = "embedded default: sail vault on four pillars, free arches, two oculi";
     Model {
         name: "vault".into(),

@@ -44,7 +44,7 @@ fn q_scale(q: impl Iterator<Item = f64>) -> (f64, Vec<(f64, String)>) {
 fn plan_box(mesh: &Mesh, positions: &[[f64; 3]]) -> ([f64; 2], [f64; 2]) {
     bbox(
         (0..mesh.n_vertices())
-            .filter(|&v| mesh.referenced[v])
+            .filter(|&v| mesh.referenced()[v])
             .map(|v| plan(&positions[v])),
     )
 }
@@ -78,7 +78,7 @@ fn polygon(view: &View, points: impl IntoIterator<Item = [f64; 2]>) -> Polygon {
 /// Faces filled with `fill(face)`.
 fn faces(mesh: &Mesh, pos: &[[f64; 3]], view: &View, fill: impl Fn(usize) -> String) -> Group {
     let mut g = Bulk::default();
-    for (t, f) in mesh.faces.iter().enumerate() {
+    for (t, f) in mesh.faces().iter().enumerate() {
         let c = fill(t);
         g = g.add(
             polygon(view, f.map(|v| plan(&pos[v as usize])))
@@ -93,7 +93,7 @@ fn faces(mesh: &Mesh, pos: &[[f64; 3]], view: &View, fill: impl Fn(usize) -> Str
 /// Boundary loops (outer and holes).
 fn outline(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
     let mut g = Group::new();
-    for lp in &mesh.loops {
+    for lp in mesh.loops() {
         g = g.add(
             polygon(view, lp.vertices.iter().map(|&v| plan(&pos[v as usize])))
                 .set("fill", "none")
@@ -106,7 +106,7 @@ fn outline(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
 
 fn wireframe(mesh: &Mesh, pos: &[[f64; 3]], view: &View, colour: &str) -> Group {
     let mut g = Bulk::default();
-    for e in &mesh.edges {
+    for e in mesh.edges() {
         let [a, b] = e.v.map(|v| view.px(plan(&pos[v as usize])));
         g = g.add(line(a, b, colour, 0.5));
     }
@@ -116,7 +116,7 @@ fn wireframe(mesh: &Mesh, pos: &[[f64; 3]], view: &View, colour: &str) -> Group 
 /// Black squares at the anchored vertices.
 fn anchors(mesh: &Mesh, pos: &[[f64; 3]], view: &View) -> Group {
     let mut g = Bulk::default();
-    for v in (0..mesh.n_vertices()).filter(|&v| mesh.anchored[v] && mesh.referenced[v]) {
+    for v in (0..mesh.n_vertices()).filter(|&v| mesh.anchored()[v] && mesh.referenced()[v]) {
         let (x, y) = view.px(plan(&pos[v]));
         g = g.add(
             Rectangle::new()
@@ -178,7 +178,7 @@ fn plan_forces_of(name: &str, mesh: &Mesh, pos: &[[f64; 3]], q: &[f64], tau: &[f
     order.sort_by(|&a, &b| q[a].total_cmp(&q[b]));
     let mut edges = Bulk::default();
     for e in order {
-        let [a, b] = mesh.edges[e].v.map(|v| view.px(plan(&pos[v as usize])));
+        let [a, b] = mesh.edges()[e].v.map(|v| view.px(plan(&pos[v as usize])));
         let t = if q_top > 0.0 {
             (q[e] / q_top).min(1.0)
         } else {
@@ -281,9 +281,9 @@ fn residuals(o: &Outcome) -> Document {
     let mesh = o.model.mesh();
     let tol = o.tolerance;
     let floor = (tol / 10.0).log10().floor();
-    let mut panels = vec![("input", &o.model.mesh().positions, &o.before)];
+    let mut panels = vec![("input", mesh.positions(), &o.before)];
     if o.termination.is_some() {
-        panels.push(("form-found", &o.positions, &o.stress));
+        panels.push(("form-found", o.positions.as_slice(), &o.stress));
     }
     // |r_i| over the mean load of the same stress step (loads follow the 3-D area).
     let rel: Vec<Vec<f64>> = panels
@@ -366,7 +366,7 @@ fn residuals(o: &Outcome) -> Document {
 fn height_change(o: &Outcome) -> Document {
     let mesh = o.model.mesh();
     let dz: Vec<f64> = (0..mesh.n_vertices())
-        .map(|v| o.positions[v][2] - mesh.positions[v][2])
+        .map(|v| o.positions[v][2] - mesh.positions()[v][2])
         .collect();
     let m = dz.iter().fold(0.0f64, |a, d| a.max(d.abs()));
     let (lo, hi) = plan_box(mesh, &o.positions);
@@ -384,7 +384,7 @@ fn height_change(o: &Outcome) -> Document {
         ),
     );
     let fill = |t: usize| {
-        let mean = mesh.faces[t].iter().map(|&v| dz[v as usize]).sum::<f64>() / 3.0;
+        let mean = mesh.faces()[t].iter().map(|&v| dz[v as usize]).sum::<f64>() / 3.0;
         draw::diverging(if m > 0.0 { 0.5 + 0.5 * mean / m } else { 0.5 })
     };
     let y = height - LEGEND + 40.0;

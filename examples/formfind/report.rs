@@ -13,7 +13,7 @@ pub fn solid(solid: &voussoir::Solid, outcome: &Outcome, o: &Options) -> Value {
     let area: f64 = outcome
         .model
         .mesh()
-        .faces
+        .faces()
         .iter()
         .map(|f| {
             let [a, b, c] = f.map(|v| outcome.positions[v as usize]);

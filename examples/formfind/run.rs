@@ -53,7 +53,7 @@ impl Outcome {
             None => Run::Analysis(&self.before),
         };
         let mut report = Report::new(&self.model.read, settings, run);
-        report.settings.supports = self.model.supports.clone();
+        report.settings.read.supports = self.model.supports.clone();
         report
     }
 }
@@ -85,7 +85,7 @@ pub fn run(mut model: Model, o: &Options) -> voussoir::Result<Outcome> {
         return Ok(Outcome {
             found: None,
             termination: None,
-            positions: problem.mesh.positions.clone(),
+            positions: problem.mesh.positions().to_vec(),
             stress: before.clone(),
             iterations: 1,
             hausdorff: 0.0,

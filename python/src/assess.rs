@@ -8,15 +8,7 @@ use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use voussoir::report::AssessmentReport;
-use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, QBound, Thickness};
-
-const OBJECTIVES: [&str; 5] = [
-    "fit",
-    "min-thickness",
-    "min-thrust",
-    "max-thrust",
-    "max-load",
-];
+use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, Objective, QBound, Thickness};
 
 fn text(name: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
     v.extract().map_err(|_| {
@@ -62,17 +54,7 @@ pub fn settings_from(kwargs: &Bound<'_, PyDict>) -> PyResult<AssessSettings> {
     for (key, v) in kwargs.iter() {
         let key: String = key.extract()?;
         match key.as_str() {
-            "objective" => {
-                let name = text(&key, &v)?;
-                s.objective = name.parse().map_err(|_| {
-                    let allowed: Vec<String> =
-                        OBJECTIVES.iter().map(|o| format!("'{o}'")).collect();
-                    invalid(
-                        &key,
-                        format_args!("'{name}' is not one of {}", allowed.join(", ")),
-                    )
-                })?;
-            }
+            "objective" => s.objective = crate::settings::named::<Objective>(&key, &v)?,
             "fixed_supports" => {
                 s.fixed_supports = v
                     .extract::<bool>()
@@ -284,7 +266,7 @@ fn fields<'py>(
     d.set_item("termination_detail", detail)?;
     d.set_item("iterations", r.iterations)?;
     d.set_item("positions", matrix(py, &r.positions))?;
-    let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
+    let edges: Vec<[u32; 2]> = mesh.edges().iter().map(|e| e.v).collect();
     d.set_item("edges", matrix(py, &edges))?;
     d.set_item(
         "force_densities",

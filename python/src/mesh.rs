@@ -310,7 +310,7 @@ impl Mesh {
     /// Vertex positions, (n, 3) float64: x, y plan, z height.
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        crate::results::matrix(py, &self.mesh().positions)
+        crate::results::matrix(py, self.mesh().positions())
     }
 
     /// Faces, (m, 3) uint32, in the orientation given.
@@ -322,16 +322,13 @@ impl Mesh {
     /// Anchored vertex ids, sorted, (k,) uint32.
     #[getter]
     fn anchored<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
-        let ids: Vec<u32> = (0..self.mesh().n_vertices() as u32)
-            .filter(|&v| self.mesh().anchored[v as usize])
-            .collect();
-        PyArray1::from_vec(py, ids)
+        PyArray1::from_vec(py, self.mesh().anchored_ids())
     }
 
     /// Edges, (E, 2) uint32, smaller id first, sorted: row e is edge e of per-edge arrays.
     #[getter]
     fn edges<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<u32>> {
-        let edges: Vec<[u32; 2]> = self.mesh().edges.iter().map(|e| e.v).collect();
+        let edges: Vec<[u32; 2]> = self.mesh().edges().iter().map(|e| e.v).collect();
         crate::results::matrix(py, &edges)
     }
 

@@ -29,7 +29,7 @@ pub fn stress<'py>(
     let d = PyDict::new(py);
     d.set_item("status", s.status.as_str())?;
     d.set_item("positions", matrix(py, positions))?;
-    let edges: Vec<[u32; 2]> = mesh.edges.iter().map(|e| e.v).collect();
+    let edges: Vec<[u32; 2]> = mesh.edges().iter().map(|e| e.v).collect();
     d.set_item("edges", matrix(py, &edges))?;
     d.set_item(
         "force_densities",

@@ -8,8 +8,8 @@ use pyo3::types::PyDict;
 use std::str::FromStr;
 use voussoir::io::UpAxis;
 use voussoir::{
-    EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, QBound, QpSolver,
-    TauMode,
+    EdgeScope, FormFindSettings, FormMethod, Formulation, HoleMode, LoadRule, Objective, QBound,
+    QpSolver, TauMode,
 };
 
 const KINDS: [(&str, bool); 2] = [("relative", true), ("absolute", false)];
@@ -69,6 +69,7 @@ pub fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("holes", names(HoleMode::ALL))?;
     d.set_item("load_rule", names(LoadRule::ALL))?;
     d.set_item("up", names(UpAxis::ALL))?;
+    d.set_item("objective", names(Objective::ALL))?;
     let kinds: Vec<&str> = KINDS.iter().map(|k| k.0).collect();
     d.set_item("q_min_kind", kinds.clone())?;
     d.set_item("q_max_kind", kinds)?;

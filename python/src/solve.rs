@@ -62,7 +62,7 @@ pub fn analyse<'py>(
         .map_err(|e| from_error("mesh", e))?;
     // A Ctrl-C during the solve is a KeyboardInterrupt now, not somewhere after.
     py.check_signals()?;
-    let d = results::stress(py, &m.problem().mesh, &m.problem().mesh.positions, &stress)?;
+    let d = results::stress(py, &m.problem().mesh, m.problem().mesh.positions(), &stress)?;
     if report {
         let run = voussoir::report::Run::Analysis(&stress);
         d.set_item("report", Report::new(&m.model, &form, run).to_json())?;

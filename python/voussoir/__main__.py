@@ -132,7 +132,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--density", type=float, default=1.0, help="weight per unit area of every face [1]")
     p.add_argument("--load", choices=names["load_rule"], help=f"[{d['load_rule']}]")
     a = p.add_argument_group("assessment (instead of form finding; MESH is the middle surface)")
-    a.add_argument("--assess", choices=["fit", "min-thickness", "min-thrust", "max-thrust", "max-load"],
+    a.add_argument("--assess", choices=names["objective"],
                    help="a compression-only thrust surface inside the masonry: the one nearest the "
                    "middle surface, the least thickness, the least or greatest thrust, the largest "
                    "factor on --load-pattern")

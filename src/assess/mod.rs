@@ -26,7 +26,8 @@ use crate::problem::Problem;
 use crate::solve::{Progress, Termination};
 use crate::stress::QBound;
 
-/// What [`assess`] optimises over the thrust surfaces that fit inside the envelope.
+/// What [`assess`] optimises over the thrust surfaces that fit inside the envelope. Its names
+/// (`fit`, `min-thickness`, ...: `as_str`, `Display`, `FromStr`) are those of `src/names.rs`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Objective {
@@ -44,40 +45,6 @@ pub enum Objective {
     MaxThrust,
     /// The largest factor λ on [`AssessSettings::load_pattern`] added to the self-weight.
     MaxLoad,
-}
-
-impl Objective {
-    /// The name used by the command line, Python and the JSON report.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Objective::Fit => "fit",
-            Objective::MinThickness => "min-thickness",
-            Objective::MinThrust => "min-thrust",
-            Objective::MaxThrust => "max-thrust",
-            Objective::MaxLoad => "max-load",
-        }
-    }
-}
-
-impl std::str::FromStr for Objective {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Objective> {
-        let all = [
-            Objective::Fit,
-            Objective::MinThickness,
-            Objective::MinThrust,
-            Objective::MaxThrust,
-            Objective::MaxLoad,
-        ];
-        all.into_iter()
-            .find(|o| o.as_str() == s)
-            .ok_or_else(|| Error::InvalidArgument {
-                name: "objective",
-                reason: format!(
-                    "'{s}' is not one of fit, min-thickness, min-thrust, max-thrust, max-load"
-                ),
-            })
-    }
 }
 
 /// Settings of [`assess`]. `Default` gives the documented defaults.

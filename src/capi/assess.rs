@@ -4,12 +4,12 @@
 
 use super::assessment::VsrAssessment;
 use super::boundary::{
-    boundary, checked_len, copy_out, from_error, handle, handle_mut, input, out_ptr, CResult,
-    Failure,
+    boundary, checked_len, copy_out, free, from_error, give, handle, handle_mut, input, out_ptr,
+    CResult, Failure,
 };
 use super::enum_args;
 use super::mesh::VsrMesh;
-use super::settings::VsrProgressFn;
+use super::settings::{Progress, VsrProgressFn};
 use super::status::VsrStatus;
 use crate::assess::{assess, AssessSettings, Envelope};
 use crate::solid::Thickness;
@@ -23,13 +23,6 @@ use std::ffi::c_void;
 /// at once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
 pub struct VsrEnvelope {
     pub(crate) envelope: Envelope,
-}
-
-/// Writes a new envelope handle to `out`.
-fn give(out: *mut *mut VsrEnvelope, envelope: Envelope) {
-    let handle = Box::new(VsrEnvelope { envelope });
-    // SAFETY: `out` was checked non-NULL; writable by the caller's contract.
-    unsafe { out.write(Box::into_raw(handle)) };
 }
 
 fn finite_values(name: &str, values: &[f64], what: &str) -> CResult {
@@ -86,8 +79,8 @@ pub unsafe extern "C" fn vsr_envelope_from_thickness(
         };
         finite_values("thickness", values, "entry")?;
         let envelope = Envelope::from_thickness(m, &t).map_err(|e| from_error("thickness", e))?;
-        give(out, envelope);
-        Ok(())
+        // SAFETY: `out` checked above, writable by the caller's contract.
+        unsafe { give(out, VsrEnvelope { envelope }) }
     })
 }
 
@@ -201,8 +194,8 @@ pub unsafe extern "C" fn vsr_envelope_from_surfaces(
             (&upper.0, &upper.1),
         )
         .map_err(|e| from_error("intrados", e))?;
-        give(out, envelope);
-        Ok(())
+        // SAFETY: `out` checked above, writable by the caller's contract.
+        unsafe { give(out, VsrEnvelope { envelope }) }
     })
 }
 
@@ -213,12 +206,8 @@ pub unsafe extern "C" fn vsr_envelope_from_surfaces(
 /// destroyed, used by no other thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_envelope_destroy(envelope: *mut VsrEnvelope) {
-    boundary!(keep_error, (), {
-        if !envelope.is_null() {
-            // SAFETY: from Box::into_raw in give(), destroyed once (caller's contract).
-            drop(unsafe { Box::from_raw(envelope) });
-        }
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(envelope) } })
 }
 
 /// Borrows the envelope and copies `pick(envelope)` out.
@@ -290,8 +279,7 @@ pub unsafe extern "C" fn vsr_envelope_face_thickness(
 /// with `vsr_assess_settings_destroy`.
 pub struct VsrAssessSettings {
     pub(crate) settings: AssessSettings,
-    pub(crate) progress: VsrProgressFn,
-    pub(crate) user: *mut c_void,
+    pub(crate) progress: Progress,
 }
 
 /// Creates assessment settings with the documented defaults (those of the Rust
@@ -317,15 +305,12 @@ pub struct VsrAssessSettings {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_assess_settings_create(out: *mut *mut VsrAssessSettings) -> VsrStatus {
     boundary!({
-        let out = out_ptr("out", out)?;
-        let handle = Box::new(VsrAssessSettings {
+        let handle = VsrAssessSettings {
             settings: AssessSettings::default(),
-            progress: None,
-            user: std::ptr::null_mut(),
-        });
-        // SAFETY: non-NULL, writable by the caller's contract.
-        unsafe { out.write(Box::into_raw(handle)) };
-        Ok(())
+            progress: Progress::default(),
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { give(out, handle) }
     })
 }
 
@@ -336,12 +321,8 @@ pub unsafe extern "C" fn vsr_assess_settings_create(out: *mut *mut VsrAssessSett
 /// used by no other thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_assess_settings_destroy(settings: *mut VsrAssessSettings) {
-    boundary!(keep_error, (), {
-        if !settings.is_null() {
-            // SAFETY: from Box::into_raw in vsr_assess_settings_create, destroyed once.
-            drop(unsafe { Box::from_raw(settings) });
-        }
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(settings) } })
 }
 
 /// Applies `f` to a copy of the settings, validates the copy, and stores it on success.
@@ -538,17 +519,8 @@ pub unsafe extern "C" fn vsr_assess_settings_set_progress(
     callback: VsrProgressFn,
     user: *mut c_void,
 ) -> VsrStatus {
-    boundary!({
-        // SAFETY: caller's contract.
-        let s = unsafe { handle_mut("settings", settings)? };
-        s.progress = callback;
-        s.user = if callback.is_some() {
-            user
-        } else {
-            std::ptr::null_mut()
-        };
-        Ok(())
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { Progress::set(settings, |s| &mut s.progress, callback, user) } })
 }
 
 /// Masonry assessment (Heyman's safe theorem): a compression-only thrust surface over the
@@ -590,19 +562,9 @@ pub unsafe extern "C" fn vsr_assess(
         };
         let out = out_ptr("out", out)?;
         let (problem, s) = (&mesh.problem, &settings.settings);
-        let result = match settings.progress {
-            Some(cb) => {
-                let user = settings.user;
-                let mut progress = |k: usize, infeasibility: f64| {
-                    // SAFETY: the callback and `user` are valid for this call (caller's
-                    // contract); C code does not unwind into Rust.
-                    unsafe { cb(user, k, infeasibility) == 0 }
-                };
-                assess(problem, &envelope.envelope, s, Some(&mut progress))
-            }
-            None => assess(problem, &envelope.envelope, s, None),
-        }
-        .map_err(|e| from_error("mesh", e))?;
+        let result = (settings.progress)
+            .run(|progress| assess(problem, &envelope.envelope, s, progress))
+            .map_err(|e| from_error("mesh", e))?;
         let handle = Box::new(VsrAssessment::new(&problem.mesh, result));
         // SAFETY: non-NULL, writable by the caller's contract.
         unsafe { out.write(Box::into_raw(handle)) };

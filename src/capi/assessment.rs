@@ -1,7 +1,7 @@
 //! `VsrAssessment` (the outcome of `vsr_assess`) and its getters. Array getters copy out as
 //! `VsrResult`'s do: `(assessment, out, len, needed)`.
 
-use super::boundary::{boundary, copy_out, handle, out_ptr, CResult};
+use super::boundary::{boundary, c_string, copy, free, handle, out_ptr, scalars};
 use super::status::{VsrObjective, VsrStatus, VsrTermination};
 use crate::assess::AssessResult;
 use crate::mesh::Mesh;
@@ -35,44 +35,8 @@ impl VsrAssessment {
 /// thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_assessment_destroy(assessment: *mut VsrAssessment) {
-    boundary!(keep_error, (), {
-        if !assessment.is_null() {
-            // SAFETY: from Box::into_raw in vsr_assess, destroyed once (caller's contract).
-            drop(unsafe { Box::from_raw(assessment) });
-        }
-    })
-}
-
-/// Borrows the assessment, checks every out-pointer, then writes `pick(result)` into them.
-unsafe fn scalars<T: Copy, const N: usize>(
-    assessment: *const VsrAssessment,
-    outs: [(&str, *mut T); N],
-    pick: impl FnOnce(&AssessResult) -> [T; N],
-) -> CResult {
-    // SAFETY: caller's contract.
-    let a = unsafe { handle("assessment", assessment)? };
-    for (name, p) in outs {
-        out_ptr(name, p)?;
-    }
-    for ((_, p), v) in outs.into_iter().zip(pick(&a.result)) {
-        // SAFETY: non-NULL and writable by the caller's contract.
-        unsafe { p.write(v) };
-    }
-    Ok(())
-}
-
-/// Borrows the assessment and copies `pick(assessment)` out.
-unsafe fn copy<T: Copy>(
-    assessment: *const VsrAssessment,
-    out: *mut T,
-    len: usize,
-    needed: *mut usize,
-    pick: impl FnOnce(&VsrAssessment) -> Vec<T>,
-) -> CResult {
-    // SAFETY: caller's contract.
-    let a = unsafe { handle("assessment", assessment)? };
-    // SAFETY: caller's contract.
-    unsafe { copy_out(&pick(a), out, len, needed) }
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(assessment) } })
 }
 
 /// The analysis that was run (a `VsrObjective`). Written only on success.
@@ -87,8 +51,8 @@ pub unsafe extern "C" fn vsr_assessment_objective(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(assessment, [("out", out)], |r| {
-                [VsrObjective::of(r.objective)]
+            scalars("assessment", assessment, [("out", out)], |a| {
+                Ok([VsrObjective::of(a.result.objective)])
             })
         }
     })
@@ -157,13 +121,14 @@ pub unsafe extern "C" fn vsr_assessment_figures(
         ];
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(assessment, outs, |r| {
-                [
+            scalars("assessment", assessment, outs, |a| {
+                let r = &a.result;
+                Ok([
                     r.thickness_scale,
                     r.safety_factor,
                     r.thrust_horizontal,
                     r.load_factor,
-                ]
+                ])
             })
         }
     })
@@ -229,14 +194,8 @@ pub unsafe extern "C" fn vsr_assessment_termination_message(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(assessment, out, len, needed, |a| {
-                let text = a.result.termination.to_string();
-                let mut bytes: Vec<c_char> = (text.bytes())
-                    .filter(|&b| b != 0)
-                    .map(|b| b as c_char)
-                    .collect();
-                bytes.push(0);
-                bytes
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(c_string(&a.result.termination.to_string()))
             })
         }
     })
@@ -257,8 +216,8 @@ pub unsafe extern "C" fn vsr_assessment_positions(
     // SAFETY: forwarded caller's contract.
     boundary!({
         unsafe {
-            copy(assessment, out, len, needed, |a| {
-                a.result.positions.iter().flatten().copied().collect()
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.positions.iter().flatten().copied().collect())
             })
         }
     })
@@ -280,8 +239,8 @@ pub unsafe extern "C" fn vsr_assessment_force_densities(
     // SAFETY: forwarded caller's contract.
     boundary!({
         unsafe {
-            copy(assessment, out, len, needed, |a| {
-                a.result.force_densities.clone()
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.force_densities.clone())
             })
         }
     })
@@ -301,7 +260,13 @@ pub unsafe extern "C" fn vsr_assessment_loads(
     needed: *mut usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.loads.clone()) } })
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.loads.clone())
+            })
+        }
+    })
 }
 
 /// Vertical residual per vertex, #V doubles (0 at supports).
@@ -317,7 +282,13 @@ pub unsafe extern "C" fn vsr_assessment_residuals(
     needed: *mut usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.residuals.clone()) } })
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.residuals.clone())
+            })
+        }
+    })
 }
 
 /// Lower bound per vertex at the reported thickness (the envelope's intrados, scaled by the
@@ -334,7 +305,13 @@ pub unsafe extern "C" fn vsr_assessment_lower(
     needed: *mut usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.lower.clone()) } })
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.lower.clone())
+            })
+        }
+    })
 }
 
 /// Upper bound per vertex at the reported thickness, #V doubles.
@@ -350,7 +327,13 @@ pub unsafe extern "C" fn vsr_assessment_upper(
     needed: *mut usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.result.upper.clone()) } })
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.upper.clone())
+            })
+        }
+    })
 }
 
 /// Horizontal reaction per vertex, #V by 2 doubles (non-zero at supports): the force the
@@ -369,8 +352,8 @@ pub unsafe extern "C" fn vsr_assessment_reactions(
     // SAFETY: forwarded caller's contract.
     boundary!({
         unsafe {
-            copy(assessment, out, len, needed, |a| {
-                a.result.reactions.iter().flatten().copied().collect()
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.reactions.iter().flatten().copied().collect())
             })
         }
     })
@@ -390,5 +373,11 @@ pub unsafe extern "C" fn vsr_assessment_edges(
     needed: *mut usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { copy(assessment, out, len, needed, |a| a.edges.clone()) } })
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.edges.clone())
+            })
+        }
+    })
 }

@@ -187,6 +187,84 @@ pub(crate) fn out_ptr<T>(name: &str, ptr: *mut T) -> CResult<*mut T> {
     }
 }
 
+/// Moves `value` to the heap and gives it to the caller through `out` (checked first): the
+/// body of the `_create` functions and of the solves.
+///
+/// # Safety
+/// `out` must be NULL or writable.
+pub(crate) unsafe fn give<T>(out: *mut *mut T, value: T) -> CResult {
+    let out = out_ptr("out", out)?;
+    // SAFETY: non-NULL, writable by the caller's contract.
+    unsafe { out.write(Box::into_raw(Box::new(value))) };
+    Ok(())
+}
+
+/// Frees a handle made by [`give`]; NULL is a no-op: the body of the `_destroy` functions.
+///
+/// # Safety
+/// `ptr` must be NULL or a handle from [`give`] not yet freed, used by no other thread.
+pub(crate) unsafe fn free<T>(ptr: *mut T) {
+    if !ptr.is_null() {
+        // SAFETY: from Box::into_raw in `give`, freed once (caller's contract).
+        drop(unsafe { Box::from_raw(ptr) });
+    }
+}
+
+/// Borrows the handle `name`, checks every out-pointer, then writes `pick(handle)` into
+/// them: the body of the getters of several scalars of one type.
+///
+/// # Safety
+/// As [`handle`]; the out-pointers writable.
+pub(crate) unsafe fn scalars<H, T: Copy, const N: usize>(
+    name: &str,
+    ptr: *const H,
+    outs: [(&str, *mut T); N],
+    pick: impl FnOnce(&H) -> CResult<[T; N]>,
+) -> CResult {
+    // SAFETY: caller's contract.
+    let h = unsafe { handle(name, ptr)? };
+    for (name, p) in outs {
+        out_ptr(name, p)?;
+    }
+    let values = pick(h)?;
+    for ((_, p), v) in outs.into_iter().zip(values) {
+        // SAFETY: non-NULL and writable by the caller's contract.
+        unsafe { p.write(v) };
+    }
+    Ok(())
+}
+
+/// Borrows the handle `name` and copies `pick(handle)` out with [`copy_out`]: the body of
+/// every array getter.
+///
+/// # Safety
+/// As [`handle`] and [`copy_out`].
+pub(crate) unsafe fn copy<H, T: Copy>(
+    name: &str,
+    ptr: *const H,
+    out: *mut T,
+    len: usize,
+    needed: *mut usize,
+    pick: impl FnOnce(&H) -> CResult<Vec<T>>,
+) -> CResult {
+    // SAFETY: caller's contract.
+    let h = unsafe { handle(name, ptr)? };
+    let data = pick(h)?;
+    // SAFETY: caller's contract.
+    unsafe { copy_out(&data, out, len, needed) }
+}
+
+/// `text` as a NUL-terminated string for [`copy`] (its NUL bytes, if any, left out).
+pub(crate) fn c_string(text: &str) -> Vec<c_char> {
+    let mut bytes: Vec<c_char> = text
+        .bytes()
+        .filter(|&b| b != 0)
+        .map(|b| b as c_char)
+        .collect();
+    bytes.push(0);
+    bytes
+}
+
 /// Copies `data` into the caller's buffer `out` of capacity `len` elements and reports
 /// `data.len()` through `needed` (optional).
 ///

@@ -1,7 +1,7 @@
 //! `VsrMesh`: a validated mesh and its loading (a [`Problem`]).
 
 use super::boundary::{
-    boundary, checked_len, copy_out, from_error, handle, handle_mut, input, out_ptr, CResult,
+    boundary, checked_len, copy_out, free, from_error, handle, handle_mut, input, out_ptr, CResult,
     Failure,
 };
 use super::status::VsrStatus;
@@ -128,12 +128,8 @@ pub unsafe extern "C" fn vsr_mesh_create(
 /// other thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_mesh_destroy(mesh: *mut VsrMesh) {
-    boundary!(keep_error, (), {
-        if !mesh.is_null() {
-            // SAFETY: from Box::into_raw in vsr_mesh_create, destroyed once (caller's contract).
-            drop(unsafe { Box::from_raw(mesh) });
-        }
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(mesh) } })
 }
 
 /// Reads `rows` by `width` doubles (one row per face or per vertex), checks finiteness, and applies `set` to a copy of the

@@ -5,7 +5,7 @@
 //! number of elements the data has, on success and on `VSR_STATUS_BUFFER_TOO_SMALL`; `out`
 //! is written only on success.
 
-use super::boundary::{boundary, copy_out, handle, out_ptr, CResult, Failure};
+use super::boundary::{boundary, c_string, copy, free, handle, out_ptr, scalars, CResult, Failure};
 use super::status::{VsrQpSolver, VsrResultKind, VsrStatus, VsrStressStatus, VsrTermination};
 use crate::mesh::Mesh;
 use crate::stress::StressResult;
@@ -67,40 +67,6 @@ impl VsrResult {
     }
 }
 
-/// Borrows the result and copies `pick(result)` out.
-unsafe fn copy<T: Copy>(
-    result: *const VsrResult,
-    out: *mut T,
-    len: usize,
-    needed: *mut usize,
-    pick: impl FnOnce(&VsrResult) -> CResult<Vec<T>>,
-) -> CResult {
-    // SAFETY: caller's contract.
-    let r = unsafe { handle("result", result)? };
-    let data = pick(r)?;
-    // SAFETY: caller's contract.
-    unsafe { copy_out(&data, out, len, needed) }
-}
-
-/// Borrows the result, checks every out-pointer, then writes `pick(result)` into them.
-unsafe fn scalars<T: Copy, const N: usize>(
-    result: *const VsrResult,
-    outs: [(&str, *mut T); N],
-    pick: impl FnOnce(&VsrResult) -> CResult<[T; N]>,
-) -> CResult {
-    // SAFETY: caller's contract.
-    let r = unsafe { handle("result", result)? };
-    for (name, p) in outs {
-        out_ptr(name, p)?;
-    }
-    let values = pick(r)?;
-    for ((_, p), v) in outs.into_iter().zip(values) {
-        // SAFETY: non-NULL and writable by the caller's contract.
-        unsafe { p.write(v) };
-    }
-    Ok(())
-}
-
 fn flat2(v: &[[f64; 2]]) -> Vec<f64> {
     v.iter().flatten().copied().collect()
 }
@@ -111,12 +77,8 @@ fn flat2(v: &[[f64; 2]]) -> Vec<f64> {
 /// `result` must be NULL or a handle from a solve not yet destroyed, used by no other thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_result_destroy(result: *mut VsrResult) {
-    boundary!(keep_error, (), {
-        if !result.is_null() {
-            // SAFETY: from Box::into_raw in a solve, destroyed once (caller's contract).
-            drop(unsafe { Box::from_raw(result) });
-        }
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(result) } })
 }
 
 /// Which solve produced the result: `VSR_RESULT_KIND_ANALYSIS` or
@@ -132,7 +94,7 @@ pub unsafe extern "C" fn vsr_result_kind(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, [("out", out)], |r| {
+            scalars("result", result, [("out", out)], |r| {
                 Ok([match r.outcome {
                     Outcome::Analysis { .. } => VsrResultKind::Analysis,
                     Outcome::FormFinding(_) => VsrResultKind::FormFinding,
@@ -164,7 +126,7 @@ pub unsafe extern "C" fn vsr_result_counts(
         ];
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, outs, |r| {
+            scalars("result", result, outs, |r| {
                 Ok([
                     r.positions().len(),
                     r.edges.len() / 2,
@@ -193,7 +155,7 @@ pub unsafe extern "C" fn vsr_result_positions(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.positions().iter().flatten().copied().collect())
             })
         }
@@ -215,7 +177,7 @@ pub unsafe extern "C" fn vsr_result_edges(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { copy(result, out, len, needed, |r| Ok(r.edges.clone())) }
+        unsafe { copy("result", result, out, len, needed, |r| Ok(r.edges.clone())) }
     })
 }
 
@@ -234,7 +196,7 @@ pub unsafe extern "C" fn vsr_result_force_densities(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.stress().force_densities.clone())
             })
         }
@@ -258,7 +220,11 @@ pub unsafe extern "C" fn vsr_result_airy(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().airy.clone())) }
+        unsafe {
+            copy("result", result, out, len, needed, |r| {
+                Ok(r.stress().airy.clone())
+            })
+        }
     })
 }
 
@@ -279,7 +245,11 @@ pub unsafe extern "C" fn vsr_result_weights(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().weights.clone())) }
+        unsafe {
+            copy("result", result, out, len, needed, |r| {
+                Ok(r.stress().weights.clone())
+            })
+        }
     })
 }
 
@@ -297,7 +267,11 @@ pub unsafe extern "C" fn vsr_result_tau(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().tau.clone())) }
+        unsafe {
+            copy("result", result, out, len, needed, |r| {
+                Ok(r.stress().tau.clone())
+            })
+        }
     })
 }
 
@@ -316,7 +290,7 @@ pub unsafe extern "C" fn vsr_result_external_horizontal(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(flat2(&r.stress().external_horizontal))
             })
         }
@@ -337,7 +311,11 @@ pub unsafe extern "C" fn vsr_result_loads(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { copy(result, out, len, needed, |r| Ok(r.stress().loads.clone())) }
+        unsafe {
+            copy("result", result, out, len, needed, |r| {
+                Ok(r.stress().loads.clone())
+            })
+        }
     })
 }
 
@@ -357,7 +335,7 @@ pub unsafe extern "C" fn vsr_result_residuals(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.stress().residuals.clone())
             })
         }
@@ -381,7 +359,7 @@ pub unsafe extern "C" fn vsr_result_horizontal_imbalance(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(flat2(&r.stress().horizontal_imbalance))
             })
         }
@@ -409,7 +387,7 @@ pub unsafe extern "C" fn vsr_result_hole_coefficients(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.stress()
                     .hole_coefficients
                     .iter()
@@ -439,7 +417,7 @@ pub unsafe extern "C" fn vsr_result_force_diagram_centres(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(flat2(&r.stress().force_diagram.centres))
             })
         }
@@ -464,7 +442,7 @@ pub unsafe extern "C" fn vsr_result_force_diagram_segments(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.stress()
                     .force_diagram
                     .segments
@@ -492,7 +470,7 @@ pub unsafe extern "C" fn vsr_result_force_diagram_segment_edges(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.stress()
                     .force_diagram
                     .segments
@@ -525,7 +503,7 @@ pub unsafe extern "C" fn vsr_result_eps_history(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(r.form("an eps history")?.history.clone())
             })
         }
@@ -550,7 +528,7 @@ pub unsafe extern "C" fn vsr_result_step_solvers(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 let steps = &r.form("the step solvers")?.solvers;
                 Ok(steps.iter().map(|&s| VsrQpSolver::of(s)).collect())
             })
@@ -610,7 +588,11 @@ pub unsafe extern "C" fn vsr_result_regularisation(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        unsafe { scalars(result, [("out", out)], |r| Ok([r.stress().regularisation])) }
+        unsafe {
+            scalars("result", result, [("out", out)], |r| {
+                Ok([r.stress().regularisation])
+            })
+        }
     })
 }
 
@@ -627,7 +609,7 @@ pub unsafe extern "C" fn vsr_result_qp_solver(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, [("out", out)], |r| {
+            scalars("result", result, [("out", out)], |r| {
                 Ok([VsrQpSolver::of(r.stress().solver)])
             })
         }
@@ -681,15 +663,9 @@ pub unsafe extern "C" fn vsr_result_termination_message(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 let text = r.form("the termination message")?.termination.to_string();
-                let mut bytes: Vec<c_char> = text
-                    .bytes()
-                    .filter(|&b| b != 0)
-                    .map(|b| b as c_char)
-                    .collect();
-                bytes.push(0);
-                Ok(bytes)
+                Ok(c_string(&text))
             })
         }
     })
@@ -711,7 +687,7 @@ pub unsafe extern "C" fn vsr_result_stalled_vertices(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            copy(result, out, len, needed, |r| {
+            copy("result", result, out, len, needed, |r| {
                 Ok(match &r.form("the stalled vertices")?.termination {
                     Termination::Stalled { vertices } | Termination::Blocked { vertices, .. } => {
                         vertices.clone()
@@ -740,7 +716,7 @@ pub unsafe extern "C" fn vsr_result_height_change(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, [("rms", rms), ("max", max)], |r| {
+            scalars("result", result, [("rms", rms), ("max", max)], |r| {
                 let f = r.form("the height change")?;
                 Ok([f.rms_change, f.max_change])
             })
@@ -766,10 +742,15 @@ pub unsafe extern "C" fn vsr_result_distances(
     boundary!({
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, [("hausdorff", hausdorff), ("l2", l2)], |r| {
-                let f = r.form("the distances")?;
-                Ok([f.hausdorff, f.l2])
-            })
+            scalars(
+                "result",
+                result,
+                [("hausdorff", hausdorff), ("l2", l2)],
+                |r| {
+                    let f = r.form("the distances")?;
+                    Ok([f.hausdorff, f.l2])
+                },
+            )
         }
     })
 }
@@ -795,7 +776,7 @@ pub unsafe extern "C" fn vsr_result_timings(
         ];
         // SAFETY: forwarded caller's contract.
         unsafe {
-            scalars(result, outs, |r| {
+            scalars("result", result, outs, |r| {
                 Ok(match &r.outcome {
                     Outcome::Analysis { stress, .. } => [stress.seconds, 0.0, stress.seconds],
                     Outcome::FormFinding(f) => [f.stress_seconds, f.shape_seconds, f.total_seconds],

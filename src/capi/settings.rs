@@ -10,7 +10,7 @@
 //! `vsr_settings_create`, then rewrite the header (`VSR_BLESS=1 cargo test --test
 //! capi_header`).
 
-use super::boundary::{boundary, handle_mut, out_ptr, CResult, Failure};
+use super::boundary::{boundary, free, give, handle_mut, CResult, Failure};
 use super::enum_args;
 use super::status::VsrStatus;
 use crate::stress::QBound;
@@ -28,12 +28,71 @@ use std::ffi::{c_int, c_void};
 pub type VsrProgressFn =
     Option<unsafe extern "C" fn(user: *mut c_void, iteration: usize, eps_inf: f64) -> c_int>;
 
+/// A progress callback with the `user` pointer passed back to it, as both settings handles
+/// (`VsrSettings`, `VsrAssessSettings`) hold it.
+#[derive(Clone, Copy)]
+pub(crate) struct Progress {
+    callback: VsrProgressFn,
+    user: *mut c_void,
+}
+
+impl Default for Progress {
+    fn default() -> Progress {
+        Progress {
+            callback: None,
+            user: std::ptr::null_mut(),
+        }
+    }
+}
+
+impl Progress {
+    /// Runs `solve` with the callback as the library's progress function (`None` without
+    /// one): a non-zero return of the callback cancels.
+    pub(crate) fn run<R>(self, solve: impl FnOnce(Option<&mut crate::Progress>) -> R) -> R {
+        match self.callback {
+            Some(cb) => {
+                let user = self.user;
+                let mut progress = |k: usize, value: f64| {
+                    // SAFETY: the callback and `user` are valid for this call (caller's
+                    // contract); C code does not unwind into Rust.
+                    unsafe { cb(user, k, value) == 0 }
+                };
+                solve(Some(&mut progress))
+            }
+            None => solve(None),
+        }
+    }
+
+    /// Stores `callback` and `user` in the `progress` of the settings handle `settings`
+    /// (`callback` NULL removes both): the body of both `_set_progress` functions.
+    ///
+    /// # Safety
+    /// `settings`: NULL or a valid handle with exclusive access.
+    pub(crate) unsafe fn set<H>(
+        settings: *mut H,
+        progress: impl FnOnce(&mut H) -> &mut Progress,
+        callback: VsrProgressFn,
+        user: *mut c_void,
+    ) -> CResult {
+        // SAFETY: caller's contract.
+        let s = unsafe { handle_mut("settings", settings)? };
+        *progress(s) = Progress {
+            callback,
+            user: if callback.is_some() {
+                user
+            } else {
+                std::ptr::null_mut()
+            },
+        };
+        Ok(())
+    }
+}
+
 /// Opaque handle: solver options. Create with `vsr_settings_create` (defaults documented
 /// there), change with the `vsr_settings_set_*` functions, free with `vsr_settings_destroy`.
 pub struct VsrSettings {
     pub(crate) form: FormFindSettings,
-    pub(crate) progress: VsrProgressFn,
-    pub(crate) user: *mut c_void,
+    pub(crate) progress: Progress,
 }
 
 /// Creates settings with the documented defaults (those of the Rust `FormFindSettings`, whose
@@ -71,15 +130,12 @@ pub struct VsrSettings {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_settings_create(out: *mut *mut VsrSettings) -> VsrStatus {
     boundary!({
-        let out = out_ptr("out", out)?;
-        let handle = Box::new(VsrSettings {
+        let handle = VsrSettings {
             form: FormFindSettings::default(),
-            progress: None,
-            user: std::ptr::null_mut(),
-        });
-        // SAFETY: non-NULL, writable by the caller's contract.
-        unsafe { out.write(Box::into_raw(handle)) };
-        Ok(())
+            progress: Progress::default(),
+        };
+        // SAFETY: forwarded caller's contract.
+        unsafe { give(out, handle) }
     })
 }
 
@@ -90,12 +146,8 @@ pub unsafe extern "C" fn vsr_settings_create(out: *mut *mut VsrSettings) -> VsrS
 /// no other thread.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn vsr_settings_destroy(settings: *mut VsrSettings) {
-    boundary!(keep_error, (), {
-        if !settings.is_null() {
-            // SAFETY: from Box::into_raw in vsr_settings_create, destroyed once.
-            drop(unsafe { Box::from_raw(settings) });
-        }
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!(keep_error, (), { unsafe { free(settings) } })
 }
 
 /// Applies `f` to a copy of the settings, validates the copy with the library's
@@ -617,17 +669,8 @@ pub unsafe extern "C" fn vsr_settings_set_progress(
     callback: VsrProgressFn,
     user: *mut c_void,
 ) -> VsrStatus {
-    boundary!({
-        // SAFETY: caller's contract.
-        let s = unsafe { handle_mut("settings", settings)? };
-        s.progress = callback;
-        s.user = if callback.is_some() {
-            user
-        } else {
-            std::ptr::null_mut()
-        };
-        Ok(())
-    })
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { Progress::set(settings, |s| &mut s.progress, callback, user) } })
 }
 
 #[cfg(test)]

@@ -70,19 +70,9 @@ pub unsafe extern "C" fn vsr_form_find(
         let (mesh, settings) = unsafe { (handle("mesh", mesh)?, handle("settings", settings)?) };
         let out = out_ptr("out", out)?;
         let problem = &mesh.problem;
-        let found = match settings.progress {
-            Some(cb) => {
-                let user = settings.user;
-                let mut progress = |k: usize, eps: f64| {
-                    // SAFETY: the callback and `user` are valid for this call (caller's
-                    // contract); C code does not unwind into Rust.
-                    unsafe { cb(user, k, eps) == 0 }
-                };
-                form_find(problem, &settings.form, Some(&mut progress))
-            }
-            None => form_find(problem, &settings.form, None),
-        }
-        .map_err(|e| from_error("mesh", e))?;
+        let found = (settings.progress)
+            .run(|progress| form_find(problem, &settings.form, progress))
+            .map_err(|e| from_error("mesh", e))?;
         let result = VsrResult::new(&problem.mesh, Outcome::FormFinding(found));
         // SAFETY: non-NULL, writable by the caller's contract.
         unsafe { out.write(Box::into_raw(Box::new(result))) };

@@ -222,6 +222,35 @@ fn check_finite(positions: &[[f64; 3]], referenced: &[bool]) -> Result<()> {
     }
 }
 
+/// New heights for a validated mesh ([`Mesh::with_heights`]): one per vertex, finite on the
+/// referenced vertices and within ±[`MAX_COORDINATE`] (the plan checks do not involve them).
+pub(super) fn check_heights(heights: &[f64], referenced: &[bool]) -> Result<()> {
+    if heights.len() != referenced.len() {
+        return Err(Error::InvalidArgument {
+            name: "heights",
+            reason: format!(
+                "{} heights for {} vertices: give one per vertex",
+                heights.len(),
+                referenced.len()
+            ),
+        });
+    }
+    let mut used = heights.iter().zip(referenced).enumerate();
+    if let Some((vertex, _)) = used.clone().find(|(_, (z, &r))| r && !z.is_finite()) {
+        return Err(Error::NonFiniteCoordinate { vertex });
+    }
+    match used.find(|(_, (z, &r))| r && z.abs() > MAX_COORDINATE) {
+        Some((v, (z, _))) => Err(Error::InvalidArgument {
+            name: "heights",
+            reason: format!(
+                "vertex {v} has the height {z:e}: beyond ±{MAX_COORDINATE:e}, loads cannot be \
+                 represented in double precision (express the model in larger units)"
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Coordinates whose squares (areas, loads) double precision can represent with room to spare.
 fn check_magnitudes(positions: &[[f64; 3]], referenced: &[bool]) -> Result<()> {
     let mut lo = [f64::INFINITY; 2];

@@ -5,6 +5,7 @@
 //! validity, supports) and derives everything the solvers need: oriented faces, edges with
 //! their adjacent faces, boundary loops, holes and connected components.
 
+mod access;
 mod build;
 mod connectivity;
 mod overlap;
@@ -60,37 +61,41 @@ pub struct BoundaryLoop {
 }
 
 /// A validated triangle mesh: plan (x, y), heights z, supports and derived connectivity.
+///
+/// Built by [`Mesh::new`] (or read by [`crate::io::read_model`]) and read through its
+/// accessors; [`Mesh::with_heights`] changes the heights, which the plan's connectivity does
+/// not depend on. Nothing else changes a mesh once validated.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
 pub struct Mesh {
     /// Vertex positions as given (x, y plan; z height). Length n_vertices.
-    pub positions: Vec<[f64; 3]>,
+    pub(crate) positions: Vec<[f64; 3]>,
     /// Faces, counter-clockwise in plan (all reversed if the input was clockwise).
-    pub faces: Vec<[u32; 3]>,
+    pub(crate) faces: Vec<[u32; 3]>,
     /// True when the input faces were clockwise in plan and have been reversed.
-    pub reversed: bool,
+    pub(crate) reversed: bool,
     /// All edges, sorted by (`v[0]`, `v[1]`).
-    pub edges: Vec<Edge>,
+    pub(crate) edges: Vec<Edge>,
     /// For face t, the edge ids of (`f[0]`,`f[1]`), (`f[1]`,`f[2]`), (`f[2]`,`f[0]`).
-    pub face_edges: Vec<[u32; 3]>,
+    pub(crate) face_edges: Vec<[u32; 3]>,
     /// CSR vertex → incident edge ids: `vertex_edges[vertex_edge_start[v]..vertex_edge_start[v+1]]`.
-    pub vertex_edge_start: Vec<u32>,
+    pub(crate) vertex_edge_start: Vec<u32>,
     /// The incident edge ids of every vertex, concatenated (see `vertex_edge_start`).
-    pub vertex_edges: Vec<u32>,
+    pub(crate) vertex_edges: Vec<u32>,
     /// Anchored (support) flag per vertex.
-    pub anchored: Vec<bool>,
+    pub(crate) anchored: Vec<bool>,
     /// Vertex lies on a boundary loop.
-    pub on_boundary: Vec<bool>,
+    pub(crate) on_boundary: Vec<bool>,
     /// Vertex referenced by at least one face. Unreferenced vertices are ignored.
-    pub referenced: Vec<bool>,
+    pub(crate) referenced: Vec<bool>,
     /// Connected component per vertex (u32::MAX for unreferenced vertices) and per face.
-    pub vertex_component: Vec<u32>,
+    pub(crate) vertex_component: Vec<u32>,
     /// Connected component per face.
-    pub face_component: Vec<u32>,
+    pub(crate) face_component: Vec<u32>,
     /// The number of connected components.
-    pub n_components: usize,
+    pub(crate) n_components: usize,
     /// Boundary loops of all components; holes are the loops with `is_outer == false`.
-    pub loops: Vec<BoundaryLoop>,
+    pub(crate) loops: Vec<BoundaryLoop>,
     /// Ids of vertices referenced by no face (ignored by every solver, reported to the user).
-    pub unreferenced: Vec<u32>,
+    pub(crate) unreferenced: Vec<u32>,
 }

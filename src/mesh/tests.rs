@@ -420,6 +420,41 @@ fn unreferenced_nan_vertex_is_ignored() {
     check_invariants(&mesh);
 }
 
+/// New heights keep the plan's connectivity; wrong lengths, NaN or huge heights of referenced
+/// vertices are refused with the vertex named; an unreferenced vertex's height is free.
+#[test]
+fn with_heights_changes_only_heights_and_checks_them() {
+    let (mut p, f) = grid(3, 2);
+    p.insert(0, [f64::NAN, 0.0, 0.0]);
+    let f: Faces = f.iter().map(|t| t.map(|i| i + 1)).collect();
+    let mesh = Mesh::new(p, f, &[1, 4]).expect("valid");
+    let z: Vec<f64> = (0..mesh.n_vertices()).map(|v| v as f64 / 7.0).collect();
+    let lifted = mesh.clone().with_heights(&z).expect("finite heights");
+    for (v, (a, b)) in mesh.positions().iter().zip(lifted.positions()).enumerate() {
+        assert_eq!([a[0], a[1], z[v]].map(f64::to_bits), b.map(f64::to_bits));
+    }
+    assert_eq!(lifted.edges(), mesh.edges());
+    assert_eq!(lifted.loops(), mesh.loops());
+    assert_eq!(lifted.anchored_ids(), [1, 4]);
+    let mut nan_unused = z.clone();
+    nan_unused[0] = f64::NAN;
+    assert!(mesh.clone().with_heights(&nan_unused).is_ok());
+    let message = |z: &[f64]| mesh.clone().with_heights(z).unwrap_err().to_string();
+    assert!(message(&z[1..]).contains("12 heights for 13 vertices"));
+    let mut bad = z.clone();
+    bad[5] = f64::INFINITY;
+    assert_eq!(
+        mesh.clone().with_heights(&bad).unwrap_err(),
+        Error::NonFiniteCoordinate { vertex: 5 }
+    );
+    bad[5] = 1e200;
+    let text = message(&bad);
+    assert!(
+        text.contains("heights") && text.contains("vertex 5"),
+        "{text}"
+    );
+}
+
 /// Invariants every valid mesh satisfies.
 fn check_invariants(mesh: &Mesh) {
     let n = mesh.n_vertices();

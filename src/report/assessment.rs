@@ -4,8 +4,8 @@
 
 use serde::Serialize;
 
-use super::{anchored, termination_fields, MeshCounts};
-use crate::io::{Model, UpAxis, WeldSummary};
+use super::{anchored, Ending, MeshCounts, ReadSettings};
+use crate::io::Model;
 use crate::mesh::repair::PlanRepair;
 use crate::{AssessResult, AssessSettings, Envelope, LoadRule, QBound};
 
@@ -63,14 +63,9 @@ pub struct AssessmentFigures {
     pub objective: &'static str,
     /// Whether the thrust surface is certified inside the envelope.
     pub feasible: bool,
-    /// The termination's name ([`crate::Termination::name`]).
-    pub termination: &'static str,
-    /// The termination as a sentence.
-    pub termination_message: String,
-    /// The vertices a `stalled` termination lists.
-    pub termination_vertices: Vec<u32>,
-    /// The constraint (`infeasible`) or failure (`numerical_error`) it names.
-    pub termination_detail: Option<String>,
+    /// How the search ended.
+    #[serde(flatten)]
+    pub ending: Ending,
     /// Sequential QP iterations.
     pub iterations: usize,
     /// Wall time, seconds.
@@ -112,18 +107,9 @@ pub struct AssessmentFigures {
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
 pub struct AssessmentSettings {
-    /// Where the mesh (the middle surface) came from.
-    pub mesh: String,
-    /// How the supports were chosen.
-    pub supports: String,
-    /// The welding; null when the file's vertices were kept as they are.
-    pub weld: Option<WeldSummary>,
-    /// The plan repair tolerance (0: slivers were rejected).
-    pub repair_tolerance: f64,
-    /// The input's up axis.
-    pub up: UpAxis,
-    /// The number of polygon diagonals, which q_min does not bind.
-    pub polygon_diagonals: usize,
+    /// How the input was read.
+    #[serde(flatten)]
+    pub read: ReadSettings,
     /// The analysis.
     pub objective: &'static str,
     /// The uniform thickness (null for a per-face one or intrados and extrados).
@@ -209,12 +195,7 @@ impl AssessmentReport {
                     area (plus the load factor x the load pattern), force densities = force / \
                     length",
             settings: AssessmentSettings {
-                mesh: model.source.clone(),
-                supports: model.options.supports.to_string(),
-                weld: model.weld.clone(),
-                repair_tolerance: model.options.repair_tolerance,
-                up: model.options.up,
-                polygon_diagonals: model.diagonals.len(),
+                read: ReadSettings::of(model),
                 objective: settings.objective.as_str(),
                 thickness,
                 intrados: None,
@@ -244,15 +225,11 @@ fn figures(
     r: &AssessResult,
     thickness: Option<f64>,
 ) -> AssessmentFigures {
-    let (termination, message, vertices, detail) = termination_fields(&r.termination);
     let excess = |(excess, vertex): (f64, Option<u32>)| Excess { excess, vertex };
     AssessmentFigures {
         objective: r.objective.as_str(),
         feasible: r.feasible,
-        termination,
-        termination_message: message,
-        termination_vertices: vertices,
-        termination_detail: detail,
+        ending: Ending::of(&r.termination),
         iterations: r.iterations,
         seconds: r.seconds,
         thickness,

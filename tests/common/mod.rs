@@ -88,16 +88,18 @@ pub fn holed_disk(seed: u64, max_area: f64, anchor: impl Fn([f64; 2], bool) -> b
 /// keeping the plan valid (Mesh::new validates), so the mesh is no longer Delaunay.
 pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
     let mut rng = Rng::new(seed);
-    let mut pos = mesh.positions.clone();
+    let mut pos = mesh.positions().to_vec();
     for (v, p) in pos.iter_mut().enumerate() {
-        if mesh.on_boundary[v] || !mesh.referenced[v] {
+        if mesh.on_boundary()[v] || !mesh.referenced()[v] {
             continue;
         }
         let h = mesh
             .edges_at(v)
             .iter()
             .map(|&e| {
-                let [a, b] = mesh.edges[e as usize].v.map(|x| mesh.positions[x as usize]);
+                let [a, b] = mesh.edges()[e as usize]
+                    .v
+                    .map(|x| mesh.positions()[x as usize]);
                 (a[0] - b[0]).hypot(a[1] - b[1])
             })
             .fold(f64::INFINITY, f64::min);
@@ -105,18 +107,18 @@ pub fn jiggle(mesh: &Mesh, seed: u64, amount: f64) -> Mesh {
         p[1] += amount * h * rng.uniform(-1.0, 1.0);
     }
     let anchored: Vec<u32> = (0..pos.len() as u32)
-        .filter(|&v| mesh.anchored[v as usize])
+        .filter(|&v| mesh.anchored()[v as usize])
         .collect();
-    Mesh::new(pos, mesh.faces.clone(), &anchored).expect("jiggled mesh stays valid")
+    Mesh::new(pos, mesh.faces().to_vec(), &anchored).expect("jiggled mesh stays valid")
 }
 
 /// ε∞ of a form-finding result recomputed here from its positions and force densities: loads
 /// a third of each 3-D triangle's area (the default load rule, unit density), vertical
 /// residuals Σ_j q_ij (z_i − z_j) − p_i at the non-anchored vertices, over their mean load.
 pub fn recomputed_eps_inf(mesh: &Mesh, r: &voussoir::FormFindResult) -> f64 {
-    let n = mesh.positions.len();
+    let n = mesh.positions().len();
     let mut load = vec![0.0; n];
-    for f in &mesh.faces {
+    for f in mesh.faces() {
         let [a, b, c] = f.map(|v| r.positions[v as usize]);
         let (u, w) = (
             [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
@@ -131,7 +133,7 @@ pub fn recomputed_eps_inf(mesh: &Mesh, r: &voussoir::FormFindResult) -> f64 {
         f.iter().for_each(|&v| load[v as usize] += area / 3.0);
     }
     let mut residual = vec![0.0; n];
-    for (edge, q) in mesh.edges.iter().zip(&r.stress.force_densities) {
+    for (edge, q) in mesh.edges().iter().zip(&r.stress.force_densities) {
         let [i, j] = edge.v.map(|v| v as usize);
         let dz = r.positions[i][2] - r.positions[j][2];
         (residual[i], residual[j]) = (residual[i] + q * dz, residual[j] - q * dz);
@@ -147,7 +149,7 @@ pub fn recomputed_eps_inf(mesh: &Mesh, r: &voussoir::FormFindResult) -> f64 {
 /// The plan bounding-box diagonal of the referenced vertices of `mesh`.
 pub fn plan_diagonal(mesh: &Mesh) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for (p, _) in (mesh.positions.iter().zip(&mesh.referenced)).filter(|(_, r)| **r) {
+    for (p, _) in (mesh.positions().iter().zip(mesh.referenced())).filter(|(_, r)| **r) {
         for d in 0..2 {
             (lo[d], hi[d]) = (lo[d].min(p[d]), hi[d].max(p[d]));
         }
@@ -159,7 +161,7 @@ pub fn plan_diagonal(mesh: &Mesh) -> f64 {
 /// here.
 pub fn largest_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
     let diagonal = plan_diagonal(mesh);
-    (mesh.positions.iter().zip(positions))
+    (mesh.positions().iter().zip(positions))
         .map(|(a, b)| (a[2] - b[2]).abs() / diagonal)
         .fold(0.0, f64::max)
 }

@@ -121,8 +121,11 @@ pub fn flag(
         "--assess" => {
             let text = value()?;
             let objective = text.parse::<Objective>().map_err(|_| {
+                let (last, others) = Objective::ALL.split_last().expect("objectives");
+                let others: Vec<&str> = others.iter().map(|o| o.as_str()).collect();
                 format!(
-                    "--assess: expected fit, min-thickness, min-thrust, max-thrust or max-load, got `{text}`"
+                    "--assess: expected {} or {last}, got `{text}`",
+                    others.join(", ")
                 )
             })?;
             a.objective = Some(objective);

@@ -20,7 +20,7 @@ pub fn build(o: &Options, a: &Assessed) -> AssessmentReport {
     );
     let path = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     let settings = &mut report.settings;
-    settings.supports = a.model.supports.clone();
+    settings.read.supports = a.model.supports.clone();
     settings.intrados = path(&o.assess.intrados);
     settings.extrados = path(&o.assess.extrados);
     settings.load_pattern = path(&o.assess.load_pattern);

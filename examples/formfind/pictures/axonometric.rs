@@ -99,7 +99,7 @@ impl Projection {
 /// Face indices from the farthest to the nearest by mean depth (the painter's order).
 fn back_to_front(mesh: &Mesh, pos: &[V3], projection: &Projection) -> Vec<usize> {
     let depth: Vec<f64> = mesh
-        .faces
+        .faces()
         .iter()
         .map(|f| {
             f.iter()
@@ -127,7 +127,7 @@ pub(super) fn shaded_faces(
 ) -> Group {
     let mut g = draw::Bulk::default();
     for t in back_to_front(mesh, pos, projection) {
-        let corners = mesh.faces[t].map(|v| pos[v as usize]);
+        let corners = mesh.faces()[t].map(|v| pos[v as usize]);
         let points: Vec<String> = corners
             .iter()
             .map(|&p| {
@@ -154,7 +154,7 @@ pub(super) fn shaded_faces(
 
 /// Per face: the mean height change of its vertices.
 fn face_change(mesh: &Mesh, before: &[V3], after: &[V3]) -> Vec<f64> {
-    mesh.faces
+    mesh.faces()
         .iter()
         .map(|f| {
             f.iter()
@@ -170,20 +170,20 @@ fn face_change(mesh: &Mesh, before: &[V3], after: &[V3]) -> Vec<f64> {
 pub fn shape_3d(o: &Outcome) -> Document {
     let mesh = o.model.mesh();
     let projection = Projection::new();
-    let mut panels = vec![("input", &mesh.positions)];
+    let mut panels = vec![("input", mesh.positions())];
     if o.termination.is_some() {
-        panels.push(("form-found", &o.positions));
+        panels.push(("form-found", o.positions.as_slice()));
     }
-    let referenced = || (0..mesh.n_vertices()).filter(|&v| mesh.referenced[v]);
+    let referenced = || (0..mesh.n_vertices()).filter(|&v| mesh.referenced()[v]);
     let (lo, hi) = bbox(
         panels
             .iter()
             .flat_map(|(_, pos)| referenced().map(|v| projection.screen(pos[v]))),
     );
     let (height, views) = layout(lo, hi, panels.len());
-    let dz = face_change(mesh, &mesh.positions, &o.positions);
+    let dz = face_change(mesh, mesh.positions(), &o.positions);
     let m = referenced()
-        .map(|v| (o.positions[v][2] - mesh.positions[v][2]).abs())
+        .map(|v| (o.positions[v][2] - mesh.positions()[v][2]).abs())
         .fold(0.0, f64::max);
     let base: Vec<[f64; 3]> = dz
         .iter()

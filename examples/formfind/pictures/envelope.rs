@@ -20,7 +20,7 @@ const VEIL: f64 = 0.3;
 /// at the extrados (outside [0, 1] where the surface leaves the envelope).
 pub fn depth_in_masonry(a: &Assessed) -> Vec<f64> {
     let r = &a.result;
-    (a.model.mesh().faces.iter())
+    (a.model.mesh().faces().iter())
         .map(|f| {
             f.iter()
                 .map(|&v| {
@@ -42,11 +42,11 @@ pub fn shape_3d(a: &Assessed) -> Document {
     let mesh = a.model.mesh();
     let projection = Projection::new();
     let middle = a.envelope.middle_positions(mesh);
-    let extrados: Vec<[f64; 3]> = (mesh.positions.iter().zip(&a.envelope.upper))
+    let extrados: Vec<[f64; 3]> = (mesh.positions().iter().zip(&a.envelope.upper))
         .map(|(p, &u)| [p[0], p[1], u])
         .collect();
     let thrust = &a.result.positions;
-    let referenced = || (0..mesh.n_vertices()).filter(|&v| mesh.referenced[v]);
+    let referenced = || (0..mesh.n_vertices()).filter(|&v| mesh.referenced()[v]);
     let (lo, hi) = bbox(
         [&middle, &extrados, thrust]
             .into_iter()

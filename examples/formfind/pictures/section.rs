@@ -45,7 +45,7 @@ impl Station {
 
 /// The plane's position: the value given or the plan's centre on its axis.
 pub fn position(mesh: &Mesh, section: Section) -> f64 {
-    let (lo, hi) = plan_box(mesh, &mesh.positions);
+    let (lo, hi) = plan_box(mesh, mesh.positions());
     section
         .at
         .unwrap_or(0.5 * (lo[section.axis] + hi[section.axis]))
@@ -55,7 +55,7 @@ pub fn position(mesh: &Mesh, section: Section) -> f64 {
 pub fn check(mesh: &Mesh, section: Section) -> Result<(), String> {
     let at = position(mesh, section);
     if cut(mesh, section.axis, at).is_empty() {
-        let (lo, hi) = plan_box(mesh, &mesh.positions);
+        let (lo, hi) = plan_box(mesh, mesh.positions());
         let name = section.axis_name();
         return Err(format!(
             "--section: the plane {name} = {at} does not cross the plan ({name} from {} to {})",
@@ -70,12 +70,12 @@ pub fn check(mesh: &Mesh, section: Section) -> Result<(), String> {
 /// crosses its two edges there).
 fn cut(mesh: &Mesh, axis: usize, at: f64) -> Vec<[Station; 2]> {
     let along = 1 - axis;
-    let (lo, hi) = plan_box(mesh, &mesh.positions);
+    let (lo, hi) = plan_box(mesh, mesh.positions());
     let tolerance = 1e-9 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
     let mut segments = Vec::new();
-    for f in &mesh.faces {
+    for f in mesh.faces() {
         let v = f.map(|v| v as usize);
-        let d = v.map(|v| mesh.positions[v][axis] - at);
+        let d = v.map(|v| mesh.positions()[v][axis] - at);
         let mut points: Vec<Station> = Vec::new();
         for k in 0..3 {
             let (i, j) = (k, (k + 1) % 3);
@@ -87,7 +87,7 @@ fn cut(mesh: &Mesh, axis: usize, at: f64) -> Vec<[Station; 2]> {
                 continue;
             };
             let (a, b) = (v[i], v[j]);
-            let s = (1.0 - t) * mesh.positions[a][along] + t * mesh.positions[b][along];
+            let s = (1.0 - t) * mesh.positions()[a][along] + t * mesh.positions()[b][along];
             if points.iter().all(|p| (p.s - s).abs() > tolerance) {
                 points.push(Station { s, a, b, t });
             }
@@ -153,8 +153,8 @@ fn supports(mesh: &Mesh, segments: &[[Station; 2]], z: &[f64], view: &View) -> G
     let mut seen: Vec<f64> = Vec::new();
     for p in segments.iter().flatten() {
         let anchored = match p.vertex() {
-            Some(v) => mesh.anchored[v],
-            None => mesh.anchored[p.a] && mesh.anchored[p.b],
+            Some(v) => mesh.anchored()[v],
+            None => mesh.anchored()[p.a] && mesh.anchored()[p.b],
         };
         if !anchored || seen.contains(&p.s) {
             continue;
