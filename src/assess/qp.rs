@@ -1,8 +1,9 @@
-//! One step of the sequential QP (docs/method.md §16.3): the objective's model plus a
-//! proximal term, the vertical residuals linearised with elastic slacks e⁺, e⁻ priced at ν
-//! (the exact ℓ1 penalty), and every linear constraint exact: q = S y, horizontal balance,
-//! force-density bounds, the envelope and, for the least thrust, a second-order cone per
-//! support. Solved by clarabel.
+//! One step of the sequential QP (docs/method.md §16.3): the objective's model, the
+//! convexified Hessian of the Lagrangian and a proximal term; the vertical residuals
+//! linearised with elastic slacks e⁺, e⁻ priced at ν (the exact ℓ1 penalty), and every
+//! linear constraint exact: q = S y, horizontal balance, force-density bounds, the envelope
+//! and, for the least thrust, a second-order cone per support. Solved by clarabel, in units
+//! of ν.
 
 use super::model::{other_end, Model, State};
 use super::Objective;
@@ -86,6 +87,9 @@ pub(super) struct StepInput<'a> {
     /// Multipliers μ of the residual rows for the Hessian of the Lagrangian (none: no
     /// curvature but the proximal term).
     pub multipliers: Option<&'a [f64]>,
+    /// The last accepted step's dq and dz (per edge, per vertex): its ratio per edge sets
+    /// the convexification's balance α_e.
+    pub direction: Option<(&'a [f64], &'a [f64])>,
 }
 
 /// A step and its model's figures.
@@ -148,7 +152,7 @@ pub(super) fn solve_step(
     let (mut p, c) = objective(model, layout, state, input);
     let hessian = input
         .multipliers
-        .map(|mu| lagrangian_hessian(model, layout, state, mu));
+        .map(|mu| lagrangian_hessian(model, layout, state, mu, input.direction));
     if let Some(h) = &hessian {
         for b in &h.blocks {
             b.push_into(&mut p);
@@ -196,6 +200,17 @@ struct Hessian {
     blocks: Vec<EdgeBlock>,
 }
 
+/// α_e: |dd|/|dq| of the last step, where the addition equals the exact term's size along
+/// it, kept within a factor 1e3 of the units' ratio `units`; `units` without a step.
+fn balance(units: f64, last: Option<(f64, f64)>) -> f64 {
+    match last {
+        Some((dq, dd)) if dq != 0.0 && dd != 0.0 => {
+            (dd / dq).abs().clamp(1e-3 * units, 1e3 * units)
+        }
+        _ => units,
+    }
+}
+
 struct EdgeBlock {
     e: usize,
     q: usize,
@@ -236,7 +251,13 @@ impl Hessian {
     }
 }
 
-fn lagrangian_hessian(model: &Model, layout: &Layout, state: &State, mu: &[f64]) -> Hessian {
+fn lagrangian_hessian(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    mu: &[f64],
+    direction: Option<(&[f64], &[f64])>,
+) -> Hessian {
     let edges = &model.problem.mesh.edges;
     let forced = || (layout.q_col.iter().enumerate()).filter_map(|(e, c)| c.map(|c| (e, c)));
     let count = forced().count().max(1) as f64;
@@ -261,7 +282,10 @@ fn lagrangian_hessian(model: &Model, layout: &Layout, state: &State, mu: &[f64])
                 i,
                 j,
                 w,
-                alpha: (dz(e) + floor_dz) / (state.q[e].abs() + floor_q),
+                alpha: balance(
+                    (dz(e) + floor_dz) / (state.q[e].abs() + floor_q),
+                    direction.map(|(dq, dz)| (dq[e], dz[i] - dz[j])),
+                ),
             })
         })
         .collect();
@@ -514,9 +538,9 @@ fn run_clarabel(n: usize, p: Triplets, c: &[f64], rows: Rows) -> Option<Solution
     let settings = DefaultSettingsBuilder::default()
         .verbose(false)
         .max_iter(200)
-        .tol_gap_abs(1e-8)
-        .tol_gap_rel(1e-8)
-        .tol_feas(1e-8)
+        .tol_gap_abs(1e-10)
+        .tol_gap_rel(1e-10)
+        .tol_feas(1e-10)
         .build()
         .expect("static clarabel settings are valid");
     let mut solver = DefaultSolver::new(&pm, c, &am, &rows.b, &cones, settings).ok()?;

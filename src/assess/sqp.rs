@@ -1,10 +1,11 @@
 //! The sequential QP of the assessment (docs/method.md §16.3): minimise the merit
 //! φ = f + ν Σ |c_i| (c the vertical residuals, exact ℓ1 penalty) by steps of `qp.rs`,
-//! damped by a proximal weight ρ (Levenberg–Marquardt): a step is accepted only when φ falls
-//! by at least a tenth of what its model predicts, else once retried with a second-order
-//! correction (the constraints are bilinear, so their second-order term is known exactly)
-//! and then ρ grows. ν grows while the linearised residuals cannot be met at its price and
-//! otherwise follows the step's multipliers (ten times the largest).
+//! whose model carries the convexified Hessian of the Lagrangian (the multipliers of the
+//! last accepted step) and a proximal weight ρ (Levenberg–Marquardt): a step is accepted
+//! only when φ falls by at least a tenth of what its model predicts, else once retried with
+//! a second-order correction (the constraints are bilinear, so their second-order term is
+//! known exactly) and then ρ grows. ν grows while the linearised residuals cannot be met
+//! at its price and otherwise follows the step's multipliers (ten times the largest).
 
 use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
@@ -104,6 +105,8 @@ struct Search<'m, 'a> {
     /// The multipliers of the last accepted step's residual rows: the Hessian of the
     /// Lagrangian in the next step's model.
     mu: Option<Vec<f64>>,
+    /// The last accepted step's dq and dz.
+    direction: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<'m, 'a> Search<'m, 'a> {
@@ -135,6 +138,7 @@ impl<'m, 'a> Search<'m, 'a> {
             history: Vec::new(),
             polishing: false,
             mu: None,
+            direction: None,
         }
     }
 
@@ -148,6 +152,7 @@ impl<'m, 'a> Search<'m, 'a> {
             nu: 1e6,
             correction: None,
             multipliers: None,
+            direction: None,
         };
         if let Some(step) = solve_step(self.model, layout, &self.state, &input) {
             self.state = self.apply(&step);
@@ -217,6 +222,7 @@ impl<'m, 'a> Search<'m, 'a> {
             return self.reject();
         };
         let before = self.model.objective_value(&self.state);
+        self.direction = Some((step.dq.clone(), step.dz.clone()));
         self.state = next;
         if let Some(multipliers) = multipliers {
             self.update_penalty(&multipliers, step.slack);
@@ -314,7 +320,13 @@ impl<'m, 'a> Search<'m, 'a> {
             rho_z: self.rho,
             nu: self.nu,
             correction,
-            multipliers: self.mu.as_deref(),
+            // The fit's own curvature (the area shares) is small beside the convexified
+            // Lagrangian's, which would dwarf it: its steps keep the proximal term alone.
+            multipliers: self
+                .mu
+                .as_deref()
+                .filter(|_| self.model.objective != Objective::Fit),
+            direction: (self.direction.as_ref()).map(|(dq, dz)| (dq.as_slice(), dz.as_slice())),
         }
     }
 
