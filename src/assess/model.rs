@@ -12,7 +12,7 @@ use crate::stress::linear::LinearStress;
 use crate::stress::{equilibrium, StressSettings, TauMode};
 
 /// A point of the search, in frame units.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct State {
     /// Stress unknowns: q = S y.
     pub y: Vec<f64>,
@@ -266,7 +266,11 @@ impl<'a> Model<'a> {
             .collect();
         let (residuals, imbalance) =
             equilibrium(mesh, &positions, &force_densities, &loads, &external);
-        let mean = self.p_bar;
+        // The mean of the returned loads (λ × pattern included) over the non-anchored vertices.
+        let mean = (self.residual.iter())
+            .map(|&v| loads[v as usize])
+            .sum::<f64>()
+            / self.residual.len() as f64;
         let (worst_residual_vertex, max_r) = (self.residual.iter())
             .map(|&v| (v, residuals[v as usize].abs()))
             .fold((None, 0.0), |(bv, bm), (v, m)| {

@@ -1,8 +1,9 @@
-//! One step of the sequential QP (docs/method.md §16.3): the objective's model plus a
-//! proximal term, the vertical residuals linearised with elastic slacks e⁺, e⁻ priced at ν
-//! (the exact ℓ1 penalty), and every linear constraint exact: q = S y, horizontal balance,
-//! force-density bounds, the envelope and, for the least thrust, a second-order cone per
-//! support. Solved by clarabel.
+//! One step of the sequential QP (docs/method.md §16.3): the objective's model, the
+//! convexified Hessian of the Lagrangian and a proximal term; the vertical residuals
+//! linearised with elastic slacks e⁺, e⁻ priced at ν (the exact ℓ1 penalty), and every
+//! linear constraint exact: q = S y, horizontal balance, force-density bounds, the envelope
+//! and, for the least thrust, a second-order cone per support. Solved by clarabel, in units
+//! of ν.
 
 use super::model::{other_end, Model, State};
 use super::Objective;
@@ -26,6 +27,8 @@ pub(super) struct Layout {
     /// First column of the thrust bounds h_a (least thrust), one per support.
     h_start: usize,
     n: usize,
+    /// Residual row per vertex (None at anchored and unreferenced vertices).
+    row_of: Vec<Option<usize>>,
 }
 
 impl Layout {
@@ -55,7 +58,12 @@ impl Layout {
         } else {
             0
         };
+        let mut row_of = vec![None; model.variable.len()];
+        for (k, &v) in model.residual.iter().enumerate() {
+            row_of[v as usize] = Some(k);
+        }
         Layout {
+            row_of,
             n_y,
             q_col,
             z_col,
@@ -76,6 +84,12 @@ pub(super) struct StepInput<'a> {
     pub rho_z: f64,
     pub nu: f64,
     pub correction: Option<&'a [f64]>,
+    /// Multipliers μ of the residual rows for the Hessian of the Lagrangian (none: no
+    /// curvature but the proximal term).
+    pub multipliers: Option<&'a [f64]>,
+    /// The last accepted step's dq and dz (per edge, per vertex): its ratio per edge sets
+    /// the convexification's balance α_e.
+    pub direction: Option<(&'a [f64], &'a [f64])>,
 }
 
 /// A step and its model's figures.
@@ -90,8 +104,11 @@ pub(super) struct Step {
     pub slack: f64,
     /// The objective's model at the step.
     pub model_objective: f64,
-    /// Multipliers μ of the residual rows (|μ| ≤ ν).
-    pub multipliers: Vec<f64>,
+    /// Multipliers μ of the residual rows (|μ| ≤ ν); none when the QP stopped short of
+    /// optimality.
+    pub multipliers: Option<Vec<f64>>,
+    /// ½ dᵀ B d of the convexified Hessian of the Lagrangian (0 without multipliers).
+    pub curvature: f64,
 }
 
 #[derive(Default)]
@@ -132,7 +149,15 @@ pub(super) fn solve_step(
     state: &State,
     input: &StepInput,
 ) -> Option<Step> {
-    let (p, c) = objective(model, layout, state, input);
+    let (mut p, c) = objective(model, layout, state, input);
+    let hessian = input
+        .multipliers
+        .map(|mu| lagrangian_hessian(model, layout, state, mu, input.direction));
+    if let Some(h) = &hessian {
+        for b in &h.blocks {
+            b.push_into(&mut p);
+        }
+    }
     let mut rows = Rows {
         a: Triplets::default(),
         b: Vec::new(),
@@ -149,11 +174,122 @@ pub(super) fn solve_step(
     thrust_cones(model, layout, state, &mut rows);
     rows.n_soc = (rows.next() - rows.n_zero - rows.n_nonneg) / 3;
     let first_residual_row = layout.q_col.iter().flatten().count();
+    // The QP in units of ν: the slacks cost 1, so that its tolerances do not depend on
+    // how dear the penalty has become (the step and the multipliers are the same).
+    let unit = input.nu.max(1.0);
+    p.v.iter_mut().for_each(|v| *v /= unit);
+    let c: Vec<f64> = c.iter().map(|v| v / unit).collect();
     let (x, z) = run_clarabel(layout.n, p, &c, rows)?;
-    let multipliers = z[first_residual_row..first_residual_row + model.residual.len()].to_vec();
+    let multipliers = z.map(|z| {
+        (z[first_residual_row..first_residual_row + model.residual.len()].iter())
+            .map(|m| m * unit)
+            .collect()
+    });
     let mut step = read_step(model, layout, state, &x);
     step.multipliers = multipliers;
+    step.curvature = hessian.map_or(0.0, |h| h.curvature(&step));
     Some(step)
+}
+
+/// The Hessian of the Lagrangian Σ μ_i c_i, convexified edge by edge. Edge e = (i, j)
+/// enters c_i and c_j bilinearly, so its exact second-order term is w dq_e (dz_i − dz_j)
+/// with w = μ_i − μ_j (μ = 0 at supports), indefinite; adding |w| (α dq_e² + (dz_i −
+/// dz_j)²/α)/2 makes it ½|w| (√α dq_e + sign(w) (dz_i − dz_j)/√α)², the least addition of
+/// that form that is positive semidefinite. α balances the units of q and heights.
+struct Hessian {
+    blocks: Vec<EdgeBlock>,
+}
+
+/// α_e: |dd|/|dq| of the last step, where the addition equals the exact term's size along
+/// it, kept within a factor 1e3 of the units' ratio `units`; `units` without a step.
+fn balance(units: f64, last: Option<(f64, f64)>) -> f64 {
+    match last {
+        Some((dq, dd)) if dq != 0.0 && dd != 0.0 => {
+            (dd / dq).abs().clamp(1e-3 * units, 1e3 * units)
+        }
+        _ => units,
+    }
+}
+
+struct EdgeBlock {
+    e: usize,
+    q: usize,
+    zi: Option<usize>,
+    zj: Option<usize>,
+    i: usize,
+    j: usize,
+    w: f64,
+    alpha: f64,
+}
+
+impl EdgeBlock {
+    fn push_into(&self, p: &mut Triplets) {
+        let (w, a) = (self.w, self.alpha);
+        p.push(self.q, self.q, w.abs() * a);
+        for (z, sign) in [(self.zi, 1.0), (self.zj, -1.0)] {
+            if let Some(z) = z {
+                p.push(self.q.min(z), self.q.max(z), sign * w);
+                p.push(z, z, w.abs() / a);
+            }
+        }
+        if let (Some(zi), Some(zj)) = (self.zi, self.zj) {
+            p.push(zi.min(zj), zi.max(zj), -w.abs() / a);
+        }
+    }
+}
+
+impl Hessian {
+    /// ½ dᵀ B d at a step.
+    fn curvature(&self, step: &Step) -> f64 {
+        (self.blocks.iter())
+            .map(|b| {
+                let dq = step.dq[b.e];
+                let dd = step.dz[b.i] - step.dz[b.j];
+                b.w * dq * dd + 0.5 * b.w.abs() * (b.alpha * dq * dq + dd * dd / b.alpha)
+            })
+            .sum()
+    }
+}
+
+fn lagrangian_hessian(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    mu: &[f64],
+    direction: Option<(&[f64], &[f64])>,
+) -> Hessian {
+    let edges = &model.problem.mesh.edges;
+    let forced = || (layout.q_col.iter().enumerate()).filter_map(|(e, c)| c.map(|c| (e, c)));
+    let count = forced().count().max(1) as f64;
+    let dz = |e: usize| {
+        let [i, j] = edges[e].v;
+        (state.z[i as usize] - state.z[j as usize]).abs()
+    };
+    let mean_dz = forced().map(|(e, _)| dz(e)).sum::<f64>() / count;
+    let mean_q = forced().map(|(e, _)| state.q[e].abs()).sum::<f64>() / count;
+    let (floor_dz, floor_q) = (mean_dz.max(1e-12), mean_q.max(1e-12));
+    let blocks = forced()
+        .filter_map(|(e, q)| {
+            let [i, j] = edges[e].v.map(|v| v as usize);
+            let (zi, zj) = (layout.z_col[i], layout.z_col[j]);
+            let mu_of = |v: usize| layout.row_of[v].map_or(0.0, |k| mu[k]);
+            let w = mu_of(i) - mu_of(j);
+            (w != 0.0 && (zi.is_some() || zj.is_some())).then(|| EdgeBlock {
+                e,
+                q,
+                zi,
+                zj,
+                i,
+                j,
+                w,
+                alpha: balance(
+                    (dz(e) + floor_dz) / (state.q[e].abs() + floor_q),
+                    direction.map(|(dq, dz)| (dq[e], dz[i] - dz[j])),
+                ),
+            })
+        })
+        .collect();
+    Hessian { blocks }
 }
 
 /// ½ dᵀ P d + cᵀ d: the proximal term ρ (Σ dz² + Σ l² dq² + dt²), the objective's model and
@@ -384,7 +520,13 @@ fn thrust_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) 
     }
 }
 
-fn run_clarabel(n: usize, p: Triplets, c: &[f64], rows: Rows) -> Option<(Vec<f64>, Vec<f64>)> {
+/// The largest primal residual of a QP stopped short of optimality whose step is tried.
+const PRIMAL_SLACK: f64 = 1e-8;
+
+/// The QP's solution and, when it was solved, its multipliers.
+type Solution = (Vec<f64>, Option<Vec<f64>>);
+
+fn run_clarabel(n: usize, p: Triplets, c: &[f64], rows: Rows) -> Option<Solution> {
     let m = rows.b.len();
     let pm = CscMatrix::new_from_triplets(n, n, p.i, p.j, p.v);
     let am = CscMatrix::new_from_triplets(m, n, rows.a.i, rows.a.j, rows.a.v);
@@ -403,11 +545,27 @@ fn run_clarabel(n: usize, p: Triplets, c: &[f64], rows: Rows) -> Option<(Vec<f64
         .expect("static clarabel settings are valid");
     let mut solver = DefaultSolver::new(&pm, c, &am, &rows.b, &cones, settings).ok()?;
     solver.solve();
-    matches!(
-        solver.solution.status,
-        SolverStatus::Solved | SolverStatus::AlmostSolved
-    )
-    .then(|| (solver.solution.x.clone(), solver.solution.z.clone()))
+    let solution = &solver.solution;
+    if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
+        eprintln!(
+            "qp {:?} {} it {:.3}s rprim {:.1e}",
+            solution.status, solution.iterations, solution.solve_time, solution.r_prim
+        );
+    }
+    match solution.status {
+        SolverStatus::Solved | SolverStatus::AlmostSolved => {
+            Some((solution.x.clone(), Some(solution.z.clone())))
+        }
+        // An interior point that stopped short of optimality but meets the constraints
+        // is still a candidate step: the merit test judges it; its multipliers are not
+        // used.
+        SolverStatus::InsufficientProgress | SolverStatus::MaxIterations
+            if solution.r_prim <= PRIMAL_SLACK && solution.x.iter().all(|x| x.is_finite()) =>
+        {
+            Some((solution.x.clone(), None))
+        }
+        _ => None,
+    }
 }
 
 fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
@@ -449,6 +607,7 @@ fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
         dt,
         slack,
         model_objective,
-        multipliers: Vec::new(),
+        multipliers: None,
+        curvature: 0.0,
     }
 }

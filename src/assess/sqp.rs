@@ -1,10 +1,11 @@
 //! The sequential QP of the assessment (docs/method.md §16.3): minimise the merit
 //! φ = f + ν Σ |c_i| (c the vertical residuals, exact ℓ1 penalty) by steps of `qp.rs`,
-//! damped by a proximal weight ρ (Levenberg–Marquardt): a step is accepted only when φ falls
-//! by at least a tenth of what its model predicts, else once retried with a second-order
-//! correction (the constraints are bilinear, so their second-order term is known exactly)
-//! and then ρ grows. ν grows while the linearised residuals cannot be met at its price and
-//! otherwise follows the step's multipliers (ten times the largest).
+//! whose model carries the convexified Hessian of the Lagrangian (the multipliers of the
+//! last accepted step) and a proximal weight ρ (Levenberg–Marquardt): a step is accepted
+//! only when φ falls by at least a tenth of what its model predicts, else once retried with
+//! a second-order correction (the constraints are bilinear, so their second-order term is
+//! known exactly) and then ρ grows. ν grows while the linearised residuals cannot be met
+//! at its price and otherwise follows the step's multipliers (ten times the largest).
 
 use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
@@ -101,6 +102,11 @@ struct Search<'m, 'a> {
     history: Vec<f64>,
     /// Once the objective has settled: ν stays high until the residuals meet the target.
     polishing: bool,
+    /// The multipliers of the last accepted step's residual rows: the Hessian of the
+    /// Lagrangian in the next step's model.
+    mu: Option<Vec<f64>>,
+    /// The last accepted step's dq and dz.
+    direction: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<'m, 'a> Search<'m, 'a> {
@@ -131,6 +137,8 @@ impl<'m, 'a> Search<'m, 'a> {
             best_feasible: None,
             history: Vec::new(),
             polishing: false,
+            mu: None,
+            direction: None,
         }
     }
 
@@ -143,9 +151,12 @@ impl<'m, 'a> Search<'m, 'a> {
             rho_z: 1e8,
             nu: 1e6,
             correction: None,
+            multipliers: None,
+            direction: None,
         };
         if let Some(step) = solve_step(self.model, layout, &self.state, &input) {
             self.state = self.apply(&step);
+            self.mu = step.multipliers.clone();
             self.residual = max_abs(&self.model.residuals(&self.state));
             self.record();
         }
@@ -195,7 +206,7 @@ impl<'m, 'a> Search<'m, 'a> {
             return self.reject();
         };
         let phi = self.merit(&self.state);
-        let predicted = phi - (step.model_objective + self.nu * step.slack);
+        let predicted = phi - (step.model_objective + self.nu * step.slack + step.curvature);
         let trial = self.apply(&step);
         let multipliers = step.multipliers.clone();
         let accepted = self
@@ -203,12 +214,7 @@ impl<'m, 'a> Search<'m, 'a> {
             .then_some(trial)
             .or_else(|| {
                 let correction = bilinear_term(self.model, &step);
-                let input = StepInput {
-                    rho: self.rho,
-                    rho_z: self.rho,
-                    nu: self.nu,
-                    correction: Some(&correction),
-                };
+                let input = self.input(Some(&correction));
                 let second = solve_step(self.model, layout, &self.state, &input)?;
                 let trial = self.apply(&second);
                 self.acceptable(phi, predicted, &trial).then_some(trial)
@@ -217,8 +223,12 @@ impl<'m, 'a> Search<'m, 'a> {
             return self.reject();
         };
         let before = self.model.objective_value(&self.state);
+        self.direction = Some((step.dq.clone(), step.dz.clone()));
         self.state = next;
-        self.update_penalty(&multipliers, step.slack);
+        if let Some(multipliers) = multipliers {
+            self.update_penalty(&multipliers, step.slack);
+            self.mu = Some(multipliers);
+        }
         self.residual = max_abs(&self.model.residuals(&self.state));
         self.record();
         // Steps the model predicts well need less damping.
@@ -286,12 +296,7 @@ impl<'m, 'a> Search<'m, 'a> {
     /// unmet at its price.
     fn steered_step(&mut self, layout: &Layout) -> Option<Step> {
         for _ in 0..2 {
-            let input = StepInput {
-                rho: self.rho,
-                rho_z: self.rho,
-                nu: self.nu,
-                correction: None,
-            };
+            let input = self.input(None);
             let step = solve_step(self.model, layout, &self.state, &input)?;
             let l1: f64 = self
                 .model
@@ -306,13 +311,24 @@ impl<'m, 'a> Search<'m, 'a> {
             }
             return Some(step);
         }
-        let input = StepInput {
+        solve_step(self.model, layout, &self.state, &self.input(None))
+    }
+
+    /// The step's inputs at the current ρ and ν, with the last multipliers' curvature.
+    fn input<'s>(&'s self, correction: Option<&'s [f64]>) -> StepInput<'s> {
+        StepInput {
             rho: self.rho,
             rho_z: self.rho,
             nu: self.nu,
-            correction: None,
-        };
-        solve_step(self.model, layout, &self.state, &input)
+            correction,
+            // The fit's own curvature (the area shares) is small beside the convexified
+            // Lagrangian's, which would dwarf it: its steps keep the proximal term alone.
+            multipliers: self
+                .mu
+                .as_deref()
+                .filter(|_| self.model.objective != Objective::Fit),
+            direction: (self.direction.as_ref()).map(|(dq, dz)| (dq.as_slice(), dz.as_slice())),
+        }
     }
 
     fn acceptable(&self, phi: f64, predicted: f64, trial: &State) -> bool {
@@ -327,11 +343,26 @@ impl<'m, 'a> Search<'m, 'a> {
         let q = (s.q.iter().zip(&step.dq).zip(&model.stress.bounds))
             .map(|((q, dq), b)| b.map_or(0.0, |(lo, hi)| (q + dq).clamp(lo, hi)))
             .collect();
-        let z = (s.z.iter().zip(&step.dz)).map(|(a, b)| a + b).collect();
         let t = match model.objective {
             Objective::MinThickness => (s.t + step.dt).max(0.0),
             _ => s.t + step.dt,
         };
+        // Within the envelope at the new scale (the QP meets it to its tolerance).
+        let scale = model.scale(&State {
+            t,
+            ..State::default()
+        });
+        let z = (0..s.z.len())
+            .map(|v| {
+                let z = s.z[v] + step.dz[v];
+                if model.variable[v] {
+                    let (m, h) = (model.middle[v], scale * model.half[v]);
+                    z.clamp(m - h, m + h)
+                } else {
+                    z
+                }
+            })
+            .collect();
         State { y, q, z, t }
     }
 
