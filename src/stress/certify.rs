@@ -14,8 +14,10 @@ use super::sparse::Csr;
 use super::{ipm, StressStatus};
 
 /// The absolute gap (frame units: Σ (r/p̄)²) of the polishing solve, and its relative gap.
-const GAP_ABS: f64 = 1e-20;
-const GAP_REL: f64 = 1e-14;
+const GAP_ABS: f64 = 1e-16;
+const GAP_REL: f64 = 1e-12;
+/// Its iteration budget.
+const MAX_ITER: u32 = 200;
 
 /// The polished force densities per edge and τ per vertex (frame units).
 pub(super) struct Certified {
@@ -110,6 +112,7 @@ pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certifi
     let tol = ipm::Tolerances {
         gap_abs: GAP_ABS,
         gap_rel: GAP_REL,
+        max_iter: MAX_ITER,
         ..ipm::Tolerances::for_size(n)
     };
     let out = qp::solve_native_with(inp, &mut ipm::PatternCache::default(), &tol);
