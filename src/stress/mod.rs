@@ -8,6 +8,7 @@
 pub mod airy;
 mod attempts;
 mod cache;
+mod certify;
 mod framed;
 mod gauge;
 pub mod holes;
@@ -21,6 +22,7 @@ pub mod sparse;
 use crate::error::Result;
 use crate::geometry::dual::{self, ForceDiagram};
 use crate::problem::Problem;
+use airy::HoleMode;
 use attempts::{run_attempts, slot, Attempt, Attempts};
 use cache::PlanKey;
 pub use cache::{Prior, StressCache};
@@ -202,9 +204,20 @@ pub fn analyse_cached(
     } else {
         vec![0.0; map.s().ncols]
     };
-    let q_frame = map.s().mul(&y);
+    let mut q_frame = map.s().mul(&y);
+    let mut tau_frame = if usable { out.tau } else { vec![0.0; n] };
+    let polished = (usable && status != StressStatus::Infeasible)
+        .then(|| polish(problem, &step, settings, prior, cache, &q_frame, &tau_frame))
+        .flatten();
+    let y = match polished {
+        Some(c) => {
+            let y = refit(&map, &y, &q_frame, &c.q);
+            (q_frame, tau_frame) = (c.q, c.tau);
+            y
+        }
+        None => y,
+    };
     let airy_op = map.airy();
-    let tau_frame = if usable { out.tau } else { vec![0.0; n] };
 
     // Back to physical units.
     let force_densities: Vec<f64> = q_frame.iter().map(|q| q * unit).collect();
@@ -262,6 +275,98 @@ pub fn analyse_cached(
         regularisation,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Whether the certificate polish runs on a step's answer: in a fresh analysis (not in form
+/// finding, whose loop judges its steps by recomputed residuals), where the reduced optimum is
+/// the edge-based one (affine hole jumps, or no holes), and where the answer nearly stands
+/// (ε∞ below `POLISH_BELOW`), where the solvers' tolerances bound its residuals loosely.
+const POLISH_BELOW: f64 = 1e-2;
+
+/// The answer `q_frame`, `tau_frame` polished in edge coordinates (`certify`), if the polish
+/// runs and improves it.
+fn polish(
+    problem: &Problem,
+    step: &FramedStep,
+    settings: &StressSettings,
+    prior: Option<Prior>,
+    cache: &StressCache,
+    q_frame: &[f64],
+    tau_frame: &[f64],
+) -> Option<certify::Certified> {
+    let mesh = &problem.mesh;
+    let same_optimum = settings.holes == HoleMode::Affine || mesh.holes().next().is_none();
+    if cache.coarse || cache.load_offset.is_some() || !same_optimum {
+        return None;
+    }
+    let eps = (step.free.iter())
+        .map(|&v| {
+            let v = v as usize;
+            let sum: f64 = (mesh.edges_at(v).iter())
+                .map(|&e| {
+                    let [a, b] = mesh.edges[e as usize].v.map(|x| x as usize);
+                    let w = if a == v { b } else { a };
+                    q_frame[e as usize] * (step.z[v] - step.z[w])
+                })
+                .sum();
+            (sum - step.p[v]).abs()
+        })
+        .fold(0.0, f64::max);
+    if eps.is_nan() || eps >= POLISH_BELOW {
+        return None;
+    }
+    let (s, balance) = attempts::force_model(
+        mesh,
+        &step.plan,
+        settings.holes,
+        Formulation::EdgeBased,
+        &step.bounds,
+        &step.free,
+        None,
+    )
+    .ok()?;
+    let prior_frame: Option<Vec<f64>> =
+        prior.map(|p| p.force_densities.iter().map(|q| q / step.unit).collect());
+    let inp = qp::QpInput {
+        s: s.s(),
+        edges: &step.edges,
+        length: &step.plan.length,
+        u: &step.plan.u,
+        z: &step.z,
+        residual_vertices: &step.free,
+        load: &step.p,
+        balance_vertices: &balance,
+        external: &step.external,
+        tau_normal: &step.tau_normal,
+        bounds: &step.bounds,
+        regularisation: prior.map_or(settings.regularisation, |p| p.weight),
+        prior: prior_frame.as_deref(),
+        smoothing_pairs: &step.smoothing_pairs,
+        smoothing: settings.dual_length_smoothing,
+        lift_forces: false,
+    };
+    certify::certify(&inp, q_frame, tau_frame)
+}
+
+/// The unknowns of `map` for the polished force densities `q_new`: y itself in the edge-based
+/// formulation; in the reduced one y moved by the least-squares fit of S Δy = q_new − q_old.
+fn refit(map: &attempts::ForceMap, y: &[f64], q_old: &[f64], q_new: &[f64]) -> Vec<f64> {
+    let dq: Vec<f64> = q_new.iter().zip(q_old).map(|(a, b)| a - b).collect();
+    match map {
+        attempts::ForceMap::Selection(s) => {
+            let mut y = y.to_vec();
+            for (e, &d) in dq.iter().enumerate() {
+                if let Some((c, _)) = s.row(e).next() {
+                    y[c] += d;
+                }
+            }
+            y
+        }
+        attempts::ForceMap::Airy(op) => match certify::least_squares(&op.s, &dq) {
+            Some(dy) => y.iter().zip(&dy).map(|(a, b)| a + b).collect(),
+            None => y.to_vec(),
+        },
+    }
 }
 
 /// The upper median (element len/2 in increasing order), found in linear time.

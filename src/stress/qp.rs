@@ -77,7 +77,7 @@ impl Triplets {
 }
 
 /// One row l_a force_a − l_b force_b per smoothing pair (columns may repeat; they add up).
-fn smoothing_rows<'a>(
+pub(super) fn smoothing_rows<'a>(
     inp: &'a QpInput,
     force: &'a Csr,
 ) -> impl Iterator<Item = Vec<(usize, f64)>> + 'a {
@@ -93,7 +93,7 @@ fn smoothing_rows<'a>(
 
 /// Per vertex, the column of its optimised τ (numbered from `first`, in vertex order), and
 /// how many there are.
-fn tau_columns(inp: &QpInput, first: usize) -> (Vec<Option<usize>>, usize) {
+pub(super) fn tau_columns(inp: &QpInput, first: usize) -> (Vec<Option<usize>>, usize) {
     let mut tau_col = vec![None; inp.u.len()];
     let mut n_tau = 0;
     for (v, nrm) in inp.tau_normal.iter().enumerate() {
@@ -106,7 +106,7 @@ fn tau_columns(inp: &QpInput, first: usize) -> (Vec<Option<usize>>, usize) {
 }
 
 /// Per vertex, its incident edges that carry a force (those with bounds).
-fn incident_edges(inp: &QpInput) -> Vec<Vec<usize>> {
+pub(super) fn incident_edges(inp: &QpInput) -> Vec<Vec<usize>> {
     let mut incident: Vec<Vec<usize>> = vec![Vec::new(); inp.u.len()];
     for (e, ev) in inp.edges.iter().enumerate() {
         if inp.bounds[e].is_some() {
@@ -118,7 +118,7 @@ fn incident_edges(inp: &QpInput) -> Vec<Vec<usize>> {
 }
 
 /// The end of edge `e` that is not `v`.
-fn other_end(inp: &QpInput, e: usize, v: usize) -> usize {
+pub(super) fn other_end(inp: &QpInput, e: usize, v: usize) -> usize {
     let ev = inp.edges[e];
     if ev[0] as usize == v {
         ev[1] as usize
@@ -432,7 +432,7 @@ fn native_objective(inp: &QpInput, incident: &[Vec<usize>], n: usize) -> NativeO
 }
 
 /// Horizontal balance rows of the native QP: Σ_e (u_i − u_j) S_e y − τ_i ν_i = −P_i.
-fn native_balance_rows(
+pub(super) fn native_balance_rows(
     inp: &QpInput,
     incident: &[Vec<usize>],
     tau_col: &[Option<usize>],
@@ -499,6 +499,28 @@ pub fn solve_native(
     coarse: bool,
     inexact: Option<f64>,
 ) -> QpOutput {
+    let n = inp.s.ncols + inp.tau_normal.iter().flatten().count();
+    let tol = if coarse {
+        ipm::Tolerances::for_form_finding(n)
+    } else {
+        ipm::Tolerances::for_size(n)
+    };
+    let (tol, loosened) = match inexact {
+        Some(gap) if gap > tol.gap_rel => (tol.inexact(gap), true),
+        _ => (tol, false),
+    };
+    let mut out = solve_native_with(inp, cache, &tol);
+    out.coarse = coarse && ipm::fallback_is_costly(n);
+    out.inexact = loosened && out.status == StressStatus::Solved;
+    out
+}
+
+/// `solve_native` with the tolerances `tol`.
+pub fn solve_native_with(
+    inp: &QpInput,
+    cache: &mut ipm::PatternCache,
+    tol: &ipm::Tolerances,
+) -> QpOutput {
     crate::interrupt::poll();
     let n_y = inp.s.ncols;
     let (tau_col, n_tau) = tau_columns(inp, n_y);
@@ -509,15 +531,6 @@ pub fn solve_native(
     let (ineq, h, lower_row) = native_bound_rows(inp, &tau_col, n);
     let groups = balanced_stars(inp, &incident, &lower_row);
     let positions = unknown_positions(inp, &tau_col, n);
-    let tol = if coarse {
-        ipm::Tolerances::for_form_finding(n)
-    } else {
-        ipm::Tolerances::for_size(n)
-    };
-    let (tol, loosened) = match inexact {
-        Some(gap) if gap > tol.gap_rel => (tol.inexact(gap), true),
-        _ => (tol, false),
-    };
     let out = ipm::solve(
         &ipm::Qp {
             quad: &objective.quad,
@@ -532,7 +545,7 @@ pub fn solve_native(
             positions: Some(&positions),
             slack_unit: Some(slack_unit(inp)),
         },
-        &tol,
+        tol,
         cache,
     );
     let tau = tau_col
@@ -549,8 +562,8 @@ pub fn solve_native(
             ipm::IpmStatus::NumericalError => StressStatus::NumericalError,
         },
         iterations: out.iterations,
-        coarse: coarse && ipm::fallback_is_costly(n),
-        inexact: loosened && out.status == ipm::IpmStatus::Solved,
+        coarse: false,
+        inexact: false,
     }
 }
 
