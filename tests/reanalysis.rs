@@ -12,10 +12,10 @@ use voussoir::*;
 /// ε∞ and the largest horizontal imbalance over p̄, recomputed from positions and forces.
 fn certificate(problem: &Problem, s: &StressResult) -> (f64, f64) {
     let mesh = &problem.mesh;
-    let (x, q) = (&mesh.positions, &s.force_densities);
+    let (x, q) = (mesh.positions(), &s.force_densities);
     let n = x.len();
     let (mut rv, mut rh) = (vec![0.0; n], vec![[0.0; 2]; n]);
-    for (e, edge) in mesh.edges.iter().enumerate() {
+    for (e, edge) in mesh.edges().iter().enumerate() {
         let [i, j] = edge.v.map(|v| v as usize);
         for (a, b) in [(i, j), (j, i)] {
             rv[a] += q[e] * (x[a][2] - x[b][2]);
@@ -24,7 +24,7 @@ fn certificate(problem: &Problem, s: &StressResult) -> (f64, f64) {
         }
     }
     let free: Vec<usize> = (0..n)
-        .filter(|&v| mesh.referenced[v] && !mesh.anchored[v])
+        .filter(|&v| mesh.referenced()[v] && !mesh.anchored()[v])
         .collect();
     let p_bar = free.iter().map(|&v| s.loads[v]).sum::<f64>() / free.len() as f64;
     let (mut eps, mut h) = (0.0f64, 0.0f64);
@@ -51,9 +51,9 @@ fn reanalysed(
         "{label}: form finding"
     );
     let path = dir.join(format!("{label}.obj"));
-    io::write_obj(&path, &r.positions, &problem.mesh.faces).expect("written");
+    io::write_obj(&path, &r.positions, problem.mesh.faces()).expect("written");
     let fresh = read_back(&path);
-    let free = (0..fresh.mesh.positions.len())
+    let free = (0..fresh.mesh.positions().len())
         .filter(|&v| fresh.mesh.is_non_anchored(v))
         .count();
     assert!(free > 10, "{label}: {free} non-anchored vertices");
@@ -150,7 +150,7 @@ fn form_found_holed_vaults_certify_that_they_stand_afresh() {
             let (eps, h) = reanalysed(&label, &problem, &dir, |path| {
                 let (positions, faces) = io::read_obj(path).expect("read back");
                 let anchored: Vec<u32> = (0..positions.len() as u32)
-                    .filter(|&v| problem.mesh.anchored[v as usize])
+                    .filter(|&v| problem.mesh.anchored()[v as usize])
                     .collect();
                 Problem::new(Mesh::new(positions, faces, &anchored).expect("mesh"))
             });
