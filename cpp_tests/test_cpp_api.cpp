@@ -529,6 +529,17 @@ TEST(CppApi, FormFindingEqualsTheCApiBitForBit) {
     EXPECT_FALSE(r.termination_message().empty());
 }
 
+TEST(CppApi, AHangingMeshIsReadUpsideDown) {
+    std::vector<double> hanging = kPositions;
+    hanging[14] = -0.3;  // the apex below the supports' plane
+    const voussoir::Result r = voussoir::form_find(voussoir::Mesh(hanging, kTriangles, kAnchored));
+    EXPECT_TRUE(r.mirrored());
+    EXPECT_GT(r.positions()[14], 0.0);
+    EXPECT_FALSE(voussoir::form_find(voussoir::Mesh(kPositions, kTriangles, kAnchored)).mirrored());
+    const voussoir::Result analysis = voussoir::analyse(voussoir::Mesh(hanging, kTriangles, kAnchored));
+    EXPECT_THROW(analysis.mirrored(), voussoir::Error);
+}
+
 TEST(CppApi, GettersFillCallerStorage) {
     const voussoir::Result r = voussoir::analyse(voussoir::Mesh(kPositions, kTriangles, kAnchored));
     const std::vector<double> expected = r.positions();

@@ -1144,6 +1144,18 @@ VsrStatus vsr_result_stalled_vertices(const struct VsrResult *result, uint32_t *
 VsrStatus vsr_result_height_change(const struct VsrResult *result, double *rms, double *max);
 
 /**
+ * Whether form finding read the input as drawn upside down (docs/method.md §13.1): 1 when
+ * the input hung below the unloaded surface over its supports and the search started from,
+ * and stayed near, its mirror image; 0 otherwise. The height change and the distances are
+ * measured from the input as given either way. Written only on success. For an analysis
+ * result: `VSR_STATUS_NOT_AVAILABLE`.
+ *
+ * # Safety
+ * `result`: a valid handle; `mirrored` writable.
+ */
+VsrStatus vsr_result_mirrored(const struct VsrResult *result, int32_t *mirrored);
+
+/**
  * Distances between the form-found and the input surfaces, over the plan bounding-box
  * diagonal (dimensionless), sampled at vertices: `hausdorff` = the symmetric Hausdorff
  * distance (the largest distance from a vertex of either surface to the other surface),

@@ -519,6 +519,12 @@ class Result {
         check(vsr_result_height_change(get(), &h.rms, &h.max));
         return h;
     }
+    /// Form finding only: whether the input hung and was read upside down (method.md 13.1).
+    bool mirrored() const {
+        int32_t m = 0;
+        check(vsr_result_mirrored(get(), &m));
+        return m != 0;
+    }
     Distances distances() const {
         Distances d;
         check(vsr_result_distances(get(), &d.hausdorff, &d.l2));

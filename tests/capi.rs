@@ -1188,3 +1188,42 @@ fn solves_reject_weightless_and_unrepresentable_loads() {
     assert_eq!(out, sentinel());
     unsafe { vsr_settings_destroy(s) };
 }
+
+/// A dome drawn upside down is read as its mirror image (docs/method.md §13.1) and the C
+/// result says so; the upright dome is not; an analysis has no such answer.
+#[test]
+fn a_hanging_dome_is_reported_mirrored_through_the_c_abi() {
+    for (scale, expected) in [(1.0, 0), (-1.0, 1)] {
+        let mut d = Dome::new(4, 10);
+        d.positions
+            .iter_mut()
+            .skip(2)
+            .step_by(3)
+            .for_each(|z| *z *= scale);
+        let mesh = d.create();
+        let s = settings();
+        let (mut form, mut analysis) = (null_mut(), null_mut());
+        assert_ok(unsafe { vsr_form_find(mesh, s, &mut form) });
+        assert_ok(unsafe { vsr_analyse(mesh, s, &mut analysis) });
+        let mut mirrored = -1;
+        assert_failed(
+            unsafe { vsr_result_mirrored(form, null_mut()) },
+            S::NullPointer,
+            "mirrored",
+        );
+        assert_failed(
+            unsafe { vsr_result_mirrored(analysis, &mut mirrored) },
+            S::NotAvailable,
+            "result",
+        );
+        assert_eq!(mirrored, -1, "written on failure");
+        assert_ok(unsafe { vsr_result_mirrored(form, &mut mirrored) });
+        assert_eq!(mirrored, expected, "heights × {scale}");
+        unsafe {
+            vsr_result_destroy(form);
+            vsr_result_destroy(analysis);
+            vsr_settings_destroy(s);
+            vsr_mesh_destroy(mesh);
+        }
+    }
+}

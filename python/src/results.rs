@@ -105,6 +105,7 @@ pub fn form_found<'py>(
     d.set_item("l2", r.l2)?;
     d.set_item("rms_change", r.rms_change)?;
     d.set_item("max_change", r.max_change)?;
+    d.set_item("mirrored", r.mirrored)?;
     d.set_item("stress_seconds", r.stress_seconds)?;
     d.set_item("shape_seconds", r.shape_seconds)?;
     d.set_item("total_seconds", r.total_seconds)?;

@@ -137,6 +137,15 @@ def test_loads_are_kept_and_change_the_answer():
     assert voussoir.analyse(heavy).loads[4] > voussoir.analyse(light).loads[4]
 
 
+def test_a_hanging_mesh_is_read_upside_down_and_says_so():
+    hanging = np.array(SQUARE_POSITIONS, dtype=np.float64)
+    hanging[4, 2] = -0.3
+    found = voussoir.form_find(voussoir.Mesh(hanging, SQUARE_FACES, SQUARE_ANCHORED))
+    assert found.mirrored and found.converged
+    assert found.positions[4, 2] > 0
+    assert not voussoir.form_find(square()).mirrored
+
+
 def test_faces_keep_their_orientation():
     clockwise = [f[::-1] for f in SQUARE_FACES]
     mesh = voussoir.Mesh(SQUARE_POSITIONS, clockwise, SQUARE_ANCHORED)

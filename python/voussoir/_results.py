@@ -106,6 +106,9 @@ class FormFindResult(StressResult):
     """Area-weighted RMS height change / plan bounding-box diagonal."""
     max_change: float = 0.0
     """Largest height change / plan bounding-box diagonal."""
+    mirrored: bool = False
+    """True when the input hung below its supports and was read upside down (its mirror
+    image was the start and the shape to stay near); changes are still from the input."""
     stress_seconds: float = 0.0
     shape_seconds: float = 0.0
     total_seconds: float = 0.0

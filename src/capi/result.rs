@@ -724,6 +724,31 @@ pub unsafe extern "C" fn vsr_result_height_change(
     })
 }
 
+/// Whether form finding read the input as drawn upside down (docs/method.md §13.1): 1 when
+/// the input hung below the unloaded surface over its supports and the search started from,
+/// and stayed near, its mirror image; 0 otherwise. The height change and the distances are
+/// measured from the input as given either way. Written only on success. For an analysis
+/// result: `VSR_STATUS_NOT_AVAILABLE`.
+///
+/// # Safety
+/// `result`: a valid handle; `mirrored` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_result_mirrored(
+    result: *const VsrResult,
+    mirrored: *mut i32,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: forwarded caller's contract.
+        unsafe {
+            scalars("result", result, [("mirrored", mirrored)], |r| {
+                Ok([i32::from(
+                    r.form("whether the input was mirrored")?.mirrored,
+                )])
+            })
+        }
+    })
+}
+
 /// Distances between the form-found and the input surfaces, over the plan bounding-box
 /// diagonal (dimensionless), sampled at vertices: `hausdorff` = the symmetric Hausdorff
 /// distance (the largest distance from a vertex of either surface to the other surface),
