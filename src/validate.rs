@@ -46,6 +46,18 @@ pub(crate) fn within(name: &'static str, v: f64, min: f64, max: f64, open: bool)
     Ok(())
 }
 
+/// Every entry of `values` finite: the first that is not is named as `what` and its index
+/// (`vertex 3: NaN is not finite`).
+pub(crate) fn all_finite(name: &'static str, values: &[f64], what: &str) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => Err(invalid(
+            name,
+            format!("{what} {k}: {} {NOT_FINITE}", values[k]),
+        )),
+    }
+}
+
 /// A count of at least `min`.
 pub(crate) fn count(name: &'static str, n: usize, min: usize) -> Result<()> {
     if n < min {
@@ -100,6 +112,9 @@ mod tests {
         assert!(!is_not_finite(&at_least("x", -1.0, 0.0).unwrap_err()));
         assert!(within("x", 1.0, 0.0, 1.0, false).is_ok() && count("x", 1, 1).is_ok());
         assert_eq!(reason(Err(below_other("x", "y"))), "must be >= y");
+        let all = all_finite("x", &[1.0, f64::INFINITY], "vertex");
+        assert_eq!(reason(all.clone()), "vertex 1: inf is not finite");
+        assert!(is_not_finite(&all.unwrap_err()) && all_finite("x", &[1.0], "v").is_ok());
         assert!(is_relation(&below_other("x", "y")));
         assert!(!is_relation(&count("x", 0, 1).unwrap_err()));
     }

@@ -541,7 +541,7 @@ fn assess_settings_setters_reject_bad_values_and_keep_the_previous_ones() {
         (
             Box::new(|s| unsafe { vsr_assess_settings_set_q_min(s, -1.0, 0) }),
             S::InvalidArgument,
-            "q_min",
+            "value",
         ),
         (
             Box::new(|s| unsafe { vsr_assess_settings_set_q_min(s, 0.0, 2) }),

@@ -6,7 +6,7 @@ mod capi_support;
 
 use capi_support::{assert_ok, last_error, settings};
 use voussoir::capi::*;
-use voussoir::{Error, FormFindSettings, QBound, StressSettings};
+use voussoir::{AssessSettings, Error, FormFindSettings, QBound, StressSettings};
 
 type Setter = Box<dyn Fn(*mut VsrSettings) -> VsrStatus>;
 type Change = Box<dyn Fn(FormFindSettings) -> FormFindSettings>;
@@ -208,4 +208,96 @@ fn the_defaults_are_valid_and_infinite_limits_are_not() {
             ..
         })
     ));
+}
+
+/// A number of `tests/assess_data/bad_settings.json` (JSON has no NaN or infinity: strings).
+fn number(v: &serde_json::Value) -> f64 {
+    match v {
+        serde_json::Value::String(s) => s.parse().expect("nan, inf or -inf"),
+        v => v.as_f64().expect("a number"),
+    }
+}
+
+/// The case's change to Rust settings, and the same change through the C setter.
+fn assess_change(
+    setting: &str,
+    value: &serde_json::Value,
+) -> (
+    AssessSettings,
+    Box<dyn Fn(*mut VsrAssessSettings) -> VsrStatus>,
+) {
+    let d = AssessSettings::default();
+    let x = match value {
+        serde_json::Value::Array(_) => 0.0,
+        v => number(v),
+    };
+    let absolute = VsrBoundKind::Absolute as u32;
+    unsafe {
+        match setting {
+            "unit_weight" => (
+                d.with_unit_weight(x),
+                Box::new(move |s| vsr_assess_settings_set_unit_weight(s, x)),
+            ),
+            "tolerance" => (
+                d.with_tolerance(x),
+                Box::new(move |s| vsr_assess_settings_set_tolerance(s, x)),
+            ),
+            "max_iterations" => (
+                d.with_max_iterations(x as usize),
+                Box::new(move |s| vsr_assess_settings_set_max_iterations(s, x as usize)),
+            ),
+            "q_min" => (
+                d.with_q_min(QBound::Absolute(x)),
+                Box::new(move |s| vsr_assess_settings_set_q_min(s, x, absolute)),
+            ),
+            "load_pattern" => {
+                let p: Vec<f64> = value
+                    .as_array()
+                    .expect("a list")
+                    .iter()
+                    .map(number)
+                    .collect();
+                let c = p.clone();
+                (
+                    d.with_load_pattern(p),
+                    Box::new(move |s| vsr_assess_settings_set_load_pattern(s, c.as_ptr(), c.len())),
+                )
+            }
+            other => panic!("no case for the setting {other}"),
+        }
+    }
+}
+
+#[test]
+fn assessment_settings_give_the_reasons_of_the_rust_validation_in_c_too() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/assess_data/bad_settings.json"
+    );
+    let data: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect(path)).expect(path);
+    let cases = data["cases"].as_array().expect("cases");
+    assert!(cases.len() >= 8);
+    for case in cases {
+        let text = |k: &str| case[k].as_str().expect(k).to_string();
+        let (setting, reason) = (text("setting"), text("reason"));
+        let (changed, set) = assess_change(&setting, &case["value"]);
+        match changed.validate() {
+            Err(Error::InvalidArgument { name, reason: r }) => {
+                assert_eq!((name, r.as_str()), (setting.as_str(), reason.as_str()))
+            }
+            other => panic!("{setting}: Rust gave {other:?}"),
+        }
+        let mut s = std::ptr::null_mut();
+        assert_ok(unsafe { vsr_assess_settings_create(&mut s) });
+        let expected = if reason.ends_with("is not finite") {
+            VsrStatus::NonFinite
+        } else {
+            VsrStatus::InvalidArgument
+        };
+        assert_eq!(set(s), expected, "{setting}: {}", last_error());
+        let c = text("c_argument");
+        assert_eq!(last_error(), format!("argument `{c}`: {reason}"));
+        unsafe { vsr_assess_settings_destroy(s) };
+    }
 }

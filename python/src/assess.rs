@@ -1,30 +1,16 @@
 //! Masonry assessment: the envelope (a thickness, or intrados and extrados surfaces), keyword
-//! settings → `AssessSettings` (checked as the C API's `vsr_assess_settings_set_*` check them,
-//! with the same messages), and `voussoir::assess` with the GIL released.
+//! settings → `AssessSettings` (converted here, checked by the library's
+//! `AssessSettings::validate` as the C API's `vsr_assess_settings_set_*` are, with the same
+//! reasons), and `voussoir::assess` with the GIL released.
 
 use crate::errors::{from_error, invalid};
 use crate::mesh::{shape_text, Mesh};
+use crate::settings;
 use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use voussoir::report::AssessmentReport;
 use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, Objective, QBound, Thickness};
-
-fn text(name: &str, v: &Bound<'_, PyAny>) -> PyResult<String> {
-    v.extract().map_err(|_| {
-        let shown = v.repr().map_or("?".into(), |r| r.to_string());
-        invalid(name, format_args!("{shown} is not a string"))
-    })
-}
-
-fn finite(name: &str, v: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let x: f64 = v.extract().map_err(|_| invalid(name, "is not a number"))?;
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(invalid(name, format_args!("{x} is not finite")))
-    }
-}
 
 /// A flat float64 array of any shape, its entries finite.
 fn floats(name: &str, a: &PyReadonlyArrayDyn<'_, f64>, what: &str) -> PyResult<Vec<f64>> {
@@ -41,27 +27,17 @@ fn floats(name: &str, a: &PyReadonlyArrayDyn<'_, f64>, what: &str) -> PyResult<V
 /// Settings from keyword arguments, on top of the Rust defaults.
 pub fn settings_from(kwargs: &Bound<'_, PyDict>) -> PyResult<AssessSettings> {
     let mut s = AssessSettings::default();
-    let kind = match kwargs.get_item("q_min_kind")? {
-        None => "absolute".to_string(),
-        Some(v) => text("q_min_kind", &v)?,
+    let relative = match kwargs.get_item("q_min_kind")? {
+        None => false,
+        Some(v) => settings::kind("q_min_kind", &v)?,
     };
-    if kind != "absolute" && kind != "relative" {
-        return Err(invalid(
-            "q_min_kind",
-            format_args!("'{kind}' is not one of 'absolute', 'relative'"),
-        ));
-    }
     for (key, v) in kwargs.iter() {
         let key: String = key.extract()?;
         match key.as_str() {
-            "objective" => s.objective = crate::settings::named::<Objective>(&key, &v)?,
-            "fixed_supports" => {
-                s.fixed_supports = v
-                    .extract::<bool>()
-                    .map_err(|_| invalid(&key, "is not True or False"))?
-            }
-            "unit_weight" => s.unit_weight = finite(&key, &v)?,
-            "load_rule" => s.load_rule = crate::settings::named::<LoadRule>(&key, &v)?,
+            "objective" => s.objective = settings::named::<Objective>(&key, &v)?,
+            "fixed_supports" => s.fixed_supports = settings::flag(&key, &v)?,
+            "unit_weight" => s.unit_weight = settings::number(&key, &v)?,
+            "load_rule" => s.load_rule = settings::named::<LoadRule>(&key, &v)?,
             "load_pattern" => {
                 s.load_pattern = if v.is_none() {
                     None
@@ -76,29 +52,24 @@ pub fn settings_from(kwargs: &Bound<'_, PyDict>) -> PyResult<AssessSettings> {
                             format_args!("has shape {shape}, expected (n,)"),
                         ));
                     }
-                    Some(floats(&key, &a, "vertex")?)
+                    Some(a.as_array().iter().copied().collect())
                 };
             }
             "q_min" => {
-                let q = finite(&key, &v)?;
-                s.q_min = if kind == "relative" {
+                let q = settings::number(&key, &v)?;
+                s.q_min = if relative {
                     QBound::Relative(q)
                 } else {
                     QBound::Absolute(q)
                 };
             }
             "q_min_kind" => {}
-            "tolerance" => s.tolerance = finite(&key, &v)?,
-            "max_iterations" => {
-                let n: i64 = v
-                    .extract()
-                    .map_err(|_| invalid(&key, "is not an integer"))?;
-                s.max_iterations = usize::try_from(n).unwrap_or(0);
-            }
+            "tolerance" => s.tolerance = settings::number(&key, &v)?,
+            "max_iterations" => s.max_iterations = settings::count(&key, &v)?,
             _ => return Err(invalid(&key, "is not an assessment setting")),
         }
     }
-    if kwargs.get_item("q_min")?.is_none() && kind == "relative" {
+    if kwargs.get_item("q_min")?.is_none() && relative {
         s.q_min = QBound::Relative(0.0);
     }
     s.validate().map_err(|e| match e {

@@ -14,7 +14,11 @@ use voussoir::{
 
 const KINDS: [(&str, bool); 2] = [("relative", true), ("absolute", false)];
 
-/// The relative/absolute kind of a bound, by name.
+/// The relative/absolute kind of a bound, by name (true: relative).
+pub fn kind(name: &str, value: &Bound<'_, PyAny>) -> PyResult<bool> {
+    choice(name, value, &KINDS)
+}
+
 fn choice(name: &str, value: &Bound<'_, PyAny>, table: &[(&str, bool)]) -> PyResult<bool> {
     let text = string(name, value)?;
     table
@@ -76,10 +80,26 @@ pub fn choices(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(d)
 }
 
-fn number(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+/// A number, converted only (the library's `validate` checks its range).
+pub fn number(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
     value
         .extract::<f64>()
         .map_err(|_| invalid(name, "is not a number"))
+}
+
+/// A count: an integer >= 0, converted only.
+pub fn count(name: &str, value: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let n: i64 = value
+        .extract()
+        .map_err(|_| invalid(name, "is not an integer"))?;
+    usize::try_from(n).map_err(|_| invalid(name, format_args!("{n} is negative")))
+}
+
+/// A flag: True or False.
+pub fn flag(name: &str, value: &Bound<'_, PyAny>) -> PyResult<bool> {
+    value
+        .extract::<bool>()
+        .map_err(|_| invalid(name, "is not True or False"))
 }
 
 /// Where a scalar setting lives in `FormFindSettings`.
@@ -128,18 +148,8 @@ impl Slot {
     fn set(&self, f: &mut FormFindSettings, name: &str, v: &Bound<'_, PyAny>) -> PyResult<()> {
         match self {
             Slot::Number(at) => *at(f) = number(name, v)?,
-            Slot::Count(at) => {
-                let n: i64 = v
-                    .extract()
-                    .map_err(|_| invalid(name, "is not an integer"))?;
-                *at(f) = usize::try_from(n)
-                    .map_err(|_| invalid(name, format_args!("{n} is negative")))?;
-            }
-            Slot::Flag(at) => {
-                *at(f) = v
-                    .extract::<bool>()
-                    .map_err(|_| invalid(name, "is not True or False"))?
-            }
+            Slot::Count(at) => *at(f) = count(name, v)?,
+            Slot::Flag(at) => *at(f) = flag(name, v)?,
         }
         Ok(())
     }
@@ -178,11 +188,11 @@ pub fn from_kwargs(kwargs: &Bound<'_, PyDict>) -> PyResult<FormFindSettings> {
     let mut f = FormFindSettings::default();
     let get = |key: &str| kwargs.get_item(key);
     let q_min_relative = match get("q_min_kind")? {
-        Some(v) => choice("q_min_kind", &v, &KINDS)?,
+        Some(v) => kind("q_min_kind", &v)?,
         None => matches!(f.stress.q_min, QBound::Relative(_)),
     };
     let q_max_relative = match get("q_max_kind")? {
-        Some(v) => choice("q_max_kind", &v, &KINDS)?,
+        Some(v) => kind("q_max_kind", &v)?,
         None => !matches!(f.stress.q_max, Some(QBound::Absolute(_))),
     };
     for (key, value) in kwargs.iter() {

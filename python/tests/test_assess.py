@@ -9,6 +9,7 @@ import json
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -165,8 +166,10 @@ def test_fixed_supports_and_settings():
         ({}, "thickness", "give the masonry's envelope"),
         ({"thickness": 0.1, "objective": "max"}, "objective", "'fit'"),
         ({"thickness": 0.1, "unit_weight": -1.0}, "unit_weight", ">= 0"),
-        ({"thickness": 0.1, "tolerance": 2.0}, "tolerance", "(0, 1)"),
-        ({"thickness": 0.1, "max_iterations": 0}, "max_iterations", "at least 1"),
+        ({"thickness": 0.1, "tolerance": 2.0}, "tolerance", "2 must be < 1"),
+        ({"thickness": 0.1, "max_iterations": 0}, "max_iterations", "must be >= 1"),
+        ({"thickness": 0.1, "max_iterations": -1}, "max_iterations", "-1 is negative"),
+        ({"thickness": 0.1, "q_min_kind": "sideways"}, "q_min_kind", "'relative', 'absolute'"),
         ({"thickness": 0.1, "load_rule": "area"}, "load_rule", "'plan_area'"),
         ({"thickness": 0.1, "q_min": -1.0}, "q_min", ">= 0"),
         ({"thickness": 0.1, "tau": "zero"}, "tau", "not an assessment setting"),
@@ -184,6 +187,27 @@ def test_bad_input_names_the_argument(kwargs, argument, detail):
     message = str(e.value)
     assert f"argument `{argument}`" in message and detail in message, message
     assert "\n" not in message
+
+
+BAD_SETTINGS = json.loads(
+    (Path(__file__).resolve().parents[2] / "tests" / "assess_data" / "bad_settings.json").read_text()
+)["cases"]
+
+
+@pytest.mark.parametrize("case", BAD_SETTINGS, ids=lambda c: f"{c['setting']}={c['value']}")
+def test_bad_settings_give_the_reason_of_the_rust_validation(case):
+    """The cases tests/settings_validation.rs checks in Rust and through the C setters: the
+    same reason, under the Python keyword."""
+    value = case["value"]
+    if isinstance(value, list):
+        value = np.array([float(x) for x in value])
+    elif isinstance(value, str):
+        value = float(value)
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    with pytest.raises(voussoir.VoussoirError) as e:
+        voussoir.assess(mesh, 0.1, **{case["setting"]: value})
+    assert str(e.value) == f"argument `{case['python_argument']}`: {case['reason']}"
 
 
 def test_bad_surfaces_name_the_vertex():

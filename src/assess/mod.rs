@@ -20,7 +20,7 @@ mod sqp;
 pub use envelope::Envelope;
 pub use family::{min_thickness_of_family, FamilyThickness};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geometry::loads::LoadRule;
 use crate::problem::Problem;
 use crate::solve::{Progress, Termination};
@@ -89,34 +89,18 @@ impl Default for AssessSettings {
 }
 
 impl AssessSettings {
-    /// Checks every setting; errors name it.
+    /// Checks every setting; errors name it, worded as `FormFindSettings::validate` words
+    /// its own (the C API and Python report these reasons under their argument names).
     pub fn validate(&self) -> Result<()> {
-        let bad = |name: &'static str, reason: String| Err(Error::InvalidArgument { name, reason });
-        if !(self.unit_weight.is_finite() && self.unit_weight >= 0.0) {
-            return bad(
-                "unit_weight",
-                format!("{} is not a finite number >= 0", self.unit_weight),
-            );
-        }
-        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return bad("tolerance", format!("{} is not in (0, 1)", self.tolerance));
-        }
-        if self.max_iterations == 0 {
-            return bad("max_iterations", "must be at least 1".into());
-        }
-        let q = match self.q_min {
-            QBound::Absolute(q) | QBound::Relative(q) => q,
-        };
-        if !(q.is_finite() && q >= 0.0) {
-            return bad("q_min", format!("{q} is not a finite number >= 0"));
-        }
+        use crate::validate::{above, all_finite, at_least, count, within};
+        at_least("unit_weight", self.unit_weight, 0.0)?;
+        above("tolerance", self.tolerance, 0.0)?;
+        within("tolerance", self.tolerance, 0.0, 1.0, true)?;
+        count("max_iterations", self.max_iterations, 1)?;
+        let (QBound::Absolute(q) | QBound::Relative(q)) = self.q_min;
+        at_least("q_min", q, 0.0)?;
         if let Some(pattern) = &self.load_pattern {
-            if let Some(v) = pattern.iter().position(|p| !p.is_finite()) {
-                return bad(
-                    "load_pattern",
-                    format!("vertex {v} has {}, not a finite number", pattern[v]),
-                );
-            }
+            all_finite("load_pattern", pattern, "vertex")?;
         }
         Ok(())
     }

@@ -9,7 +9,7 @@ use super::boundary::{
 };
 use super::enum_args;
 use super::mesh::VsrMesh;
-use super::settings::{Progress, VsrProgressFn};
+use super::settings::{rejected, Progress, VsrProgressFn};
 use super::status::VsrStatus;
 use crate::assess::{assess, AssessSettings, Envelope};
 use crate::solid::Thickness;
@@ -325,29 +325,22 @@ pub unsafe extern "C" fn vsr_assess_settings_destroy(settings: *mut VsrAssessSet
     boundary!(keep_error, (), { unsafe { free(settings) } })
 }
 
-/// Applies `f` to a copy of the settings, validates the copy, and stores it on success.
-unsafe fn update(settings: *mut VsrAssessSettings, f: impl FnOnce(&mut AssessSettings)) -> CResult {
+/// Applies `f` to a copy of the settings, validates the copy with the library's
+/// [`AssessSettings::validate`] (the one set of range checks), and stores it on success.
+/// `args` maps the settings' field names to the setter's argument names, which a failure
+/// names.
+unsafe fn update(
+    settings: *mut VsrAssessSettings,
+    args: &[(&str, &str)],
+    f: impl FnOnce(&mut AssessSettings),
+) -> CResult {
     // SAFETY: caller's contract (valid handle, exclusive access).
     let s = unsafe { handle_mut("settings", settings)? };
     let mut copy = s.settings.clone();
     f(&mut copy);
-    copy.validate().map_err(|e| match e {
-        crate::Error::InvalidArgument { name, reason } => Failure::invalid(name, reason),
-        e => Failure::invalid("settings", e),
-    })?;
+    copy.validate().map_err(|e| rejected(e, args))?;
     s.settings = copy;
     Ok(())
-}
-
-fn finite(name: &str, v: f64) -> CResult<f64> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Failure::new(
-            VsrStatus::NonFinite,
-            format!("argument `{name}`: {v} is not finite"),
-        ))
-    }
 }
 
 fn flag(name: &str, v: u32) -> CResult<bool> {
@@ -370,7 +363,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_objective(
     boundary!({
         let o = enum_args::objective("objective", objective)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.objective = o) }
+        unsafe { update(settings, &[], |s| s.objective = o) }
     })
 }
 
@@ -387,7 +380,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_fixed_supports(
     boundary!({
         let on = flag("fixed", fixed)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.fixed_supports = on) }
+        unsafe { update(settings, &[], |s| s.fixed_supports = on) }
     })
 }
 
@@ -403,9 +396,8 @@ pub unsafe extern "C" fn vsr_assess_settings_set_unit_weight(
     unit_weight: f64,
 ) -> VsrStatus {
     boundary!({
-        let w = finite("unit_weight", unit_weight)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.unit_weight = w) }
+        unsafe { update(settings, &[], |s| s.unit_weight = unit_weight) }
     })
 }
 
@@ -422,7 +414,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_load_rule(
     boundary!({
         let rule = enum_args::load_rule("rule", rule)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.load_rule = rule) }
+        unsafe { update(settings, &[], |s| s.load_rule = rule) }
     })
 }
 
@@ -442,10 +434,10 @@ pub unsafe extern "C" fn vsr_assess_settings_set_load_pattern(
     boundary!({
         // SAFETY: caller's contract.
         let values = unsafe { input("loads", loads, n)? };
-        finite_values("loads", values, "vertex")?;
         let pattern = (n > 0).then(|| values.to_vec());
+        let args = [("load_pattern", "loads")];
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.load_pattern = pattern) }
+        unsafe { update(settings, &args, |s| s.load_pattern = pattern) }
     })
 }
 
@@ -463,14 +455,13 @@ pub unsafe extern "C" fn vsr_assess_settings_set_q_min(
 ) -> VsrStatus {
     boundary!({
         let relative = enum_args::bound_kind("kind", kind)?;
-        let v = finite("value", value)?;
         let bound = if relative {
-            QBound::Relative(v)
+            QBound::Relative(value)
         } else {
-            QBound::Absolute(v)
+            QBound::Absolute(value)
         };
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.q_min = bound) }
+        unsafe { update(settings, &[("q_min", "value")], |s| s.q_min = bound) }
     })
 }
 
@@ -485,9 +476,8 @@ pub unsafe extern "C" fn vsr_assess_settings_set_tolerance(
     tolerance: f64,
 ) -> VsrStatus {
     boundary!({
-        let t = finite("tolerance", tolerance)?;
         // SAFETY: forwarded caller's contract.
-        unsafe { update(settings, |s| s.tolerance = t) }
+        unsafe { update(settings, &[], |s| s.tolerance = tolerance) }
     })
 }
 
@@ -501,7 +491,7 @@ pub unsafe extern "C" fn vsr_assess_settings_set_max_iterations(
     max_iterations: usize,
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
-    boundary!({ unsafe { update(settings, |s| s.max_iterations = max_iterations) } })
+    boundary!({ unsafe { update(settings, &[], |s| s.max_iterations = max_iterations) } })
 }
 
 /// Sets the progress callback of `vsr_assess` (a `VsrProgressFn`, called once per step with

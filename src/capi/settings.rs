@@ -152,9 +152,7 @@ pub unsafe extern "C" fn vsr_settings_destroy(settings: *mut VsrSettings) {
 
 /// Applies `f` to a copy of the settings, validates the copy with the library's
 /// [`FormFindSettings::validate`] (the one set of range checks), and stores it on success.
-/// `args` maps the settings' field names to the setter's argument names, which a failure
-/// names; a field outside it, or a relation between two settings (q_max below q_min), keeps
-/// the setting's own name.
+/// `args` maps the settings' field names to the setter's argument names (see [`rejected`]).
 unsafe fn update(
     settings: *mut VsrSettings,
     args: &[(&str, &str)],
@@ -164,24 +162,31 @@ unsafe fn update(
     let s = unsafe { handle_mut("settings", settings)? };
     let mut form = s.form.clone();
     f(&mut form);
-    form.validate().map_err(|e| {
-        let relation = crate::validate::is_relation(&e);
-        let status = if crate::validate::is_not_finite(&e) {
-            VsrStatus::NonFinite
-        } else {
-            VsrStatus::InvalidArgument
-        };
-        match e {
-            crate::Error::InvalidArgument { name, reason } => {
-                let field = |a: &&(&str, &str)| a.0 == name && !relation;
-                let arg = args.iter().find(field).map_or(name, |a| a.1);
-                Failure::new(status, format!("argument `{arg}`: {reason}"))
-            }
-            e => Failure::invalid("settings", e),
-        }
-    })?;
+    form.validate().map_err(|e| rejected(e, args))?;
     s.form = form;
     Ok(())
+}
+
+/// A setter's failure from the library's validation of the settings (the reason as the
+/// library words it; `VSR_STATUS_NON_FINITE` for NaN and infinities): `args` maps the
+/// settings' field names to the setter's argument names, which the message names; a field
+/// outside it, or a relation between two settings (q_max below q_min), keeps the setting's
+/// own name.
+pub(crate) fn rejected(e: crate::Error, args: &[(&str, &str)]) -> Failure {
+    let relation = crate::validate::is_relation(&e);
+    let status = if crate::validate::is_not_finite(&e) {
+        VsrStatus::NonFinite
+    } else {
+        VsrStatus::InvalidArgument
+    };
+    match e {
+        crate::Error::InvalidArgument { name, reason } => {
+            let field = |a: &&(&str, &str)| a.0 == name && !relation;
+            let arg = args.iter().find(field).map_or(name, |a| a.1);
+            Failure::new(status, format!("argument `{arg}`: {reason}"))
+        }
+        e => Failure::invalid("settings", e),
+    }
 }
 
 /// Sets the convergence tolerance on ε∞ = max |r_i| / mean p_i (dimensionless): form
