@@ -3,7 +3,7 @@
 use std::ffi::{c_char, CStr};
 use std::path::PathBuf;
 
-use super::boundary::{boundary, checked_len, copy_out, from_error, handle, input, out_ptr};
+use super::boundary::{boundary, checked_len, copy, from_error, handle, input, out_ptr};
 use super::boundary::{CResult, Failure};
 use super::mesh::VsrMesh;
 use super::result::VsrResult;
@@ -135,17 +135,14 @@ pub unsafe extern "C" fn vsr_mesh_welded_ids(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: forwarded caller's contract.
-        let mesh = unsafe { handle("mesh", mesh)? };
-        let identity: Vec<u32>;
-        let ids = match &mesh.welded_ids {
-            Some(ids) => ids.as_slice(),
-            None => {
-                identity = (0..mesh.problem.mesh.n_vertices() as u32).collect();
-                identity.as_slice()
-            }
-        };
-        // SAFETY: forwarded caller's contract.
-        unsafe { copy_out(ids, out, len, needed) }
+        unsafe {
+            copy("mesh", mesh, out, len, needed, |m| {
+                Ok(match &m.welded_ids {
+                    Some(ids) => ids.clone(),
+                    None => (0..m.problem.mesh.n_vertices() as u32).collect(),
+                })
+            })
+        }
     })
 }
 
@@ -230,13 +227,10 @@ pub unsafe extern "C" fn vsr_mesh_plan_flips(
     len: usize,
     needed: *mut usize,
 ) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
     boundary!({
-        // SAFETY: forwarded caller's contract.
-        let mesh = unsafe { handle("mesh", mesh)? };
-        let rows: Vec<u32> = mesh
-            .repairs
-            .iter()
-            .flat_map(|r| match r {
+        unsafe {
+            repairs(mesh, out, len, needed, |r| match r {
                 PlanRepair::Flip {
                     faces,
                     removed,
@@ -251,9 +245,7 @@ pub unsafe extern "C" fn vsr_mesh_plan_flips(
                 ],
                 _ => Vec::new(),
             })
-            .collect();
-        // SAFETY: forwarded caller's contract.
-        unsafe { copy_out(&rows, out, len, needed) }
+        }
     })
 }
 
@@ -271,18 +263,32 @@ pub unsafe extern "C" fn vsr_mesh_plan_nudges(
     len: usize,
     needed: *mut usize,
 ) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
     boundary!({
-        // SAFETY: forwarded caller's contract.
-        let mesh = unsafe { handle("mesh", mesh)? };
-        let rows: Vec<u32> = mesh
-            .repairs
-            .iter()
-            .flat_map(|r| match r {
+        unsafe {
+            repairs(mesh, out, len, needed, |r| match r {
                 PlanRepair::Nudge { vertex, face, .. } => vec![*vertex, *face as u32],
                 _ => Vec::new(),
             })
-            .collect();
-        // SAFETY: forwarded caller's contract.
-        unsafe { copy_out(&rows, out, len, needed) }
+        }
     })
+}
+
+/// Copies out the rows `row` gives for the plan repairs `vsr_mesh_read` made, in order.
+///
+/// # Safety
+/// As [`copy`].
+unsafe fn repairs(
+    mesh: *const VsrMesh,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+    row: impl Fn(&PlanRepair) -> Vec<u32>,
+) -> CResult {
+    // SAFETY: forwarded caller's contract.
+    unsafe {
+        copy("mesh", mesh, out, len, needed, |m| {
+            Ok(m.repairs.iter().flat_map(row).collect())
+        })
+    }
 }

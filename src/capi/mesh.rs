@@ -1,7 +1,7 @@
 //! `VsrMesh`: a validated mesh and its loading (a [`Problem`]).
 
 use super::boundary::{
-    boundary, checked_len, copy_out, free, from_error, handle, handle_mut, input, out_ptr, CResult,
+    boundary, checked_len, copy, free, from_error, handle, handle_mut, input, out_ptr, CResult,
     Failure,
 };
 use super::status::VsrStatus;
@@ -366,10 +366,11 @@ pub unsafe extern "C" fn vsr_mesh_edges(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: caller's contract.
-        let mesh = unsafe { handle("mesh", mesh)? };
-        let edges: Vec<u32> = mesh.problem.mesh.edges.iter().flat_map(|e| e.v).collect();
-        // SAFETY: caller's contract.
-        unsafe { copy_out(&edges, out, len, needed) }
+        unsafe {
+            copy("mesh", mesh, out, len, needed, |m| {
+                Ok(m.problem.mesh.edges.iter().flat_map(|e| e.v).collect())
+            })
+        }
     })
 }
 
@@ -445,9 +446,10 @@ pub unsafe extern "C" fn vsr_mesh_polygon_diagonals(
 ) -> VsrStatus {
     boundary!({
         // SAFETY: caller's contract.
-        let mesh = unsafe { handle("mesh", mesh)? };
-        let pairs: Vec<u32> = mesh.problem.polygon_diagonals().concat();
-        // SAFETY: caller's contract.
-        unsafe { copy_out(&pairs, out, len, needed) }
+        unsafe {
+            copy("mesh", mesh, out, len, needed, |m| {
+                Ok(m.problem.polygon_diagonals().concat())
+            })
+        }
     })
 }
