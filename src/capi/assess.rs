@@ -4,12 +4,12 @@
 
 use super::assessment::VsrAssessment;
 use super::boundary::{
-    boundary, checked_len, copy_out, free, from_error, give, handle, handle_mut, input, out_ptr,
-    CResult, Failure,
+    boundary, checked_len, copy_out, free, from_error, give, handle, input, out_ptr, CResult,
+    Failure,
 };
 use super::enum_args;
 use super::mesh::VsrMesh;
-use super::settings::{rejected, Progress, VsrProgressFn};
+use super::settings::{validated, Progress, VsrProgressFn};
 use super::status::VsrStatus;
 use crate::assess::{assess, AssessSettings, Envelope};
 use crate::solid::Thickness;
@@ -334,13 +334,16 @@ unsafe fn update(
     args: &[(&str, &str)],
     f: impl FnOnce(&mut AssessSettings),
 ) -> CResult {
-    // SAFETY: caller's contract (valid handle, exclusive access).
-    let s = unsafe { handle_mut("settings", settings)? };
-    let mut copy = s.settings.clone();
-    f(&mut copy);
-    copy.validate().map_err(|e| rejected(e, args))?;
-    s.settings = copy;
-    Ok(())
+    // SAFETY: forwarded caller's contract.
+    unsafe {
+        validated(
+            settings,
+            |h| &mut h.settings,
+            AssessSettings::validate,
+            args,
+            f,
+        )
+    }
 }
 
 fn flag(name: &str, v: u32) -> CResult<bool> {

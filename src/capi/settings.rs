@@ -158,12 +158,37 @@ unsafe fn update(
     args: &[(&str, &str)],
     f: impl FnOnce(&mut FormFindSettings),
 ) -> CResult {
+    // SAFETY: forwarded caller's contract.
+    unsafe {
+        validated(
+            settings,
+            |h| &mut h.form,
+            FormFindSettings::validate,
+            args,
+            f,
+        )
+    }
+}
+
+/// The body of every settings setter of both handles: applies `f` to a copy of the settings
+/// `slot` picks in the handle `settings`, checks the copy with the library's `validate`, and
+/// stores it on success (a failure is [`rejected`], naming the setter's argument by `args`).
+///
+/// # Safety
+/// `settings`: NULL or a valid handle with exclusive access.
+pub(crate) unsafe fn validated<H, S: Clone>(
+    settings: *mut H,
+    slot: impl FnOnce(&mut H) -> &mut S,
+    validate: fn(&S) -> crate::Result<()>,
+    args: &[(&str, &str)],
+    f: impl FnOnce(&mut S),
+) -> CResult {
     // SAFETY: caller's contract (valid handle, exclusive access).
-    let s = unsafe { handle_mut("settings", settings)? };
-    let mut form = s.form.clone();
-    f(&mut form);
-    form.validate().map_err(|e| rejected(e, args))?;
-    s.form = form;
+    let stored = slot(unsafe { handle_mut("settings", settings)? });
+    let mut copy = stored.clone();
+    f(&mut copy);
+    validate(&copy).map_err(|e| rejected(e, args))?;
+    *stored = copy;
     Ok(())
 }
 
@@ -172,7 +197,7 @@ unsafe fn update(
 /// settings' field names to the setter's argument names, which the message names; a field
 /// outside it, or a relation between two settings (q_max below q_min), keeps the setting's
 /// own name.
-pub(crate) fn rejected(e: crate::Error, args: &[(&str, &str)]) -> Failure {
+fn rejected(e: crate::Error, args: &[(&str, &str)]) -> Failure {
     let relation = crate::validate::is_relation(&e);
     let status = if crate::validate::is_not_finite(&e) {
         VsrStatus::NonFinite
