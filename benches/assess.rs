@@ -13,7 +13,9 @@
 //! strip with free sides) over the family of shells R ± t/2 read vertically
 //! (`min_thickness_of_family`), against Heyman's t/R ≈ 0.042 and Milankovitch's 0.1075.
 
-use std::path::PathBuf;
+#[path = "../tests/common/models.rs"]
+mod models;
+
 use voussoir::{
     assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
     Thickness,
@@ -67,11 +69,9 @@ fn hemispheres() {
 }
 
 fn models() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if !dir.is_dir() {
-        println!("\nshared models: {} not found", dir.display());
+    let Some(dir) = models::models_dir() else {
         return;
-    }
+    };
     header("Shared models, uniform thickness 2 % of the plan diagonal");
     for name in [
         "free_vault",
@@ -82,12 +82,7 @@ fn models() {
         "hex",
         "lilium",
     ] {
-        let mesh = voussoir::io::load_model(
-            &dir.join(format!("{name}.obj")),
-            &dir.join(format!("{name}.json")),
-        )
-        .unwrap()
-        .mesh;
+        let mesh = models::read_shared(&dir, name).unwrap().mesh;
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in mesh.positions() {
             for d in 0..2 {

@@ -11,7 +11,9 @@
 //! the nearest self-supporting shape is at least as near the input as the truth is. The table
 //! gives the area-weighted RMS and the largest height change of the result over the truth's.
 
-use std::path::PathBuf;
+#[path = "../tests/common/models.rs"]
+mod models;
+
 use std::time::Instant;
 use voussoir::generate::{self, KnownPlan, Perturbation};
 use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem, QpSolver};
@@ -158,19 +160,12 @@ fn solver_counts(r: &FormFindResult) -> String {
 /// The models of the form-finding table: the shared ones (when found), the generated
 /// Cas-size stand-in and, with `--large`, the 97k-vertex dome.
 fn model_list(large: bool) -> Vec<(String, Problem)> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
     let mut list = Vec::new();
-    if dir.is_dir() {
-        for name in SHARED {
-            let problem = voussoir::io::load_model(
-                &dir.join(format!("{name}.obj")),
-                &dir.join(format!("{name}.json")),
-            )
-            .expect("model");
+    if let Some(dir) = models::models_dir() {
+        for name in models::MODELS {
+            let problem = models::read_shared(&dir, name).expect("model");
             list.push((name.to_string(), problem));
         }
-    } else {
-        println!("\nshared models: {} not found", dir.display());
     }
     let mut generated = vec![5951];
     if large {
@@ -183,18 +178,6 @@ fn model_list(large: bool) -> Vec<(String, Problem)> {
     }
     list
 }
-
-const SHARED: [&str; 9] = [
-    "free_vault",
-    "dome_with_doors",
-    "lilium",
-    "cheese",
-    "four_holes",
-    "neumunster",
-    "hex",
-    "three_pillar",
-    "vault_pq",
-];
 
 fn models(large: bool) {
     println!("\nForm finding, default settings (distances over the plan diagonal; \"/ cold\": the form finding's time over one cold stress step of the input)\n");

@@ -12,7 +12,10 @@
 //! that did not end `Solved` shows its status and gets no ratio.
 //! Rows without a shared model use generated stand-ins of the paper's size and kind.
 
-use std::path::{Path, PathBuf};
+#[path = "../tests/common/models.rs"]
+mod models;
+
+use std::path::Path;
 use std::time::Instant;
 use voussoir::generate::{self, Domain};
 use voussoir::{
@@ -95,14 +98,6 @@ fn variable_load_dome(n: usize) -> Problem {
         }
     }
     problem
-}
-
-fn shared_model(dir: &Path, name: &str) -> Option<Problem> {
-    voussoir::io::load_model(
-        &dir.join(format!("{name}.obj")),
-        &dir.join(format!("{name}.json")),
-    )
-    .ok()
 }
 
 /// Runs of a stress step timed for its median when one run takes less than a second: at least
@@ -251,7 +246,7 @@ const PAPER: [PaperRow; 11] = [
 /// Our model for a paper row: the shared model where there is one, else a generated stand-in
 /// ("gen."), else none (no model of that kind).
 fn model_for(row: &PaperRow, dir: Option<&Path>) -> Option<(String, Problem)> {
-    let shared = |name: &str| dir.and_then(|d| shared_model(d, name));
+    let shared = |name: &str| dir.and_then(|d| models::read_shared(d, name).ok());
     let generated = |p: Problem| Some(("gen.".to_string(), p));
     match row.name {
         "Cheese-model" => shared("cheese").map(|p| ("cheese".to_string(), p)),
@@ -338,7 +333,7 @@ fn shared_models_table(dir: &Path) {
     println!("| model | V;E;F | holes | reduced | edge-based | edge/reduced |");
     println!("|---|---|---|---|---|---|");
     for name in names {
-        let Some(problem) = shared_model(dir, &name) else {
+        let Some(problem) = models::read_shared(dir, &name).ok() else {
             println!("| {name} | could not be read | | | | |");
             continue;
         };
@@ -440,11 +435,7 @@ fn scaling(large: bool, large_ff: bool) {
 fn main() {
     let large = std::env::args().any(|a| a == "--large");
     let large_ff = large && std::env::args().any(|a| a == "--large-ff");
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    let dir = dir.is_dir().then_some(dir);
-    if dir.is_none() {
-        println!("shared models skipped: ../shared/data/models not found (generated rows only)");
-    }
+    let dir = models::models_dir();
     paper_table(dir.as_deref());
     if let Some(dir) = dir.as_deref() {
         shared_models_table(dir);

@@ -3,6 +3,7 @@
 //! hostile paths and files (status, a message naming the argument, untouched outputs).
 
 mod capi_support;
+mod common;
 
 use std::ffi::{c_char, CString};
 use std::fs;
@@ -145,29 +146,10 @@ fn every_format_reads_form_finds_and_writes_back_every_bit() {
 /// polygons, so it form-finds with the default settings.
 #[test]
 fn a_quad_dome_read_from_a_file_form_finds_with_defaults() {
-    let (rings, sectors) = (4, 16);
-    let mut obj = String::from("v 0 0 0.6\n");
-    for r in 1..=rings {
-        for s in 0..sectors {
-            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
-            let rr = r as f64 / rings as f64;
-            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
-        }
-    }
-    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
-    for s in 0..sectors {
-        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
-    }
-    for r in 1..rings {
-        for s in 0..sectors {
-            let q = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
-            obj += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
-        }
-    }
+    let (obj, rim) = common::quad_dome_obj(4, 16);
     let dir = TempDir::new("quads");
     let file = dir.path("dome.obj");
     fs::write(&file, obj).unwrap();
-    let rim: Vec<u32> = (0..sectors).map(|s| id(rings, s) as u32 - 1).collect();
     let (s, mesh, _) = read(&file, None, &rim, 1e-9);
     assert_ok(s);
     let result = form_find(mesh);

@@ -727,24 +727,7 @@ fn a_stall_without_vertices_prints_no_empty_details() {
 #[test]
 fn a_latitude_longitude_quad_dome_form_finds_with_defaults() {
     let (rings, sectors) = (5, 24);
-    let mut obj = String::from("v 0 0 0.6\n");
-    for r in 1..=rings {
-        for s in 0..sectors {
-            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
-            let rr = r as f64 / rings as f64;
-            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
-        }
-    }
-    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
-    for s in 0..sectors {
-        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
-    }
-    for r in 1..rings {
-        for s in 0..sectors {
-            let quad = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
-            obj += &format!("f {} {} {} {}\n", quad[0], quad[1], quad[2], quad[3]);
-        }
-    }
+    let (obj, _) = common::quad_dome_obj(rings, sectors);
     let dir = Scratch::new("lat-long");
     fs::write(dir.path("dome.obj"), obj).unwrap();
     let out = run(&dir.0, &["dome.obj", "--anchor-lowest", "1e-9"]);

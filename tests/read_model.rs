@@ -12,23 +12,12 @@ use std::path::Path;
 use std::ptr::{null, null_mut};
 
 use capi_support::{assert_ok, settings, snapshot, Snapshot};
-use formfind_support::{models_dir, read_json, run, Scratch};
+use formfind_support::{models_dir, read_json, run, Scratch, MODELS};
 use serde_json::Value;
 use voussoir::capi::*;
 use voussoir::io::{self, read_model, ReadOptions, Supports, UpAxis};
 use voussoir::{analyse, Problem, StressResult, StressSettings};
 
-const MODELS: [&str; 9] = [
-    "free_vault",
-    "dome_with_doors",
-    "lilium",
-    "cheese",
-    "four_holes",
-    "neumunster",
-    "hex",
-    "three_pillar",
-    "vault_pq",
-];
 /// Every format `read_mesh` reads: its extension, and `-ascii` for the text variant of a
 /// binary one (3MF is written only).
 const FORMATS: [&str; 6] = ["obj", "off", "ply", "ply-ascii", "stl", "stl-ascii"];

@@ -4,7 +4,7 @@
 
 mod models;
 #[allow(unused_imports)] // each test binary uses its own part
-pub use models::{find_models, models_dir, models_required};
+pub use models::{find_models, models_dir, models_required, MODELS};
 use voussoir::generate::{self, Domain};
 use voussoir::Mesh;
 
@@ -27,28 +27,40 @@ impl Rng {
     }
 }
 
-pub const MODELS: [&str; 9] = [
-    "free_vault",
-    "dome_with_doors",
-    "lilium",
-    "cheese",
-    "four_holes",
-    "neumunster",
-    "hex",
-    "three_pillar",
-    "vault_pq",
-];
-
 pub fn load_model(name: &str) -> Option<Mesh> {
     let dir = models_dir()?;
     Some(
-        voussoir::io::load_model(
-            &dir.join(format!("{name}.obj")),
-            &dir.join(format!("{name}.json")),
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
-        .mesh,
+        models::read_shared(&dir, name)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .mesh,
     )
+}
+
+/// A latitude-longitude dome in quads, as a modeller builds one, as OBJ text: a centre
+/// vertex (a fan of triangles around it) and `rings` rings of `sectors` vertices joined by
+/// quads, every ring's quads split along the same diagonal by a fan split. With it the
+/// 0-based ids of the outer ring.
+pub fn quad_dome_obj(rings: usize, sectors: usize) -> (String, Vec<u32>) {
+    let mut obj = String::from("v 0 0 0.6\n");
+    for r in 1..=rings {
+        for s in 0..sectors {
+            let a = std::f64::consts::TAU * s as f64 / sectors as f64;
+            let rr = r as f64 / rings as f64;
+            obj += &format!("v {} {} {}\n", rr * a.cos(), rr * a.sin(), 0.6 * (1.0 - rr));
+        }
+    }
+    let id = |r: usize, s: usize| 2 + (r - 1) * sectors + s % sectors;
+    for s in 0..sectors {
+        obj += &format!("f 1 {} {}\n", id(1, s), id(1, s + 1));
+    }
+    for r in 1..rings {
+        for s in 0..sectors {
+            let quad = [id(r, s), id(r + 1, s), id(r + 1, s + 1), id(r, s + 1)];
+            obj += &format!("f {} {} {} {}\n", quad[0], quad[1], quad[2], quad[3]);
+        }
+    }
+    let rim = (0..sectors).map(|s| id(rings, s) as u32 - 1).collect();
+    (obj, rim)
 }
 
 /// A spherical cap of rim angle `angle` on the structured polar disk, rim anchored.

@@ -1,9 +1,33 @@
 //! Where the shared real models are, and whether their absence fails the tests that need them:
 //! it does in CI (`CI` set, as CI services do) and whenever `VSR_REQUIRE_MODELS=1`, so that a
 //! missing folder cannot make those tests pass without checking anything; elsewhere they say
-//! skipped.
+//! skipped. Included by the benches too (`#[path]`), which print the models' rows when the
+//! folder is there.
+#![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+/// The shared real models: `NAME.obj` with its supports `NAME.json` in [`models_dir`].
+pub const MODELS: [&str; 9] = [
+    "free_vault",
+    "dome_with_doors",
+    "lilium",
+    "cheese",
+    "four_holes",
+    "neumunster",
+    "hex",
+    "three_pillar",
+    "vault_pq",
+];
+
+/// The shared model `name` of `dir` (see [`models_dir`]) with its supports, read as every
+/// layer reads a file (`io::load_model`).
+pub fn read_shared(dir: &Path, name: &str) -> voussoir::Result<voussoir::Problem> {
+    voussoir::io::load_model(
+        &dir.join(format!("{name}.obj")),
+        &dir.join(format!("{name}.json")),
+    )
+}
 
 /// Whether the models must be present, from the values of `CI` and `VSR_REQUIRE_MODELS`.
 pub fn models_required(ci: Option<&str>, require: Option<&str>) -> bool {

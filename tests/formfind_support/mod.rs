@@ -118,9 +118,10 @@ pub fn run(cwd: &Path, args: &[&str]) -> Output {
 pub mod views;
 pub mod xml;
 
-#[path = "../common/models.rs"]
-mod models;
-pub use models::models_dir;
+#[path = "../common/mod.rs"]
+pub mod common;
+#[allow(unused_imports)] // each test binary uses its own part
+pub use common::{models_dir, MODELS};
 
 /// Vertices and triangles (0-based) of an OBJ file: `v x y z` and `f a b c` lines only.
 pub fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
