@@ -54,7 +54,31 @@ def test_form_finding_equals_the_rust_api(name, models, formfind, tmp_path):
         assert getattr(result, key) == report[key], key
 
 
-FORMATS = ("obj", "off", "ply", "stl")
+FORMATS = ("obj", "off", "ply", "ply-ascii", "stl", "stl-ascii")
+
+
+def write_as(mesh, path, fmt):
+    """`mesh` to `path` in `fmt`: `Mesh.write` for the formats it writes (binary PLY and STL),
+    text written here for the ASCII variants (shortest round-trip decimals; single precision
+    for STL, as its binary form)."""
+    if not fmt.endswith("-ascii"):
+        mesh.write(path)
+        return
+    v, f = mesh.vertices, mesh.faces
+    if fmt == "ply-ascii":
+        head = ["ply", "format ascii 1.0", f"element vertex {len(v)}", "property double x",
+                "property double y", "property double z", f"element face {len(f)}",
+                "property list uchar int vertex_indices", "end_header"]
+        rows = [" ".join(repr(float(c)) for c in p) for p in v]
+        rows += ["3 " + " ".join(str(int(i)) for i in t) for t in f]
+        path.write_text("\n".join(head + rows) + "\n")
+        return
+    lines = ["solid vault"]
+    for t in f:
+        lines += ["facet normal 0 0 0", "outer loop"]
+        lines += ["vertex " + " ".join(str(np.float32(c)) for c in v[i]) for i in t]
+        lines += ["endloop", "endfacet"]
+    path.write_text("\n".join(lines + ["endsolid vault"]) + "\n")
 
 
 @pytest.mark.parametrize("name", MODEL_NAMES)
@@ -71,8 +95,8 @@ def test_every_format_reads_as_the_rust_api_reads_it(name, models, formfind, tmp
             (["--anchor-lowest", "0.02"], {"anchor_lowest": 0.02}),
         ]
     for fmt in FORMATS:
-        path = tmp_path / f"{name}.{fmt}"
-        source.write(path)
+        path = tmp_path / f"{name}-{fmt}.{fmt.removesuffix('-ascii')}"
+        write_as(source, path, fmt)
         for flags, keywords in ways:
             rust = subprocess.run(
                 [formfind, path, *flags, "--stress-only", "--out", "out.obj", "--report", "r.json",
