@@ -5,8 +5,9 @@
 
 use crate::errors::{from_error, invalid};
 use crate::mesh::{shape_text, Mesh};
+use crate::results::matrix;
 use crate::settings;
-use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use voussoir::report::AssessmentReport;
@@ -225,7 +226,6 @@ fn fields<'py>(
     env: &Envelope,
     r: &AssessResult,
 ) -> PyResult<Bound<'py, PyDict>> {
-    use crate::results::matrix;
     let d = PyDict::new(py);
     let (vertices, detail) = crate::results::termination(&r.termination);
     let name = r.termination.name();
@@ -338,4 +338,36 @@ pub fn min_thickness_of_family<'py>(
     d.set_item("rounds", found.rounds)?;
     d.set_item("family_converged", found.converged)?;
     Ok(d)
+}
+
+/// Vertices (n, 3) and faces (m, 3) as numpy arrays.
+type SurfaceArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<u32>>);
+
+/// `read_surface(path, up)`: an intrados or extrados file in the Z-up frame
+/// (`voussoir::io::read_surface`): (vertices (n, 3) float64, faces (m, 3) uint32).
+#[pyfunction]
+pub fn read_surface<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+    up: &str,
+) -> PyResult<SurfaceArrays<'py>> {
+    let up = up.parse().map_err(|e| from_error("up", e))?;
+    let (positions, faces) =
+        voussoir::io::read_surface(&path, up).map_err(|e| from_error("path", e))?;
+    Ok((matrix(py, &positions), matrix(py, &faces)))
+}
+
+/// `read_load_pattern(mesh, path)`: a live load pattern file as a load per mesh vertex
+/// (`voussoir::io::read_load_pattern`, file vertex ids mapped by the mesh's welding).
+#[pyfunction]
+pub fn read_load_pattern<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, Mesh>,
+    path: std::path::PathBuf,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let m: &Mesh = mesh.get();
+    let n = m.problem().mesh.n_vertices();
+    let loads = voussoir::io::read_load_pattern(&path, &m.model.welded_ids, n)
+        .map_err(|e| from_error("load_pattern", e))?;
+    Ok(PyArray1::from_vec(py, loads))
 }

@@ -31,6 +31,8 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::form_find, m)?)?;
     m.add_function(wrap_pyfunction!(assess::assess, m)?)?;
     m.add_function(wrap_pyfunction!(assess::min_thickness_of_family, m)?)?;
+    m.add_function(wrap_pyfunction!(assess::read_surface, m)?)?;
+    m.add_function(wrap_pyfunction!(assess::read_load_pattern, m)?)?;
     m.add_function(wrap_pyfunction!(solve::write_mesh, m)?)?;
     Ok(())
 }

@@ -286,6 +286,45 @@ def test_the_command_line_assesses_as_formfind(files, formfind):
     assert not (files / "bad.obj").exists()
 
 
+def test_both_command_lines_read_surfaces_and_load_patterns_alike(files, formfind):
+    """--intrados, --extrados and --load-pattern are read by the library's `io::read_surface`
+    and `io::read_load_pattern` in both command lines: the same answer, the same errors."""
+    v, f, _ = dome(scale=1.05)
+    write_obj(files / "lo.obj", v - [0, 0, 0.05], f)
+    write_obj(files / "hi.obj", v + [0, 0, 0.05], f)
+    (files / "p.json").write_text(json.dumps({"loads": {"0": 1.0, "5": 0.5}}))
+    (files / "far.json").write_text(json.dumps({"loads": {"99": 1.0}}))
+    (files / "nan.json").write_text("[" + ", ".join(["1"] * 36 + ["null"]) + "]")
+    both = [
+        [formfind, "dome.obj", "--out", "rust.obj", "--report", "rust.json"],
+        [sys.executable, "-m", "voussoir", "dome.obj", "--out", "py.obj", "--report", "py.json"],
+    ]
+    args = ["--supports", "dome.json", "--assess", "max-load", "--intrados", "lo.obj",
+            "--extrados", "hi.obj"]
+    runs = [subprocess.run([*cmd, *args, "--load-pattern", "p.json"], cwd=files,
+                           capture_output=True, text=True) for cmd in both]
+    for r in runs:
+        assert r.returncode in (0, 3), r.stderr
+    assert np.array_equal(read_obj_vertices(files / "py.obj"), read_obj_vertices(files / "rust.obj"))
+    a, b = (json.loads((files / f"{n}.json").read_text())["assessment"] for n in ("py", "rust"))
+    for key in ("feasible", "termination", "load_factor", "thrust_horizontal", "bounds"):
+        assert a[key] == b[key], key
+    for bad, expected in [("far.json", "`99` is not a vertex id of MESH (0 to 36"),
+                          ("nan.json", "the load of vertex 36 is null, not a finite number"),
+                          ("none.json", "--load-pattern: none.json: ")]:
+        errors = []
+        for cmd in both:
+            r = subprocess.run([*cmd, *args, "--load-pattern", bad], cwd=files,
+                               capture_output=True, text=True)
+            assert r.returncode == 2 and expected in r.stderr, r.stderr
+            errors.append(r.stderr.strip().split(": ", 1)[1])
+        assert errors[0] == errors[1], errors
+    for cmd in both:
+        r = subprocess.run([*cmd, *args[:4], "--intrados", "none.obj", "--extrados", "hi.obj",
+                            "--load-pattern", "p.json"], cwd=files, capture_output=True, text=True)
+        assert r.returncode == 2 and "--intrados: none.obj: " in r.stderr, r.stderr
+
+
 def vertex_normals_z(v, f):
     """z-component of the unit vertex normals (area-weighted means of the face normals)."""
     cross = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])

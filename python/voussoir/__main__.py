@@ -10,9 +10,9 @@ finished without converging (outputs written), 2 bad input or options, 1 other f
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
+import re
 import stat
 import sys
 import tempfile
@@ -283,43 +283,26 @@ def _thickness(a: argparse.Namespace) -> float:
     return t
 
 
+def _flagged(flag: str, e: voussoir.VoussoirError) -> Failure:
+    """A library error about the file of `flag`, in the command line's words (as formfind's)."""
+    return Failure(f"{flag}: {re.sub(r'^argument `[^`]*`: ', '', str(e))}")
+
+
 def _load_pattern(path: Path, mesh: voussoir.Mesh) -> np.ndarray:
-    """The loads of a JSON file per mesh vertex; loads of file vertices welded into one add."""
-    welded = mesh.welded_ids
+    """The loads of a JSON file per mesh vertex (the library's `io::read_load_pattern`: loads
+    of file vertices welded into one add)."""
     try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError) as e:
-        raise Failure(f"--load-pattern: {path}: {e}") from None
-    loads = data.get("loads") if isinstance(data, dict) else data
-    n = len(welded)
-    if isinstance(loads, list):
-        if len(loads) != n:
-            raise Failure(f"--load-pattern: {path}: has {len(loads)} loads, expected one per vertex "
-                          f"of MESH ({n}, ids before welding)")
-        entries = list(enumerate(loads))
-    elif isinstance(loads, dict):
-        entries = []
-        for key in sorted(loads):
-            if not key.strip().isdigit() or int(key) >= n:
-                raise Failure(f"--load-pattern: {path}: `{key}` is not a vertex id of MESH "
-                              f"(0 to {n - 1}, ids before welding)")
-            entries.append((int(key), loads[key]))
-    else:
-        raise Failure(f'--load-pattern: {path}: expected {{"loads": [..]}}, [..] or '
-                      f'{{"loads": {{"ID": load, ..}}}}')
-    pattern = np.zeros(len(mesh.vertices))
-    for v, x in entries:
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
-            raise Failure(f"--load-pattern: {path}: the load of vertex {v} is {x}, not a finite number")
-        pattern[welded[v]] += x
-    return pattern
-
-
-def _surface(path: Path) -> Tuple[np.ndarray, np.ndarray]:
-    try:
-        vertices, faces, _ = _native.read_welded(os.fspath(path), 0.0)
+        return _native.read_load_pattern(mesh._native, os.fspath(path))
     except voussoir.VoussoirError as e:
-        raise Failure(f"{e}") from None
+        raise _flagged("--load-pattern", e) from None
+
+
+def _surface(flag: str, path: Path, up: str) -> Tuple[np.ndarray, np.ndarray]:
+    """An intrados or extrados file, Z-up (the library's `io::read_surface`)."""
+    try:
+        vertices, faces = _native.read_surface(os.fspath(path), up)
+    except voussoir.VoussoirError as e:
+        raise _flagged(flag, e) from None
     return vertices, faces.astype(np.int64)
 
 
@@ -349,7 +332,7 @@ def run_assess(a: argparse.Namespace) -> int:
         if a.load_pattern is not None:
             settings["load_pattern"] = _load_pattern(a.load_pattern, mesh)
         envelope = ((np.array([thickness]), None, None) if thickness is not None
-                    else (None, _surface(a.intrados), _surface(a.extrados)))
+                    else (None, _surface("--intrados", a.intrados, a.up), _surface("--extrados", a.extrados, a.up)))
         # The natives, asked for the library's report (the formfind example's schema).
         fields = _native.assess(mesh._native, *envelope, settings, None, files)
     except voussoir.VoussoirError as e:

@@ -1,7 +1,8 @@
 //! Mesh files (OBJ, OFF, STL, PLY, chosen by extension through [`read_mesh`] and
 //! [`write_mesh`]; 3MF for closed solids, written only), welding of duplicated vertices
 //! ([`weld`]), a JSON sidecar listing the anchored (support) vertices, and [`read_model`],
-//! which makes a [`crate::Problem`] of a file: the read path of every layer.
+//! which makes a [`crate::Problem`] of a file: the read path of every layer. An assessment's
+//! other files: [`read_surface`] (intrados, extrados) and [`read_load_pattern`].
 //!
 //! ```no_run
 //! use voussoir::io::{read_model, ReadOptions, Supports};
@@ -12,6 +13,7 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 
+mod assessment;
 mod atomic;
 mod format;
 #[cfg(test)]
@@ -35,6 +37,7 @@ use std::path::Path;
 
 use crate::{Problem, Result};
 
+pub use assessment::{read_load_pattern, read_surface};
 pub use atomic::output_target;
 pub use format::{read_mesh, read_mesh_with_diagonals, write_mesh, write_mesh_as, MeshFormat};
 pub use model::{read_model, Model, ReadOptions, Supports, UpAxis, WeldSummary};

@@ -3,7 +3,6 @@
 
 use std::path::Path;
 
-use serde_json::Value;
 use voussoir::{assess, io, AssessResult, AssessSettings, Envelope, Objective};
 
 use crate::args::Options;
@@ -43,13 +42,9 @@ pub fn message(e: &voussoir::Error, fallback: &str) -> String {
     }
 }
 
-type Surface = (Vec<[f64; 3]>, Vec<[u32; 3]>);
-
 /// A mesh file of `--intrados` or `--extrados`, Z-up.
-fn surface(flag: &str, path: &Path, up: UpAxis) -> Result<Surface, String> {
-    let (positions, faces) = io::read_mesh(path).map_err(|e| format!("{flag}: {e}"))?;
-    let positions = positions.into_iter().map(|p| up.to_z_up(p)).collect();
-    Ok((positions, faces))
+fn surface(flag: &str, path: &Path, up: UpAxis) -> Result<io::RawMesh, String> {
+    io::read_surface(path, up).map_err(|e| format!("{flag}: {e}"))
 }
 
 /// The envelope of `--thickness` or `--intrados` / `--extrados` over the model's plan.
@@ -68,58 +63,11 @@ pub fn envelope(model: &Model, o: &Options) -> Result<Envelope, String> {
         .map_err(|e| message(&e, "--intrados"))
 }
 
-/// The loads of a JSON file: `[..]`, `{"loads": [..]}` (one per input vertex) or
-/// `{"loads": {"ID": load, ..}}`, as (input vertex, load) pairs.
-fn pattern_entries(text: &str, n_input: usize) -> Result<Vec<(usize, f64)>, String> {
-    let json: Value = serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-    let loads = match &json {
-        Value::Object(map) => map.get("loads").ok_or(
-            "expected {\"loads\": [..]}, [..] or {\"loads\": {\"ID\": load, ..}}".to_string(),
-        )?,
-        other => other,
-    };
-    let number = |what: String, v: &Value| match v.as_f64() {
-        Some(x) if x.is_finite() => Ok(x),
-        _ => Err(format!("{what} is {v}, not a finite number")),
-    };
-    match loads {
-        Value::Array(list) => {
-            if list.len() != n_input {
-                return Err(format!(
-                    "has {} loads, expected one per vertex of MESH ({n_input}, ids before welding)",
-                    list.len()
-                ));
-            }
-            (list.iter().enumerate())
-                .map(|(v, x)| Ok((v, number(format!("the load of vertex {v}"), x)?)))
-                .collect()
-        }
-        Value::Object(map) => map
-            .iter()
-            .map(|(id, x)| {
-                let v = id.trim().parse::<usize>().ok().filter(|&v| v < n_input);
-                let v = v.ok_or(format!(
-                    "`{id}` is not a vertex id of MESH (0 to {}, ids before welding)",
-                    n_input.saturating_sub(1)
-                ))?;
-                Ok((v, number(format!("the load of vertex {v}"), x)?))
-            })
-            .collect(),
-        _ => Err("expected {\"loads\": [..]}, [..] or {\"loads\": {\"ID\": load, ..}}".into()),
-    }
-}
-
 /// `--load-pattern`: a load per mesh vertex; the loads of input vertices welded into one add.
 pub fn load_pattern(model: &Model, path: &Path) -> Result<Vec<f64>, String> {
-    let fail = |e: String| format!("--load-pattern: {}: {e}", path.display());
-    let text = std::fs::read_to_string(path).map_err(|e| fail(e.to_string()))?;
     let n = model.mesh().n_vertices();
-    let welded = &model.read.welded_ids;
-    let mut loads = vec![0.0; n];
-    for (v, x) in pattern_entries(&text, welded.len()).map_err(fail)? {
-        loads[welded[v] as usize] += x;
-    }
-    Ok(loads)
+    io::read_load_pattern(path, &model.read.welded_ids, n)
+        .map_err(|e| message(&e, "--load-pattern"))
 }
 
 /// The settings of the command line: the assessment's defaults, changed by the options given.
