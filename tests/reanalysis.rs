@@ -163,3 +163,79 @@ fn form_found_holed_vaults_certify_that_they_stand_afresh() {
     let _ = std::fs::remove_dir_all(&dir);
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// The largest mismatch between the force diagram and the force densities over q_max × the
+/// longest plan edge: each interior edge's dual segment must be q_e times the edge turned a
+/// quarter (perpendicular to it, of length |q_e| l_e).
+fn diagram_mismatch(problem: &Problem, s: &StressResult) -> f64 {
+    let mesh = &problem.mesh;
+    let x = mesh.positions();
+    let q_max = s.force_densities.iter().fold(0.0f64, |m, q| m.max(q.abs()));
+    let mut l_max = 0.0f64;
+    let mut worst = 0.0f64;
+    for (e, edge) in mesh.edges().iter().enumerate() {
+        let [a, b] = edge.v.map(|v| x[v as usize]);
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let l = d[0].hypot(d[1]);
+        l_max = l_max.max(l);
+        let Some([p, r]) = s.force_diagram.segments[e] else {
+            continue;
+        };
+        let seg = [r[0] - p[0], r[1] - p[1]];
+        let along = (seg[0] * d[0] + seg[1] * d[1]) / l;
+        let length = seg[0].hypot(seg[1]);
+        let q = s.force_densities[e];
+        worst = worst.max(along.abs()).max((length - q.abs() * l).abs());
+    }
+    worst / (q_max * l_max)
+}
+
+/// After the certificate polish the Airy values and the force diagram are those of the
+/// polished force densities: on re-analysed holed shapes (a generated vault with free and with
+/// anchored hole rims, and the shared holed models) every dual segment reproduces q, to 1e-9
+/// of q_max l_max; on the shared models to `AIRY_FLOOR`, because there the diagram's face
+/// points are gradients of Airy values far larger than the forces (four_holes: a plan sliver
+/// with a 0.0037° corner; measured 5.1e-8).
+const AIRY_FLOOR: f64 = 1e-7;
+
+#[test]
+fn polished_forces_and_their_force_diagram_agree() {
+    let dir = scratch("reanalysis-diagram");
+    let mut cases: Vec<(String, Problem)> = [false, true]
+        .iter()
+        .map(|&anchored| {
+            (
+                format!("holes3-anchored-{anchored}"),
+                holed_vault(2, 3, anchored),
+            )
+        })
+        .collect();
+    if let Some(models) = models_dir() {
+        for name in ["four_holes", "cheese"] {
+            let supports = models.join(format!("{name}.json"));
+            let problem =
+                io::load_model(&models.join(format!("{name}.obj")), &supports).expect(name);
+            cases.push((name.to_string(), problem));
+        }
+    }
+    for (label, problem) in cases {
+        let r = form_find(&problem, &FormFindSettings::default(), None).expect(&label);
+        let path = dir.join(format!("{label}.obj"));
+        io::write_obj(&path, &r.positions, problem.mesh.faces()).expect("written");
+        let (positions, faces) = io::read_obj(&path).expect("read back");
+        let anchored: Vec<u32> = (0..positions.len() as u32)
+            .filter(|&v| problem.mesh.anchored()[v as usize])
+            .collect();
+        let fresh = Problem::new(Mesh::new(positions, faces, &anchored).expect("mesh"));
+        let s = analyse(&fresh, &StressSettings::default()).expect(&label);
+        let mismatch = diagram_mismatch(&fresh, &s);
+        println!("{label}: diagram mismatch {mismatch:.2e}");
+        let bound = if label.starts_with("holes") {
+            1e-9
+        } else {
+            AIRY_FLOOR
+        };
+        assert!(mismatch < bound, "{label}: diagram mismatch {mismatch:.2e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
