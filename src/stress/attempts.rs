@@ -60,17 +60,10 @@ const HUB_EDGES: usize = 64;
 /// grow with the fan's size) and the bounds of the edges around it dependent when all are
 /// active: on a wheel of 1000 spokes the interior-point iterations stalled short of the
 /// tolerances, while in the edge-based form each bound is a force density of its own.
-///
-/// A form finding whose reduced native QP failed or needed its cold restart (`edges_later`)
-/// solves its later native QPs in the edge-based form as well: near balance the optimum is
-/// tiny, and in reduced coordinates a force density is a difference of Airy values and hole
-/// coefficients far larger than itself (cheese's 39 holes, four_holes' plan sliver), so the
-/// iterations stall at the dual residual's rounding while the edge-based QP, free of that
-/// cancellation, is answered from the last active set.
-fn native_formulation(mesh: &Mesh, settings: &StressSettings, edges_later: bool) -> Formulation {
+fn native_formulation(mesh: &Mesh, settings: &StressSettings) -> Formulation {
     let same_optimum = settings.holes == airy::HoleMode::Affine || mesh.holes().next().is_none();
-    let hub = || (0..mesh.positions.len()).any(|v| mesh.edges_at(v).len() > HUB_EDGES);
-    if settings.formulation == Reduced && same_optimum && (edges_later || hub()) {
+    let hub = (0..mesh.positions.len()).any(|v| mesh.edges_at(v).len() > HUB_EDGES);
+    if settings.formulation == Reduced && same_optimum && hub {
         EdgeBased
     } else {
         settings.formulation
@@ -102,7 +95,7 @@ pub(super) fn run_attempts(
     use QpSolver::{Clarabel, Native};
     let mesh = &problem.mesh;
     let plan = &step.plan;
-    let native = native_formulation(mesh, settings, cache.native_edges);
+    let native = native_formulation(mesh, settings);
     let attempts = attempt_list(settings, prior.is_some_and(|p| p.lifted_first), native);
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
@@ -160,10 +153,6 @@ pub(super) fn run_attempts(
         };
         let status = out.status;
         let n_unknowns = out.y.len();
-        if solver == Native && formulation == Reduced && cache.coarse && prior.is_some() {
-            cache.native_edges |=
-                status != StressStatus::Solved || out.iterations > ipm::WARM_BUDGET;
-        }
         if best
             .as_ref()
             .is_none_or(|b| status.rank() < b.out.status.rank())

@@ -44,9 +44,6 @@ pub struct StressCache {
     /// Physical vertical loads added to those the QP balances (the nearest-shape method's
     /// multiplier shift); the result's residuals are still those of the true loads.
     pub(super) load_offset: Option<Vec<f64>>,
-    /// A form finding's later native QPs are solved in the edge-based form (see
-    /// `attempts::native_formulation`).
-    pub(super) native_edges: bool,
 }
 
 impl StressCache {

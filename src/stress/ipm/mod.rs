@@ -499,7 +499,7 @@ fn iterate(
 }
 
 /// Iterations at most from a warm start (`blend`) before the cold start takes over.
-pub(crate) const WARM_BUDGET: u32 = 30;
+const WARM_BUDGET: u32 = 30;
 
 /// Weight of the last answer in the warm start, against the cold starting point's 1 − ω.
 const WARM_WEIGHT: f64 = 0.99;
