@@ -108,6 +108,7 @@ pub(super) fn products(m: &Csr) -> impl Iterator<Item = (usize, usize, usize, f6
 
 /// `products` of the rows r of `m` with `keep(r)` (the others are not paired at all: a split
 /// row's pairs are as many as its entries squared).
+#[cfg(test)]
 pub(super) fn products_of<'a>(
     m: &'a Csr,
     keep: impl Fn(usize) -> bool + 'a,
@@ -119,6 +120,28 @@ pub(super) fn products_of<'a>(
                 .map(move |(b, vb)| (r, a, b, va, vb))
         })
     })
+}
+
+/// `products_of(m, …)` over the rows of `m` that `pattern` does not split, as plain loops
+/// (the numeric assembly of every QP of a form finding; the iterator chain cost as much as a
+/// factorisation): `f(r, v_a, v_b)` in the same order.
+fn for_each_product(
+    m: &Csr,
+    source: Source,
+    pattern: &Pattern,
+    mut f: impl FnMut(usize, f64, f64),
+) {
+    for r in (0..m.nrows()).filter(|&r| !pattern.dense.is_split(source, r)) {
+        let range = m.start[r]..m.start[r + 1];
+        let (cols, vals) = (&m.col[range.clone()], &m.val[range]);
+        for (&a, &va) in cols.iter().zip(vals) {
+            for (&b, &vb) in cols.iter().zip(vals) {
+                if b <= a {
+                    f(r, va, vb);
+                }
+            }
+        }
+    }
 }
 
 /// Lower-triangle pattern (column pointers, row indices) of the products of every row's
@@ -359,16 +382,16 @@ impl<'p> Normal<'p> {
         cons: &Csr,
     ) -> Normal<'p> {
         let mut p_values = vec![0.0; pattern.row_idx.len()];
-        let kept = products_of(quad, |r| !pattern.dense.is_split(Source::Quad, r));
-        for (&slot, (r, _, _, va, vb)) in pattern.quad_slot.iter().zip(kept) {
+        let mut slots = pattern.quad_slot.iter();
+        for_each_product(quad, Source::Quad, pattern, |r, va, vb| {
+            let slot = *slots.next().expect("one slot per product");
             p_values[slot] += quad_weight[r] * va * vb;
-        }
+        });
         fill_couplings(&pattern.dense, (quad, quad_weight), cons, &mut p_values);
         let mut row_prod = Vec::with_capacity(pattern.row_slot.len());
-        row_prod.extend(
-            products_of(cons, |r| !pattern.dense.is_split(Source::Cons, r))
-                .map(|(.., va, vb)| va * vb),
-        );
+        for_each_product(cons, Source::Cons, pattern, |_, va, vb| {
+            row_prod.push(va * vb)
+        });
         Normal {
             pattern,
             p_values,
