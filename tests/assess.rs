@@ -569,6 +569,8 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
         .collect();
     let anchored: Vec<u32> = numbers("anchored").iter().map(|&a| a as u32).collect();
     let mesh = Mesh::new(positions, faces, &anchored).unwrap();
+    // compas_tno's default constraints have no springing joint (`reac_bounds`): the supports'
+    // heights are bounded by its vertical envelope alone (an infinite reach).
     let envelope = Envelope::from_bounds(
         &mesh,
         numbers("lower"),
@@ -576,6 +578,10 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
         &Thickness::Uniform(1.0),
     )
     .unwrap();
+    let free = vec![f64::INFINITY; mesh.positions().len()];
+    let envelope = (envelope.clone())
+        .with_springing(envelope.lower, free)
+        .unwrap();
     let problem = Problem::new(mesh.clone())
         .with_extra_loads(numbers("loads"))
         .unwrap();
