@@ -24,13 +24,15 @@ pub struct Envelope {
     pub face_thickness: Vec<f64>,
     /// Height of the springing plane per vertex, read at free supports (docs/method.md
     /// §16.1): the reaction's line of action, followed down from the support to this plane,
-    /// must meet it within `reach` of the support's plan point. Default: `lower`, the
-    /// bottom of the masonry on the support's vertical.
+    /// must meet it within `reach` of the support's plan point, and the support lies on or
+    /// above it. Default: `lower`, the bottom of the masonry on the support's vertical
+    /// (from a thickness: the middle surface's height).
     pub springing: Vec<f64>,
     /// Horizontal reach of the springing joint per vertex (half its width), read at free
     /// supports; `f64::INFINITY` leaves the support's height bounded by the envelope alone
     /// (the vertical reading). Default: half the vertex's thickness (the area-weighted mean
-    /// of its faces' `face_thickness`).
+    /// of its faces' `face_thickness`; from a thickness: the slab's horizontal section,
+    /// t / (2 |n_h|)).
     pub reach: Vec<f64>,
 }
 
@@ -39,6 +41,9 @@ impl Envelope {
     /// unit vertex normal n (the area-weighted mean of the faces' normals). Read vertically
     /// through the vertex by the offset's tangent plane, that is `t / (2 n_z)` above and below
     /// the vertex. A per-face thickness gives each vertex the area-weighted mean of its faces'.
+    /// The springing joint of a support (read at free supports, docs/method.md §16.1) is the
+    /// horizontal section of that slab through the mesh's vertex: the plane at the vertex's
+    /// height, reach `t / (2 |n_h|)` (n_h the normal's plan part; infinite where it is 0).
     ///
     /// Errors name the face with a thickness that is not finite and > 0, and the vertex
     /// where the surface is vertical or overhangs (n_z ≤ 1e-6), where a normal thickness has
@@ -49,6 +54,7 @@ impl Envelope {
         let normals = vertex_normals(mesh, &mesh.positions);
         let n = mesh.positions.len();
         let (mut lower, mut upper, mut middle) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut reach = vec![0.0; n];
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
             let nz = normals[v][2];
             if nz.is_nan() || nz <= MIN_NORMAL_Z {
@@ -64,14 +70,22 @@ impl Envelope {
             let half = vertex_thickness[v] / (2.0 * nz);
             let z = mesh.positions[v][2];
             (lower[v], upper[v], middle[v]) = (z - half, z + half, z);
+            // The slab's horizontal section through the vertex: t / (2 |n_h|) to either side.
+            let nh = (1.0 - nz * nz).max(0.0).sqrt();
+            reach[v] = if nh > 0.0 {
+                vertex_thickness[v] / (2.0 * nh)
+            } else {
+                f64::INFINITY
+            };
         }
-        Ok(Envelope::with_default_joints(
-            mesh,
+        Ok(Envelope {
+            springing: middle.clone(),
+            reach,
             middle,
             lower,
             upper,
             face_thickness,
-        ))
+        })
     }
 
     /// Intrados and extrados given as triangle surfaces (any connectivity), sampled on the
@@ -171,8 +185,9 @@ impl Envelope {
         ))
     }
 
-    /// The default springing joints: the plane at `lower` and a reach of half the vertex's
-    /// thickness (the area-weighted mean of its faces' on the middle surface).
+    /// The default springing joints of bounds and surfaces: the plane at `lower` and a
+    /// reach of half the vertex's thickness (the area-weighted mean of its faces' on the
+    /// middle surface).
     fn with_default_joints(
         mesh: &Mesh,
         middle: Vec<f64>,
