@@ -11,7 +11,10 @@
 //! with a uniform normal thickness of 2 % of its plan diagonal, fit and least thickness.
 //! Heyman: the least thickness of a hemispherical dome and of a semicircular barrel (an arch
 //! strip with free sides) over the family of shells R ± t/2 read vertically
-//! (`min_thickness_of_family`), against Heyman's t/R ≈ 0.042 and Milankovitch's 0.1075.
+//! (`min_thickness_of_family`), free supports on the classical springing joint (the plane
+//! z = 0, reach t/2: `Envelope::from_bounds`' defaults), against Heyman's t/R ≈ 0.042 and
+//! Milankovitch's 0.1075 (radial joints) and the continuum values of this convention
+//! (docs/benchmarks.md).
 
 #[path = "../tests/common/models.rs"]
 mod models;

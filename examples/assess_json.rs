@@ -7,7 +7,11 @@
 //! (triangles), `anchored` (vertex ids), `lower` and `upper` (heights per vertex), `loads`
 //! (downward load per vertex: the loads alone, no self-weight is added), `objective` (fit,
 //! min-thickness, min-thrust, max-thrust, max-load), optional `fixed_supports` (false),
-//! `load_pattern` (per vertex, for max-load) and `max_iterations`.
+//! `load_pattern` (per vertex, for max-load) and `max_iterations`, and the free supports'
+//! springing joints (docs/method.md §16.1): optional `reach` (per vertex) and `springing`
+//! (per vertex, default `lower`). Without `reach` the supports have no joint, their heights
+//! bounded by `lower` and `upper` alone: compas_tno's default constraints (`funicular`,
+//! `envelope`, without `reac_bounds`).
 
 use serde_json::{json, Value};
 use voussoir::{assess, AssessSettings, Envelope, Mesh, Objective, Problem, Thickness};
@@ -81,8 +85,17 @@ fn run(doc: &Value) -> Result<Value, String> {
     let mesh = Mesh::new(vertices, faces, &anchored).map_err(|e| format!("{e}"))?;
     let lower = numbers(doc, "lower")?;
     let upper = numbers(doc, "upper")?;
-    let envelope = Envelope::from_bounds(&mesh, lower, upper, &Thickness::Uniform(1.0))
+    let envelope = Envelope::from_bounds(&mesh, lower.clone(), upper, &Thickness::Uniform(1.0))
         .map_err(|e| format!("{e}"))?;
+    let reach = match doc.get("reach") {
+        Some(_) => numbers(doc, "reach")?,
+        None => vec![f64::INFINITY; lower.len()],
+    };
+    let springing = match doc.get("springing") {
+        Some(_) => numbers(doc, "springing")?,
+        None => lower,
+    };
+    let envelope = (envelope.with_springing(springing, reach)).map_err(|e| format!("{e}"))?;
     let problem = Problem::new(mesh)
         .with_extra_loads(numbers(doc, "loads")?)
         .map_err(|e| format!("{e}"))?;

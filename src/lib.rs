@@ -38,7 +38,7 @@ mod validate;
 
 pub use assess::{
     assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, FamilyThickness,
-    Objective,
+    Objective, SpringingJoint,
 };
 pub use error::{Error, Result};
 pub use geometry::dual::ForceDiagram;

@@ -13,7 +13,7 @@ use crate::{FormFindResult, FormFindSettings, QpSolver, StressResult, StressStat
 mod assessment;
 pub use assessment::{
     AssessmentFigures, AssessmentReport, AssessmentSettings, Bounds, EnvelopeHeights, Excess,
-    NeededScale,
+    JointFigures, NeededScale,
 };
 
 /// What a run computed: the stress of the shape as it stands, or form finding.

@@ -103,13 +103,18 @@ fn plan_diagonal(mesh: &Mesh) -> f64 {
 /// On a fan every compressive stress balances the centre, so the extreme thrusts are closed
 /// forms: with load p on the centre and the rise ζ from the supports to the centre,
 /// Σ q (z_c − z_a) = p and thrust = r Σ q = p r / ζ; the least thrust takes the largest rise
-/// the envelope allows, the greatest the smallest.
+/// the envelope allows, the greatest the smallest (free supports read vertically: no
+/// springing joint).
 #[test]
 fn fan_thrusts_are_the_closed_forms() {
     let (n, r, rise, below, above) = (12, 2.0, 1.0, 0.15, 0.1);
     for fixed in [false, true] {
         let mesh = fan(n, r, rise);
         let envelope = shifted_envelope(&mesh, below, above);
+        let vertical = vec![f64::INFINITY; n + 1];
+        let envelope = (envelope.clone())
+            .with_springing(envelope.lower, vertical)
+            .unwrap();
         let (largest, smallest) = if fixed {
             (rise + above, rise - below)
         } else {
@@ -215,8 +220,11 @@ fn unit_weight_scales_forces_not_the_surface() {
     for (a, b) in base.positions.iter().zip(&heavy.positions) {
         assert!((a[2] - b[2]).abs() < 1e-6, "{} vs {}", a[2], b[2]);
     }
+    // The nearest surface fixes the heights, not every force density: where the rim's
+    // supports sit on their springing planes the search leaves the stress the objective
+    // does not see settled to its stopping test (a relative 1e-5 over five steps).
     let ratio = heavy.thrust_horizontal / base.thrust_horizontal;
-    assert!((ratio - 25.0).abs() < 25.0 * 1e-5, "thrust ratio {ratio}");
+    assert!((ratio - 25.0).abs() < 25.0 * 1e-4, "thrust ratio {ratio}");
 }
 
 /// The largest load factor: a certified surface under self-weight plus λ × the pattern.
@@ -569,6 +577,8 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
         .collect();
     let anchored: Vec<u32> = numbers("anchored").iter().map(|&a| a as u32).collect();
     let mesh = Mesh::new(positions, faces, &anchored).unwrap();
+    // compas_tno's default constraints have no springing joint (`reac_bounds`): the supports'
+    // heights are bounded by its vertical envelope alone (an infinite reach).
     let envelope = Envelope::from_bounds(
         &mesh,
         numbers("lower"),
@@ -576,6 +586,10 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
         &Thickness::Uniform(1.0),
     )
     .unwrap();
+    let free = vec![f64::INFINITY; mesh.positions().len()];
+    let envelope = (envelope.clone())
+        .with_springing(envelope.lower, free)
+        .unwrap();
     let problem = Problem::new(mesh.clone())
         .with_extra_loads(numbers("loads"))
         .unwrap();

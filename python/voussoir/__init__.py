@@ -371,8 +371,10 @@ def assess(
             least uniform scale of the thickness that still holds one; `safety_factor` is its
             inverse), "min-thrust" / "max-thrust" (the least / greatest horizontal thrust at
             the supports) or "max-load" (the largest factor on `load_pattern`).
-        fixed_supports: keep the supports at the mesh's heights (by default the thrust meets
-            each support anywhere within the envelope).
+        fixed_supports: keep the supports at the mesh's heights (by default a support's
+            height is free within the envelope and its reaction's line must meet the
+            springing joint: the envelope's bottom on the support's vertical, within half the
+            thickness; docs/method.md §16.1).
         unit_weight: weight per unit volume (>= 0; 0: the mesh's extra loads alone).
         load_pattern: (n,) downward load per vertex that "max-load" multiplies.
         progress: called as ``progress(step, infeasibility)`` after every step (1-based;

@@ -22,6 +22,18 @@ pub struct Envelope {
     pub upper: Vec<f64>,
     /// Thickness per face measured along the middle surface's normal: its weight is the load.
     pub face_thickness: Vec<f64>,
+    /// Height of the springing plane per vertex, read at free supports (docs/method.md
+    /// §16.1): the reaction's line of action, followed down from the support to this plane,
+    /// must meet it within `reach` of the support's plan point, and the support lies on or
+    /// above it. Default: `lower`, the bottom of the masonry on the support's vertical
+    /// (from a thickness: the middle surface's height).
+    pub springing: Vec<f64>,
+    /// Horizontal reach of the springing joint per vertex (half its width), read at free
+    /// supports; `f64::INFINITY` leaves the support's height bounded by the envelope alone
+    /// (the vertical reading). Default: half the vertex's thickness (the area-weighted mean
+    /// of its faces' `face_thickness`; from a thickness: the slab's horizontal section,
+    /// t / (2 |n_h|)).
+    pub reach: Vec<f64>,
 }
 
 impl Envelope {
@@ -29,6 +41,9 @@ impl Envelope {
     /// unit vertex normal n (the area-weighted mean of the faces' normals). Read vertically
     /// through the vertex by the offset's tangent plane, that is `t / (2 n_z)` above and below
     /// the vertex. A per-face thickness gives each vertex the area-weighted mean of its faces'.
+    /// The springing joint of a support (read at free supports, docs/method.md §16.1) is the
+    /// horizontal section of that slab through the mesh's vertex: the plane at the vertex's
+    /// height, reach `t / (2 |n_h|)` (n_h the normal's plan part; infinite where it is 0).
     ///
     /// Errors name the face with a thickness that is not finite and > 0, and the vertex
     /// where the surface is vertical or overhangs (n_z ≤ 1e-6), where a normal thickness has
@@ -39,6 +54,7 @@ impl Envelope {
         let normals = vertex_normals(mesh, &mesh.positions);
         let n = mesh.positions.len();
         let (mut lower, mut upper, mut middle) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let mut reach = vec![0.0; n];
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
             let nz = normals[v][2];
             if nz.is_nan() || nz <= MIN_NORMAL_Z {
@@ -54,8 +70,17 @@ impl Envelope {
             let half = vertex_thickness[v] / (2.0 * nz);
             let z = mesh.positions[v][2];
             (lower[v], upper[v], middle[v]) = (z - half, z + half, z);
+            // The slab's horizontal section through the vertex: t / (2 |n_h|) to either side.
+            let nh = (1.0 - nz * nz).max(0.0).sqrt();
+            reach[v] = if nh > 0.0 {
+                vertex_thickness[v] / (2.0 * nh)
+            } else {
+                f64::INFINITY
+            };
         }
         Ok(Envelope {
+            springing: middle.clone(),
+            reach,
             middle,
             lower,
             upper,
@@ -104,12 +129,13 @@ impl Envelope {
             .iter()
             .map(|f| f.iter().map(|&v| vertex_thickness[v as usize]).sum::<f64>() / 3.0)
             .collect();
-        Ok(Envelope {
+        Ok(Envelope::with_default_joints(
+            mesh,
             middle,
             lower,
             upper,
             face_thickness,
-        })
+        ))
     }
 
     /// Bounds given per vertex (as compas_tno's `zlb`, `zub`), with the thickness whose
@@ -149,12 +175,81 @@ impl Envelope {
         let middle = (lower.iter().zip(&upper))
             .map(|(l, u)| 0.5 * (l + u))
             .collect();
-        Ok(Envelope {
+        let face_thickness = face_values(mesh, thickness)?;
+        Ok(Envelope::with_default_joints(
+            mesh,
             middle,
             lower,
             upper,
-            face_thickness: face_values(mesh, thickness)?,
-        })
+            face_thickness,
+        ))
+    }
+
+    /// The default springing joints of bounds and surfaces: the plane at `lower` and a
+    /// reach of half the vertex's thickness (the area-weighted mean of its faces' on the
+    /// middle surface).
+    fn with_default_joints(
+        mesh: &Mesh,
+        middle: Vec<f64>,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        face_thickness: Vec<f64>,
+    ) -> Envelope {
+        let n = mesh.positions.len();
+        let positions: Vec<[f64; 3]> = (0..n)
+            .map(|v| [mesh.positions[v][0], mesh.positions[v][1], middle[v]])
+            .collect();
+        let reach = (area_mean(mesh, &positions, &face_thickness).iter())
+            .map(|t| 0.5 * t)
+            .collect();
+        Envelope {
+            springing: lower.clone(),
+            middle,
+            lower,
+            upper,
+            face_thickness,
+            reach,
+        }
+    }
+
+    /// This envelope with the springing plane's height and the joint's reach given per
+    /// vertex (read at free supports only; `f64::INFINITY` as reach: no joint, the support's
+    /// height is bounded by the envelope alone).
+    ///
+    /// Errors name the argument with the wrong length and the vertex whose springing is not
+    /// finite or lies above its upper bound, or whose reach is not a number >= 0.
+    pub fn with_springing(mut self, springing: Vec<f64>, reach: Vec<f64>) -> Result<Envelope> {
+        let n = self.lower.len();
+        for (name, values) in [("springing", &springing), ("reach", &reach)] {
+            if values.len() != n {
+                return Err(Error::InvalidArgument {
+                    name,
+                    reason: format!(
+                        "has {} entries, expected one per vertex ({n})",
+                        values.len()
+                    ),
+                });
+            }
+        }
+        if let Some(v) =
+            (0..n).find(|&v| !(springing[v].is_finite() && springing[v] <= self.upper[v]))
+        {
+            return Err(Error::InvalidArgument {
+                name: "springing",
+                reason: format!(
+                    "vertex {v} has {}: it must be finite and at most the upper bound {}",
+                    springing[v], self.upper[v]
+                ),
+            });
+        }
+        if let Some(v) = reach.iter().position(|b| b.is_nan() || *b < 0.0) {
+            return Err(Error::InvalidArgument {
+                name: "reach",
+                reason: format!("vertex {v} has {}, not a number >= 0", reach[v]),
+            });
+        }
+        (self.springing, self.reach) = (springing, reach);
+        Ok(self)
     }
 
     /// Positions of the middle surface over the mesh's plan.

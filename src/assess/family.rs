@@ -37,8 +37,10 @@ const MAX_ROUNDS: usize = 12;
 /// Each round runs the least-thickness analysis ([`Objective::MinThickness`]) on
 /// `E(t_k)`, whose loads are `E(t_k)`'s own, and finds the scale s_k of its half extents
 /// that still holds a surface; the next thickness solves s(t) = 1 (first t_k·s_k, then the
-/// secant through the last two rounds, kept inside the bracket the rounds have found). A
-/// round with s_k ≤ 1 certifies t_k: its surface lies inside `E(t_k)`. The search ends
+/// secant of ln s over ln t through the last two rounds, kept inside the bracket the rounds
+/// have found; a round whose search finds no surface, after one that did, is a thin end of
+/// the bracket). A round with s_k ≤ 1 certifies t_k: its surface lies inside `E(t_k)` (with
+/// `E(t_k)`'s springing joints scaled by s_k too). The search ends
 /// when 1 − `scale_tolerance` ≤ s_k ≤ 1 (or after twelve rounds); for a nested family (bounds that move inward as t
 /// falls) that thickness is a local minimum over the family, because the round's analysis
 /// found no uniformly thinner copy of `E(t_k)` that holds a surface. A round whose least
@@ -76,7 +78,13 @@ pub fn min_thickness_of_family(
         let result = assess(problem, &envelope_at(t)?, &settings, None)?;
         if !result.feasible {
             let end = format!("{:?}", result.termination);
-            return finish(best, rounds).ok_or_else(|| no_surface(t, &end));
+            if best.is_none() {
+                return Err(no_surface(t, &end));
+            }
+            // Too thin for the search to find a surface: a thin end of the bracket.
+            search.add(t, f64::INFINITY);
+            t = search.next(t, 1.0);
+            continue;
         }
         let s = result.thickness_scale;
         if s < STANDS {
@@ -100,7 +108,7 @@ pub fn min_thickness_of_family(
         if converged {
             break;
         }
-        search.add(t, s - target);
+        search.add(t, (s / target).ln());
         t = search.next(t, s / target);
     }
     finish(best, rounds)
@@ -118,8 +126,10 @@ fn no_surface(t: f64, end: &str) -> Error {
     }
 }
 
-/// The thicknesses tried with g = s − target: the largest with g < 0 (too thick) and the
-/// smallest with g > 0 (too thin), and the last two for the secant.
+/// The thicknesses tried with g = ln(s / target): the smallest with g < 0 (too thick) and
+/// the largest with g > 0 (too thin; +∞ where no surface was found), and the last two
+/// finite ones for the secant, taken in ln t: s(t) falls like a power of t, so the secant
+/// of ln s over ln t finds the root in a few rounds where that of s over t crawls.
 #[derive(Default)]
 struct Bracket {
     thick: Option<(f64, f64)>,
@@ -135,18 +145,23 @@ impl Bracket {
         if g > 0.0 && self.thin.is_none_or(|(b, _)| t > b) {
             self.thin = Some((t, g));
         }
-        self.last.push((t, g));
+        if g.is_finite() {
+            self.last.push((t, g));
+        }
     }
 
-    /// The secant root through the last two rounds, or t·s after one; clamped into the
-    /// open bracket (bisection when the secant leaves it).
+    /// The secant root in ln t through the last two rounds, or t·s after one; clamped into
+    /// the open bracket (bisection in ln t when the secant leaves it).
     fn next(&self, t: f64, s: f64) -> f64 {
         let guess = match self.last.as_slice() {
-            [.., (t0, g0), (t1, g1)] if (g1 - g0).abs() > 0.0 => t1 - g1 * (t1 - t0) / (g1 - g0),
+            [.., (t0, g0), (t1, g1)] if (g1 - g0).abs() > 0.0 => {
+                let (x0, x1) = (t0.ln(), t1.ln());
+                (x1 - g1 * (x1 - x0) / (g1 - g0)).exp()
+            }
             _ => t * s,
         };
         match (self.thin, self.thick) {
-            (Some((lo, _)), Some((hi, _))) if !(guess > lo && guess < hi) => 0.5 * (lo + hi),
+            (Some((lo, _)), Some((hi, _))) if !(guess > lo && guess < hi) => (lo * hi).sqrt(),
             _ if !(guess.is_finite() && guess > 0.0) => t * s,
             _ => guess,
         }

@@ -123,6 +123,30 @@ crate::setters::with_setters!(AssessSettings {
     with_max_iterations: max_iterations: usize,
 });
 
+/// Where the reaction of a free support meets its springing plane (docs/method.md §16.1).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct SpringingJoint {
+    /// The support vertex.
+    pub vertex: u32,
+    /// Height of the springing plane at the reported thickness scale σ: m − σ (m − s).
+    pub springing: f64,
+    /// The joint's reach at the reported scale: σ b.
+    pub reach: f64,
+    /// Horizontal reaction H_a (as `AssessResult::reactions`): the force the vault pushes
+    /// the support with is (H_a, −V_a).
+    pub horizontal: [f64; 2],
+    /// Vertical reaction V_a = Σ q_e (z_j − z_a) + p_a, the support's own load included.
+    pub vertical: f64,
+    /// Where the reaction's line through the support point meets the springing plane:
+    /// the support's plan point moved by (z_a − springing) H_a / V_a (the support's own
+    /// point where H_a = 0; infinitely far where V_a ≤ 0 < |H_a|).
+    pub point: [f64; 3],
+    /// Plan distance of `point` from the support: at most `reach` (to the tolerance of
+    /// `AssessResult::worst_joint`) on a certified surface.
+    pub offset: f64,
+}
+
 /// The outcome of [`assess`], in physical units.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
@@ -168,6 +192,13 @@ pub struct AssessResult {
     pub load_factor: f64,
     /// The largest excess of a height over its bound (0 when inside) and its vertex.
     pub worst_bound: (f64, Option<u32>),
+    /// The springing joint of every free support with a finite reach (none with fixed
+    /// supports), recomputed from the returned heights, forces and loads.
+    pub joints: Vec<SpringingJoint>,
+    /// The largest joint excess max(0, (z_a − s_a) |H_a| − b_a V_a) over b_a × the mean
+    /// load (at scale 1; b_a at the reported scale in the product), and its support: below
+    /// `tolerance` for a certified surface.
+    pub worst_joint: (f64, Option<u32>),
     /// The largest residual's vertex (None when there is no non-anchored vertex).
     pub worst_residual_vertex: Option<u32>,
     /// When an analysis other than the least thickness found no certified surface: the

@@ -3,7 +3,7 @@
 //! functions of a state (residuals, objective, reactions); and the certificate of a run.
 
 use super::envelope::Envelope;
-use super::{AssessResult, AssessSettings, Objective};
+use super::{AssessResult, AssessSettings, Objective, SpringingJoint};
 use crate::error::{Error, Result};
 use crate::geometry::loads;
 use crate::problem::Problem;
@@ -55,6 +55,42 @@ pub(super) struct Model<'a> {
     pub total_load: f64,
     /// Edge ids around each vertex.
     pub incident: Vec<Vec<u32>>,
+    /// The springing joints of the free supports with a finite reach.
+    pub joints: Vec<Joint>,
+}
+
+/// A free support's springing joint (frame units): the reaction's line of action, followed
+/// from the support down to the springing plane, meets it within the reach. At the scale σ
+/// of the half extents the plane lies at m − σ (m − s) and the reach is σ b (the uniformly
+/// thinner copy of the envelope about its middle).
+pub(super) struct Joint {
+    pub support: u32,
+    /// (edge, other end) of the edges with force from the support.
+    pub edges: Vec<(usize, u32)>,
+    /// Springing plane s and reach b at scale 1.
+    pub springing: f64,
+    pub reach: f64,
+}
+
+impl Joint {
+    /// The length that turns the joint's moment w |H| − σ b V into a load: b, or the frame's
+    /// unit where the reach is 0.
+    pub fn unit(&self) -> f64 {
+        if self.reach > 0.0 {
+            self.reach
+        } else {
+            1.0
+        }
+    }
+}
+
+/// A joint at a state: w = z_a − s(σ), the horizontal reaction H_a, the vertical one
+/// V_a = Σ q_e (z_j − z_a) + p_a (the support's own load included) and the scale σ.
+pub(super) struct JointState {
+    pub w: f64,
+    pub h: [f64; 2],
+    pub v: f64,
+    pub scale: f64,
 }
 
 impl<'a> Model<'a> {
@@ -121,6 +157,7 @@ impl<'a> Model<'a> {
             middle: envelope.middle.iter().map(|m| m / l0).collect(),
             half: envelope.half_extent().iter().map(|h| h / l0).collect(),
             z_start,
+            joints: joints(problem, &stress, envelope, settings, l0),
             support_edges: support_edges(problem, &stress),
             area: area_shares(problem, &stress, &variable),
             total_load: 0.0,
@@ -222,6 +259,49 @@ impl<'a> Model<'a> {
         sum / self.total_load
     }
 
+    /// Joint k at `state`.
+    pub fn joint_state(&self, state: &State, k: usize) -> JointState {
+        let joint = &self.joints[k];
+        let a = joint.support as usize;
+        let u = &self.stress.plan.u;
+        let scale = self.scale(state);
+        let (mut h, mut v) = ([0.0; 2], self.load(state, a));
+        for &(e, j) in &joint.edges {
+            let j = j as usize;
+            for d in 0..2 {
+                h[d] += state.q[e] * (u[a][d] - u[j][d]);
+            }
+            v += state.q[e] * (state.z[j] - state.z[a]);
+        }
+        let m = self.middle[a];
+        let w = state.z[a] - (m - scale * (m - joint.springing));
+        JointState { w, h, v, scale }
+    }
+
+    /// Per joint g = (w |H| − σ b V) / b, in load units: > 0 where the reaction's line
+    /// meets the springing plane beyond the reach.
+    pub fn joint_excess(&self, state: &State) -> Vec<f64> {
+        (0..self.joints.len())
+            .map(|k| {
+                let j = self.joint_state(state, k);
+                let joint = &self.joints[k];
+                (j.w * j.h[0].hypot(j.h[1]) - j.scale * joint.reach * j.v) / joint.unit()
+            })
+            .collect()
+    }
+
+    /// The largest violation (|residual| or joint excess) and the ℓ1 sum of both.
+    pub fn violation(&self, state: &State) -> (f64, f64) {
+        let c = self.residuals(state);
+        let g = self.joint_excess(state);
+        let max = (c.iter().map(|x| x.abs()))
+            .chain(g.iter().map(|x| x.max(0.0)))
+            .fold(0.0, f64::max);
+        let sum =
+            c.iter().map(|x| x.abs()).sum::<f64>() + g.iter().map(|x| x.max(0.0)).sum::<f64>();
+        (max, sum)
+    }
+
     /// The objective f at `state` (lower is better).
     pub fn objective_value(&self, state: &State) -> f64 {
         match self.objective {
@@ -301,9 +381,15 @@ impl<'a> Model<'a> {
         let thrust_horizontal = (self.supports.iter())
             .map(|&a| reactions[a as usize][0].hypot(reactions[a as usize][1]))
             .sum();
+        let (joints, worst_joint) = self.joints_of(&positions, &force_densities, &loads, s, mean);
         AssessResult {
             objective: self.objective,
-            feasible: eps_inf < settings.tolerance && q_ok && worst_bound.0 <= 1e-9 * diag,
+            feasible: eps_inf < settings.tolerance
+                && q_ok
+                && worst_bound.0 <= 1e-9 * diag
+                && worst_joint.0 < settings.tolerance
+                && (joints.iter())
+                    .all(|j| positions[j.vertex as usize][2] >= j.springing - 1e-9 * diag),
             termination: run.termination,
             iterations: run.iterations,
             positions,
@@ -320,10 +406,67 @@ impl<'a> Model<'a> {
             thrust_horizontal,
             load_factor: lambda,
             worst_bound,
+            joints,
+            worst_joint,
             worst_residual_vertex,
             needed_scale: None,
             seconds: run.seconds,
         }
+    }
+}
+
+impl Model<'_> {
+    /// The joints recomputed from physical outputs at scale `s`, and the largest excess
+    /// over the reach's unit × the mean load `mean`.
+    fn joints_of(
+        &self,
+        positions: &[[f64; 3]],
+        q: &[f64],
+        loads: &[f64],
+        s: f64,
+        mean: f64,
+    ) -> (Vec<SpringingJoint>, (f64, Option<u32>)) {
+        let mut worst = (0.0, None);
+        let joints = (self.joints.iter())
+            .map(|joint| {
+                let a = joint.support as usize;
+                let p = positions[a];
+                let (mut h, mut v) = ([0.0; 2], loads[a]);
+                for &(e, j) in &joint.edges {
+                    let o = positions[j as usize];
+                    h = [h[0] + q[e] * (p[0] - o[0]), h[1] + q[e] * (p[1] - o[1])];
+                    v += q[e] * (o[2] - p[2]);
+                }
+                let m = self.middle[a] * self.l0;
+                let springing = m - s * (m - joint.springing * self.l0);
+                let reach = s * joint.reach * self.l0;
+                let w = p[2] - springing;
+                let hn = h[0].hypot(h[1]);
+                let excess = (w * hn - reach * v).max(0.0) / (joint.unit() * self.l0 * mean);
+                if excess > worst.0 {
+                    worst = (excess, Some(joint.support));
+                }
+                let (point, offset) = if hn == 0.0 {
+                    ([p[0], p[1], springing], 0.0)
+                } else if v > 0.0 {
+                    let k = w / v;
+                    ([p[0] + k * h[0], p[1] + k * h[1], springing], k * hn)
+                } else {
+                    let far = f64::INFINITY;
+                    ([far * h[0].signum(), far * h[1].signum(), springing], far)
+                };
+                SpringingJoint {
+                    vertex: joint.support,
+                    springing,
+                    reach,
+                    horizontal: h,
+                    vertical: v,
+                    point,
+                    offset,
+                }
+            })
+            .collect();
+        (joints, worst)
     }
 }
 
@@ -343,6 +486,8 @@ fn check_lengths(problem: &Problem, envelope: &Envelope) -> Result<()> {
         ("envelope", envelope.upper.len(), n),
         ("envelope", envelope.middle.len(), n),
         ("envelope", envelope.face_thickness.len(), mesh.faces.len()),
+        ("envelope", envelope.springing.len(), n),
+        ("envelope", envelope.reach.len(), n),
     ] {
         if len != want {
             return Err(Error::InvalidArgument {
@@ -411,6 +556,33 @@ fn support_edges(problem: &Problem, stress: &LinearStress) -> Vec<(usize, u32, u
                 (false, true) => Some((e, b, a)),
                 _ => None,
             }
+        })
+        .collect()
+}
+
+/// The free supports' springing joints with a finite reach (none with fixed supports).
+fn joints(
+    problem: &Problem,
+    stress: &LinearStress,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+    l0: f64,
+) -> Vec<Joint> {
+    if settings.fixed_supports {
+        return Vec::new();
+    }
+    let mesh = &problem.mesh;
+    let edges = support_edges(problem, stress);
+    (0..mesh.positions.len())
+        .filter(|&a| mesh.referenced[a] && mesh.anchored[a] && envelope.reach[a].is_finite())
+        .map(|a| Joint {
+            support: a as u32,
+            edges: (edges.iter())
+                .filter(|&&(_, s, _)| s as usize == a)
+                .map(|&(e, _, j)| (e, j))
+                .collect(),
+            springing: envelope.springing[a] / l0,
+            reach: envelope.reach[a] / l0,
         })
         .collect()
 }

@@ -24,6 +24,8 @@ pub(super) struct Layout {
     /// First columns of e⁺ and e⁻ (one per residual vertex).
     e_plus: usize,
     e_minus: usize,
+    /// First column of the joints' slacks (one per springing joint).
+    j_start: usize,
     /// First column of the thrust bounds h_a (least thrust), one per support.
     h_start: usize,
     n: usize,
@@ -52,7 +54,8 @@ impl Layout {
         let n_r = model.residual.len();
         let e_plus = n;
         let e_minus = n + n_r;
-        let h_start = n + 2 * n_r;
+        let j_start = n + 2 * n_r;
+        let h_start = j_start + model.joints.len();
         let n_h = if model.objective == Objective::MinThrust {
             model.supports.len()
         } else {
@@ -70,6 +73,7 @@ impl Layout {
             t_col,
             e_plus,
             e_minus,
+            j_start,
             h_start,
             n: h_start + n_h,
         }
@@ -100,13 +104,15 @@ pub(super) struct Step {
     /// Per vertex (0 where the height is fixed).
     pub dz: Vec<f64>,
     pub dt: f64,
-    /// Σ (e⁺ + e⁻): the linearised ℓ1 infeasibility after the step.
+    /// Σ (e⁺ + e⁻) + Σ e_joint: the linearised ℓ1 infeasibility after the step.
     pub slack: f64,
     /// The objective's model at the step.
     pub model_objective: f64,
     /// Multipliers μ of the residual rows (|μ| ≤ ν); none when the QP stopped short of
     /// optimality.
     pub multipliers: Option<Vec<f64>>,
+    /// The largest multiplier of a joint's cone (0 without joints or multipliers).
+    pub joint_multiplier: f64,
     /// ½ dᵀ B d of the convexified Hessian of the Lagrangian (0 without multipliers).
     pub curvature: f64,
 }
@@ -172,6 +178,8 @@ pub(super) fn solve_step(
     bound_rows(model, layout, state, &mut rows);
     rows.n_nonneg = rows.next() - rows.n_zero;
     thrust_cones(model, layout, state, &mut rows);
+    let first_joint_row = rows.next();
+    joint_cones(model, layout, state, &mut rows);
     rows.n_soc = (rows.next() - rows.n_zero - rows.n_nonneg) / 3;
     let first_residual_row = layout.q_col.iter().flatten().count();
     // The QP in units of ν: the slacks cost 1, so that its tolerances do not depend on
@@ -180,6 +188,11 @@ pub(super) fn solve_step(
     p.v.iter_mut().for_each(|v| *v /= unit);
     let c: Vec<f64> = c.iter().map(|v| v / unit).collect();
     let (x, z) = run_clarabel(layout.n, p, &c, rows)?;
+    let joint_multiplier = z.as_ref().map_or(0.0, |z| {
+        (0..model.joints.len())
+            .map(|k| z[first_joint_row + 3 * k].abs() * unit)
+            .fold(0.0, f64::max)
+    });
     let multipliers = z.map(|z| {
         (z[first_residual_row..first_residual_row + model.residual.len()].iter())
             .map(|m| m * unit)
@@ -187,6 +200,7 @@ pub(super) fn solve_step(
     });
     let mut step = read_step(model, layout, state, &x);
     step.multipliers = multipliers;
+    step.joint_multiplier = joint_multiplier;
     step.curvature = hessian.map_or(0.0, |h| h.curvature(&step));
     Some(step)
 }
@@ -330,6 +344,9 @@ fn objective(
     for k in 0..model.residual.len() {
         c[layout.e_plus + k] = input.nu;
         c[layout.e_minus + k] = input.nu;
+    }
+    for k in 0..model.joints.len() {
+        c[layout.j_start + k] = input.nu;
     }
     match model.objective {
         Objective::MinThrust => {
@@ -483,11 +500,12 @@ fn bound_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
             rows.b.push(b);
         }
     }
-    for k in 0..2 * model.residual.len() {
+    for k in 0..2 * model.residual.len() + model.joints.len() {
         let row = rows.next();
         rows.a.push(row, layout.e_plus + k, -1.0);
         rows.b.push(0.0);
     }
+    springing_rows(model, layout, state, rows);
     if let (true, Some(t)) = (thickness, layout.t_col) {
         let row = rows.next();
         rows.a.push(row, t, -1.0);
@@ -516,6 +534,71 @@ fn thrust_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) 
         let col = layout.q_col[e].expect("support edges carry force");
         for (d, (ua, uj)) in u[a].iter().zip(&u[j]).enumerate() {
             rows.a.push(first_row[a] + 1 + d, col, -(ua - uj));
+        }
+    }
+}
+
+/// z_a + dz_a ≥ m − (σ + dσ)(m − s) at each joint: the support on or above its springing
+/// plane.
+fn springing_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    let thickness = model.objective == Objective::MinThickness;
+    for (k, joint) in model.joints.iter().enumerate() {
+        let a = joint.support as usize;
+        let Some(zc) = layout.z_col[a] else { continue };
+        let w = model.joint_state(state, k).w;
+        let row = rows.next();
+        rows.a.push(row, zc, -1.0);
+        if let (true, Some(t)) = (thickness, layout.t_col) {
+            rows.a.push(row, t, -(model.middle[a] - joint.springing));
+        }
+        rows.b.push(w);
+    }
+}
+
+/// The springing joints, linearised: (w + dw)·(H + dH)/u as the cone's vector and
+/// ((σ + dσ)(V + dV) b + e)/u as its bound, u the joint's unit (the bilinear products to
+/// first order): ‖w H + w dH + dw H‖ ≤ σ b V + σ b dV + b V dσ + u e, e ≥ 0 priced at ν.
+fn joint_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    let u = &model.stress.plan.u;
+    for (k, joint) in model.joints.iter().enumerate() {
+        let a = joint.support as usize;
+        let js = model.joint_state(state, k);
+        let (unit, b) = (joint.unit(), joint.reach);
+        let first = rows.next();
+        // Bound: s0 = σbV/u + σb dV/u + bV dσ/u + e; rows hold −coefficients.
+        rows.b.push(js.scale * b * js.v / unit);
+        rows.b.push(js.w * js.h[0] / unit);
+        rows.b.push(js.w * js.h[1] / unit);
+        rows.a.push(first, layout.j_start + k, -1.0);
+        let vb = js.scale * b / unit;
+        for &(e, j) in &joint.edges {
+            let j = j as usize;
+            let Some(qc) = layout.q_col[e] else { continue };
+            rows.a.push(first, qc, -vb * (state.z[j] - state.z[a]));
+            if let Some(zc) = layout.z_col[j] {
+                rows.a.push(first, zc, -vb * state.q[e]);
+            }
+            for (d, (ua, uj)) in u[a].iter().zip(&u[j]).enumerate() {
+                rows.a.push(first + 1 + d, qc, -js.w * (ua - uj) / unit);
+            }
+        }
+        let dv_dza: f64 = joint.edges.iter().map(|&(e, _)| -state.q[e]).sum();
+        if let Some(zc) = layout.z_col[a] {
+            rows.a.push(first, zc, -vb * dv_dza);
+            for d in 0..2 {
+                rows.a.push(first + 1 + d, zc, -js.h[d] / unit);
+            }
+        }
+        match (model.objective, layout.t_col) {
+            (Objective::MaxLoad, Some(t)) => rows.a.push(first, t, -vb * model.live[a]),
+            (Objective::MinThickness, Some(t)) => {
+                rows.a.push(first, t, -b * js.v / unit);
+                let dw = model.middle[a] - joint.springing;
+                for d in 0..2 {
+                    rows.a.push(first + 1 + d, t, -dw * js.h[d] / unit);
+                }
+            }
+            _ => {}
         }
     }
 }
@@ -579,7 +662,10 @@ fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
     let n_r = model.residual.len();
     let slack = (0..n_r)
         .map(|k| x[layout.e_plus + k].max(0.0) + x[layout.e_minus + k].max(0.0))
-        .sum();
+        .sum::<f64>()
+        + (0..model.joints.len())
+            .map(|k| x[layout.j_start + k].max(0.0))
+            .sum::<f64>();
     let model_objective = match model.objective {
         Objective::Fit => (0..dz.len())
             .filter(|&v| model.variable[v])
@@ -608,6 +694,7 @@ fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
         slack,
         model_objective,
         multipliers: None,
+        joint_multiplier: 0.0,
         curvature: 0.0,
     }
 }

@@ -123,7 +123,7 @@ impl<'m, 'a> Search<'m, 'a> {
         };
         debug_assert_eq!(state.z.len(), n);
         let nu = 10.0 / model.residual.len().max(1) as f64;
-        let residual = max_abs(&model.residuals(&state));
+        let residual = model.violation(&state).0;
         Search {
             model,
             least_infeasible: (residual, state.clone()),
@@ -157,7 +157,7 @@ impl<'m, 'a> Search<'m, 'a> {
         if let Some(step) = solve_step(self.model, layout, &self.state, &input) {
             self.state = self.apply(&step);
             self.mu = step.multipliers.clone();
-            self.residual = max_abs(&self.model.residuals(&self.state));
+            self.residual = self.model.violation(&self.state).0;
             self.record();
         }
     }
@@ -167,7 +167,7 @@ impl<'m, 'a> Search<'m, 'a> {
             t: self.state.t,
             ..state
         };
-        self.residual = max_abs(&self.model.residuals(&self.state));
+        self.residual = self.model.violation(&self.state).0;
         self.least_infeasible = (self.residual, self.state.clone());
         self.record();
     }
@@ -193,10 +193,9 @@ impl<'m, 'a> Search<'m, 'a> {
         self.residual
     }
 
-    /// φ = f + ν ‖c‖₁ at `state`.
+    /// φ = f + ν (‖c‖₁ + Σ max(0, g_a)) at `state` (g the joints' excess).
     fn merit(&self, state: &State) -> f64 {
-        let c = self.model.residuals(state);
-        self.model.objective_value(state) + self.nu * c.iter().map(|x| x.abs()).sum::<f64>()
+        self.model.objective_value(state) + self.nu * self.model.violation(state).1
     }
 
     /// One accepted step, or a larger ρ.
@@ -209,6 +208,7 @@ impl<'m, 'a> Search<'m, 'a> {
         let predicted = phi - (step.model_objective + self.nu * step.slack + step.curvature);
         let trial = self.apply(&step);
         let multipliers = step.multipliers.clone();
+        let joint_multiplier = step.joint_multiplier;
         let accepted = self
             .acceptable(phi, predicted, &trial)
             .then_some(trial)
@@ -226,10 +226,10 @@ impl<'m, 'a> Search<'m, 'a> {
         self.direction = Some((step.dq.clone(), step.dz.clone()));
         self.state = next;
         if let Some(multipliers) = multipliers {
-            self.update_penalty(&multipliers, step.slack);
+            self.update_penalty(&multipliers, joint_multiplier, step.slack);
             self.mu = Some(multipliers);
         }
-        self.residual = max_abs(&self.model.residuals(&self.state));
+        self.residual = self.model.violation(&self.state).0;
         self.record();
         // Steps the model predicts well need less damping.
         let ratio = (phi - self.merit(&self.state)) / predicted;
@@ -257,10 +257,10 @@ impl<'m, 'a> Search<'m, 'a> {
     /// ν at ten times the largest multiplier where the step met its linearised residuals
     /// (so the penalty stays exact without drowning the objective), never below its start;
     /// while polishing, a thousand times that.
-    fn update_penalty(&mut self, multipliers: &[f64], slack: f64) {
+    fn update_penalty(&mut self, multipliers: &[f64], joint: f64, slack: f64) {
         if slack <= 1e-12 * self.model.residual.len() as f64 {
             let factor = if self.polishing { 1e4 } else { 10.0 };
-            let largest = max_abs(multipliers);
+            let largest = max_abs(multipliers).max(joint);
             self.nu = (factor * largest).clamp(self.nu_max / NU_RANGE, self.nu_max);
         }
     }
@@ -298,12 +298,7 @@ impl<'m, 'a> Search<'m, 'a> {
         for _ in 0..2 {
             let input = self.input(None);
             let step = solve_step(self.model, layout, &self.state, &input)?;
-            let l1: f64 = self
-                .model
-                .residuals(&self.state)
-                .iter()
-                .map(|c| c.abs())
-                .sum();
+            let l1 = self.model.violation(&self.state).1;
             let unmet = self.residual > self.feasible_below && step.slack > 0.1 * l1;
             if unmet && self.nu < self.nu_max {
                 self.nu *= 10.0;
@@ -352,7 +347,7 @@ impl<'m, 'a> Search<'m, 'a> {
             t,
             ..State::default()
         });
-        let z = (0..s.z.len())
+        let mut z: Vec<f64> = (0..s.z.len())
             .map(|v| {
                 let z = s.z[v] + step.dz[v];
                 if model.variable[v] {
@@ -363,6 +358,12 @@ impl<'m, 'a> Search<'m, 'a> {
                 }
             })
             .collect();
+        // On or above the springing plane (the QP meets it to its tolerance).
+        for joint in &model.joints {
+            let a = joint.support as usize;
+            let m = model.middle[a];
+            z[a] = z[a].max(m - scale * (m - joint.springing));
+        }
         State { y, q, z, t }
     }
 

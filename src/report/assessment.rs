@@ -55,6 +55,23 @@ pub struct EnvelopeHeights {
     pub face_thickness: Vec<f64>,
 }
 
+/// Where a free support's reaction meets its springing plane ([`crate::SpringingJoint`]).
+#[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
+pub struct JointFigures {
+    /// The support vertex.
+    pub vertex: u32,
+    /// Height of the springing plane at the reported scale.
+    pub springing: f64,
+    /// The joint's reach at the reported scale.
+    pub reach: f64,
+    /// Where the reaction's line through the support meets the springing plane (null
+    /// coordinates where the vertical reaction is not downward).
+    pub point: [f64; 3],
+    /// Plan distance of `point` from the support (null where infinite).
+    pub offset: f64,
+}
+
 /// What an assessment found, at which thickness, and its certificate.
 #[derive(Debug, Clone, Serialize)]
 #[non_exhaustive]
@@ -90,6 +107,11 @@ pub struct AssessmentFigures {
     pub worst_bound: Excess,
     /// The largest residual's vertex.
     pub worst_residual_vertex: Option<u32>,
+    /// Per free support, where its reaction meets the springing plane (empty with fixed
+    /// supports).
+    pub joints: Vec<JointFigures>,
+    /// The largest joint excess over the reach × the mean load, and its support.
+    pub worst_joint: Excess,
     /// Without a certified surface (but for `min-thickness`): the least thickness scale that
     /// holds one and the vertex where it leaves the envelope most; else null.
     pub needed_scale: Option<NeededScale>,
@@ -242,6 +264,16 @@ fn figures(
         horizontal_imbalance: r.horizontal_imbalance,
         worst_bound: excess(r.worst_bound),
         worst_residual_vertex: r.worst_residual_vertex,
+        joints: (r.joints.iter())
+            .map(|j| JointFigures {
+                vertex: j.vertex,
+                springing: j.springing,
+                reach: j.reach,
+                point: j.point,
+                offset: j.offset,
+            })
+            .collect(),
+        worst_joint: excess(r.worst_joint),
         needed_scale: (r.needed_scale).map(|(scale, vertex)| NeededScale { scale, vertex }),
         bounds: Bounds {
             lower: r.lower.clone(),
