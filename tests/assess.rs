@@ -176,7 +176,7 @@ fn a_self_supporting_middle_surface_is_its_own_nearest_thrust_surface() {
 /// thickness fits inside the given one, and the passive thrust is below the active one.
 #[test]
 fn hemisphere_analyses_are_certified_and_ordered() {
-    let (p, t) = generate::polar_disk(8);
+    let (p, t) = generate::polar_disk(4);
     let mesh = generate::lift(
         &p,
         &t,
