@@ -299,18 +299,15 @@ fn bound(flag: &str, text: &str) -> Result<QBound, String> {
     })
 }
 
-/// `TOL` (relative) or `TOLabs` (absolute), at least 0.
+/// `TOL` (relative) or `TOLabs` (absolute); its range is `ReadOptions::validate`'s.
 fn tolerance(flag: &str, text: &str) -> Result<(f64, bool), String> {
     let (value, absolute) = match text.strip_suffix("abs") {
         Some(v) => (v, true),
         None => (text, false),
     };
-    match number(flag, value) {
-        Ok(v) if v >= 0.0 => Ok((v, absolute)),
-        _ => Err(format!(
-            "{flag}: expected a number >= 0 or NUMBERabs, got `{text}`"
-        )),
-    }
+    let v = number(flag, value)
+        .map_err(|_| format!("{flag}: expected a number or NUMBERabs, got `{text}`"))?;
+    Ok((v, absolute))
 }
 
 /// An enumerated option by its library name (`FromStr` of the library's enums).

@@ -242,6 +242,24 @@ def test_command_line_refuses_a_repeated_option(tmp_path):
         assert sorted(p.name for p in tmp_path.iterdir()) == ["sq.obj"]
 
 
+def test_both_command_lines_leave_read_ranges_to_the_library(tmp_path, formfind):
+    # The range of --anchor-lowest and --weld is `ReadOptions::validate`'s alone: both command
+    # lines give its reason under the option's name.
+    square().write(tmp_path / "sq.obj")
+    for args, message in [
+        (["--anchor-lowest", "-1"], "--anchor-lowest: -1 is not a finite number >= 0"),
+        (["--anchor-lowest", "-0.5abs"], "--anchor-lowest: -0.5 is not a finite number >= 0"),
+        (["--anchor-boundary", "--weld", "-1"], "--weld: -1 is not a finite number >= 0"),
+        (["--anchor-lowest", "x"], "--anchor-lowest: expected a number or NUMBERabs, got `x`"),
+    ]:
+        python = run_cli("sq.obj", *args, cwd=tmp_path)
+        rust = subprocess.run([formfind, "sq.obj", *args], cwd=tmp_path, capture_output=True,
+                              text=True)
+        for done, program in ((python, "voussoir"), (rust, "formfind")):
+            assert done.returncode == 2, done.stderr
+            assert done.stderr.strip().splitlines()[-1] == f"{program}: error: {message}"
+
+
 def test_command_line_anchors_the_boundary_of_the_welded_mesh(tmp_path):
     # An STL file repeats every vertex per triangle: the boundary is the welded mesh's.
     square().write(tmp_path / "square.stl")

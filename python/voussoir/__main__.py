@@ -177,20 +177,28 @@ def read_model(a: argparse.Namespace, density: float) -> voussoir.Mesh:
     lowest: Optional[Tuple[float, str]] = None
     if a.anchor_lowest is not None:
         lowest = _bound("--anchor-lowest", a.anchor_lowest)
-        if lowest[0] < 0:
-            raise Failure(f"--anchor-lowest: expected a number >= 0 or NUMBERabs, got `{a.anchor_lowest}`")
-    return voussoir.Mesh.from_file(
-        a.mesh,
-        a.supports,
-        anchor_boundary=a.anchor_boundary,
-        anchor_lowest=None if lowest is None else lowest[0],
-        anchor_lowest_absolute=lowest is not None and lowest[1] == "absolute",
-        weld=not a.no_weld,
-        weld_tolerance=a.weld,
-        repair_tolerance=0.0 if a.strict else None,
-        up=a.up,
-        face_density=density,
-    )
+    try:
+        return voussoir.Mesh.from_file(
+            a.mesh,
+            a.supports,
+            anchor_boundary=a.anchor_boundary,
+            anchor_lowest=None if lowest is None else lowest[0],
+            anchor_lowest_absolute=lowest is not None and lowest[1] == "absolute",
+            weld=not a.no_weld,
+            weld_tolerance=a.weld,
+            repair_tolerance=0.0 if a.strict else None,
+            up=a.up,
+            face_density=density,
+        )
+    except voussoir.VoussoirError as e:
+        # The ranges are the library's (`ReadOptions::validate`), named by their option.
+        named = re.match(r"argument `([^`]*)`: ", str(e))
+        if named and named.group(1) in READ_FLAGS:
+            raise _flagged(READ_FLAGS[named.group(1)], e) from None
+        raise
+
+
+READ_FLAGS = {"anchor_lowest": "--anchor-lowest", "weld_tolerance": "--weld"}
 
 
 def _file_kind(mode: int) -> str:
