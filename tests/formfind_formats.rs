@@ -205,7 +205,7 @@ fn bad_options_of_formats_and_supports_exit_2() {
         ),
         (
             &["m.off", "--anchor-lowest", "-1"],
-            "expected a number >= 0",
+            "--anchor-lowest: -1 is not a finite number >= 0",
         ),
         (
             &["m.off", "--anchor-lowest", "0.1", "--anchor-boundary"],
