@@ -699,7 +699,10 @@ TEST(CppApi, ConcurrentSolvesOnSharedConstObjectsAgree) {
 
 // The C API's assessment of `mesh` (0.1 thick) with `objective`, for comparison.
 struct CAssessment {
-    std::vector<double> positions, q, loads, residuals, lower, upper, reactions;
+    std::vector<double> positions, q, loads, residuals, lower, upper, reactions, joints;
+    std::vector<uint32_t> joint_vertices;
+    double worst_joint = -1;
+    uint32_t worst_joint_vertex = 0;
     uint32_t feasible = 0;
     VsrTermination termination = VSR_TERMINATION_NUMERICAL_ERROR;
     std::size_t iterations = 0;
@@ -733,6 +736,14 @@ CAssessment c_assess(const voussoir::Mesh &mesh, VsrObjective objective) {
     c.lower = c_doubles(vsr_assessment_lower, a);
     c.upper = c_doubles(vsr_assessment_upper, a);
     c.reactions = c_doubles(vsr_assessment_reactions, a);
+    c.joints = c_doubles(vsr_assessment_joints, a);
+    std::size_t n_joints = 0;
+    EXPECT_EQ(vsr_assessment_joint_vertices(a, nullptr, 0, &n_joints), VSR_STATUS_OK);
+    c.joint_vertices.resize(n_joints);
+    EXPECT_EQ(vsr_assessment_joint_vertices(a, c.joint_vertices.data(), n_joints, &n_joints),
+              VSR_STATUS_OK);
+    EXPECT_EQ(vsr_assessment_worst_joint(a, &c.worst_joint, &c.worst_joint_vertex),
+              VSR_STATUS_OK);
     double seconds = 0;
     EXPECT_EQ(vsr_assessment_outcome(a, &c.feasible, &c.termination, &c.iterations, &seconds),
               VSR_STATUS_OK);
@@ -762,6 +773,17 @@ TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
         EXPECT_TRUE(same_bits(c.lower, a.lower()));
         EXPECT_TRUE(same_bits(c.upper, a.upper()));
         EXPECT_TRUE(same_bits(c.reactions, a.reactions()));
+        EXPECT_TRUE(same_bits(c.joints, a.joints()));
+        EXPECT_EQ(c.joint_vertices, a.joint_vertices());
+        EXPECT_EQ(a.joints().size(), 9 * a.joint_vertices().size());
+        const voussoir::WorstJoint worst = a.worst_joint();
+        EXPECT_TRUE(same_bits(std::vector<double>{c.worst_joint}, std::vector<double>{worst.excess}));
+        EXPECT_EQ(c.worst_joint_vertex, worst.vertex);
+        const std::vector<double> joints = a.joints();
+        for (std::size_t j = 0; j + 9 <= joints.size(); j += 9) {
+            // A certified surface's reaction line meets its springing plane within the reach.
+            EXPECT_LE(joints[j + 8], joints[j + 1] * (1 + 1e-6) + 1e-9) << "joint " << j / 9;
+        }
         EXPECT_EQ(a.edges(), mesh.edges());
         const voussoir::AssessmentOutcome o = a.outcome();
         EXPECT_TRUE(o.feasible);

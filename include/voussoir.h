@@ -1922,6 +1922,40 @@ VsrStatus vsr_assessment_reactions(const struct VsrAssessment *assessment, doubl
 VsrStatus vsr_assessment_edges(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
 
 /**
+ * The support vertex of each springing joint, #J `uint32_t`: the free supports with a finite
+ * reach (none with fixed supports), in the rows of `vsr_assessment_joints`.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_joint_vertices(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
+
+/**
+ * The springing joints recomputed from the returned surface, #J by 9 doubles, row-major
+ * (docs/method.md §16.1): the springing plane's height and the joint's reach at the
+ * reported thickness scale; the horizontal reaction H (x, y) and the vertical reaction V
+ * (the vault pushes the support with (H, −V)); the point (x, y, z) where the reaction's line
+ * meets the springing plane; and that point's plan distance from the support, at most the
+ * reach on a certified surface.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_joints(const struct VsrAssessment *assessment, double *out, size_t len, size_t *needed);
+
+/**
+ * The largest joint excess max(0, (z − s) |H| − b V) over b × the mean load, below the
+ * tolerance on a certified surface, and its support (`VSR_NO_VERTEX` where there is none).
+ * Both pointers required; written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; the out-pointers writable.
+ */
+VsrStatus vsr_assessment_worst_joint(const struct VsrAssessment *assessment, double *excess, uint32_t *vertex);
+
+/**
  * The least thickness t of a family of envelopes whose bounds are functions of t (Heyman's
  * dome between the spheres R ± t/2 read vertically, compas_tno's `zlb`/`zub`): `envelope_at`
  * gives the bounds at t; the self-weight is the middle surface's area × t × the settings'

@@ -729,6 +729,11 @@ struct Certificate {
     double eps_inf = 0, horizontal_imbalance = 0, worst_bound = 0;
     std::uint32_t worst_bound_vertex = VSR_NO_VERTEX, worst_residual_vertex = VSR_NO_VERTEX;
 };
+/// vsr_assessment_worst_joint; vertex is VSR_NO_VERTEX where there is none.
+struct WorstJoint {
+    double excess = 0;
+    std::uint32_t vertex = VSR_NO_VERTEX;
+};
 
 /// The outcome of assess (VsrAssessment): immutable, every getter is const.
 class Assessment {
@@ -749,6 +754,10 @@ class Assessment {
     VOUSSOIR_DETAIL_GETTER(double, lower, vsr_assessment_lower, VsrAssessment)
     VOUSSOIR_DETAIL_GETTER(double, upper, vsr_assessment_upper, VsrAssessment)
     VOUSSOIR_DETAIL_GETTER(double, reactions, vsr_assessment_reactions, VsrAssessment)
+    /// #J by 9 per springing joint (vsr_assessment_joints); its supports: joint_vertices.
+    VOUSSOIR_DETAIL_GETTER(double, joints, vsr_assessment_joints, VsrAssessment)
+    VOUSSOIR_DETAIL_GETTER(std::uint32_t, joint_vertices, vsr_assessment_joint_vertices,
+                           VsrAssessment)
 
     VsrObjective objective() const {
         VsrObjective o = VSR_OBJECTIVE_FIT;
@@ -775,6 +784,11 @@ class Assessment {
                                          &c.worst_bound, &c.worst_bound_vertex,
                                          &c.worst_residual_vertex));
         return c;
+    }
+    WorstJoint worst_joint() const {
+        WorstJoint w;
+        check(vsr_assessment_worst_joint(get(), &w.excess, &w.vertex));
+        return w;
     }
     std::string termination_message() const {
         std::vector<char> text;

@@ -124,6 +124,38 @@ fn assert_same(a: *const VsrAssessment, r: &AssessResult) {
     );
     assert_eq!(wb, r.worst_bound.1.unwrap_or(VSR_NO_VERTEX));
     assert_eq!(wr, r.worst_residual_vertex.unwrap_or(VSR_NO_VERTEX));
+    assert_same_joints(a, r);
+}
+
+/// The springing joints of the C assessment equal the Rust result's, bit for bit.
+fn assert_same_joints(a: *const VsrAssessment, r: &AssessResult) {
+    let rows: Vec<f64> = (r.joints.iter())
+        .flat_map(|j| {
+            let (h, p) = (j.horizontal, j.point);
+            [
+                j.springing,
+                j.reach,
+                h[0],
+                h[1],
+                j.vertical,
+                p[0],
+                p[1],
+                p[2],
+                j.offset,
+            ]
+        })
+        .collect();
+    assert_eq!(bits(&doubles(a, vsr_assessment_joints)), bits(&rows));
+    let mut n = usize::MAX;
+    assert_ok(unsafe { vsr_assessment_joint_vertices(a, null_mut(), 0, &mut n) });
+    let mut vertices = vec![u32::MAX; n];
+    assert_ok(unsafe { vsr_assessment_joint_vertices(a, vertices.as_mut_ptr(), n, &mut n) });
+    let want: Vec<u32> = r.joints.iter().map(|j| j.vertex).collect();
+    assert_eq!(vertices, want);
+    let (mut excess, mut vertex) = (f64::NAN, 7);
+    assert_ok(unsafe { vsr_assessment_worst_joint(a, &mut excess, &mut vertex) });
+    assert_eq!(excess.to_bits(), r.worst_joint.0.to_bits());
+    assert_eq!(vertex, r.worst_joint.1.unwrap_or(VSR_NO_VERTEX));
 }
 
 /// The C name of a Rust termination, for comparison.
@@ -247,6 +279,11 @@ fn thickness_envelopes_assess_as_the_rust_api_does() {
         let settings = AssessSettings::default().with_objective(objective);
         let r = assess(&Problem::new(rust.clone()), &env, &settings, None).unwrap();
         assert!(r.feasible, "{objective:?}");
+        assert_eq!(
+            r.joints.len(),
+            d.anchored.len(),
+            "a joint at every free support"
+        );
         assert_same(a, &r);
         check_certificate(a, &d.anchored);
         let mut o = VsrObjective::MaxLoad;
@@ -694,6 +731,11 @@ fn assessment_getters_check_pointers_and_buffers() {
             vsr_assessment_objective(a, null_mut()),
             S::NullPointer,
             "out",
+        );
+        assert_failed(
+            vsr_assessment_worst_joint(a, x0, null_mut()),
+            S::NullPointer,
+            "vertex",
         );
     }
     assert_eq!(

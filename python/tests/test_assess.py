@@ -79,6 +79,29 @@ def check_certificate(r: voussoir.AssessmentResult, anchored):
     assert np.abs(horizontal[free]).max() < 1e-9 * mean
     z = r.positions[:, 2]
     assert (z >= r.lower - 1e-9).all() and (z <= r.upper + 1e-9).all()
+    check_joints(r, q, i, j, mean)
+
+
+def check_joints(r: voussoir.AssessmentResult, q, i, j, mean):
+    """Each joint's reaction line, recomputed from heights, forces and loads, meets its
+    springing plane within the reach."""
+    a = r.joint_vertices.astype(int)
+    assert r.joints.shape == (len(a), 9)
+    springing, reach, h, v_given, offset = (r.joints[:, 0], r.joints[:, 1], r.joints[:, 2:4],
+                                            r.joints[:, 4], r.joints[:, 8])
+    assert np.allclose(h, r.reactions[a], rtol=1e-9, atol=1e-12 * mean)
+    dz = r.positions[j, 2] - r.positions[i, 2]
+    vertical = r.loads.copy()
+    np.add.at(vertical, i, q * dz)
+    np.add.at(vertical, j, -q * dz)
+    v = vertical[a]
+    assert np.allclose(v, v_given, rtol=1e-9, atol=1e-12 * mean)
+    z = r.positions[a, 2]
+    assert (z >= springing - 1e-9).all()
+    recomputed = (z - springing) * np.hypot(h[:, 0], h[:, 1]) / v
+    assert np.allclose(offset, recomputed, rtol=1e-9, atol=1e-12)
+    assert (recomputed <= reach * (1 + 1e-6 * mean / v) + 1e-12).all()
+    assert r.worst_joint < 1e-6
 
 
 @pytest.fixture
@@ -119,6 +142,9 @@ def test_assess_equals_the_rust_api(objective, extra, files, formfind):
                 "thrust_horizontal", "load_factor", "eps_inf", "thickness_min"):
         assert getattr(r, key) == a[key], key
     check_certificate(r, mesh.anchored)
+    assert len(r.joint_vertices) == len(mesh.anchored) > 0
+    assert np.array_equal(r.joint_vertices, [k["vertex"] for k in a["joints"]])
+    assert np.array_equal(r.joints[:, 8], [k["offset"] for k in a["joints"]])
     if objective == "min-thickness":
         assert 0 < r.thickness_scale < 1 and r.thickness_min == r.thickness_scale * 0.1
     if objective == "max-load":

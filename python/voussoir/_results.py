@@ -179,6 +179,18 @@ class AssessmentResult:
     """Its vertex, or None."""
     worst_residual_vertex: Optional[int]
     """The vertex of the largest residual, or None."""
+    joint_vertices: np.ndarray
+    """(J,) uint32: the free supports with a springing joint (none with fixed supports)."""
+    joints: np.ndarray
+    """(J, 9) float64 per joint, recomputed from the returned surface (docs/method.md §16.1):
+    the springing plane's height and the reach at the reported thickness; the horizontal
+    reaction H (x, y) and the vertical reaction V (the vault pushes the support with (H, -V));
+    the point (x, y, z) where the reaction's line meets the springing plane; its plan distance
+    from the support, at most the reach on a certified surface."""
+    worst_joint: float
+    """The largest joint excess max(0, (z - s)|H| - b V) over b x the mean load."""
+    worst_joint_vertex: Optional[int]
+    """Its support, or None."""
     seconds: float
     """Wall time of the search."""
     envelope_lower: np.ndarray

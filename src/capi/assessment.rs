@@ -381,3 +381,95 @@ pub unsafe extern "C" fn vsr_assessment_edges(
         }
     })
 }
+
+/// The support vertex of each springing joint, #J `uint32_t`: the free supports with a finite
+/// reach (none with fixed supports), in the rows of `vsr_assessment_joints`.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_joint_vertices(
+    assessment: *const VsrAssessment,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.joints.iter().map(|j| j.vertex).collect())
+            })
+        }
+    })
+}
+
+/// The springing joints recomputed from the returned surface, #J by 9 doubles, row-major
+/// (docs/method.md §16.1): the springing plane's height and the joint's reach at the
+/// reported thickness scale; the horizontal reaction H (x, y) and the vertical reaction V
+/// (the vault pushes the support with (H, −V)); the point (x, y, z) where the reaction's line
+/// meets the springing plane; and that point's plan distance from the support, at most the
+/// reach on a certified surface.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_joints(
+    assessment: *const VsrAssessment,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok((a.result.joints.iter())
+                    .flat_map(|j| {
+                        let [hx, hy] = j.horizontal;
+                        let [px, py, pz] = j.point;
+                        [
+                            j.springing,
+                            j.reach,
+                            hx,
+                            hy,
+                            j.vertical,
+                            px,
+                            py,
+                            pz,
+                            j.offset,
+                        ]
+                    })
+                    .collect())
+            })
+        }
+    })
+}
+
+/// The largest joint excess max(0, (z − s) |H| − b V) over b × the mean load, below the
+/// tolerance on a certified surface, and its support (`VSR_NO_VERTEX` where there is none).
+/// Both pointers required; written only on success.
+///
+/// # Safety
+/// `assessment`: a valid handle; the out-pointers writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_worst_joint(
+    assessment: *const VsrAssessment,
+    excess: *mut f64,
+    vertex: *mut u32,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let a = unsafe { handle("assessment", assessment)? };
+        let (e, v) = (out_ptr("excess", excess)?, out_ptr("vertex", vertex)?);
+        let (worst, at) = a.result.worst_joint;
+        // SAFETY: non-NULL and writable (caller's contract).
+        unsafe {
+            e.write(worst);
+            v.write(at.unwrap_or(VSR_NO_VERTEX));
+        }
+        Ok(())
+    })
+}
