@@ -861,16 +861,20 @@ TEST(CppApi, AssessmentInputErrorsThrowTheCStatus) {
               VSR_STATUS_INVALID_ARGUMENT);
     EXPECT_NE(std::string(voussoir::last_error_message()).find("has 4 entries"),
               std::string::npos);
-    // The least thrust lowers free supports to their intrados; fixed ones stay, also in
-    // moved settings.
+    // A free support stands on or above its springing plane, the support's height (method.md
+    // §16.1): the least thrust keeps it there, the greatest raises it within the joint; fixed
+    // ones stay, also in moved settings.
     settings.objective(VSR_OBJECTIVE_MIN_THRUST).q_min(0.0, VSR_BOUND_KIND_ABSOLUTE);
-    const double free_z = voussoir::assess(mesh, envelope, settings).positions()[2];
-    settings.fixed_supports(true);
+    const double least_z = voussoir::assess(mesh, envelope, settings).positions()[2];
+    settings.objective(VSR_OBJECTIVE_MAX_THRUST);
+    const double greatest_z = voussoir::assess(mesh, envelope, settings).positions()[2];
+    settings.objective(VSR_OBJECTIVE_MIN_THRUST).fixed_supports(true);
     const voussoir::AssessSettings moved = std::move(settings);
     const voussoir::Assessment a = voussoir::assess(mesh, envelope, moved);
     EXPECT_TRUE(a.outcome().converged());
     EXPECT_EQ(a.positions()[2], 0.0);
-    EXPECT_LT(free_z, -1e-3);
+    EXPECT_GE(least_z, -1e-9);
+    EXPECT_GT(greatest_z, least_z + 1e-3);
 }
 
 TEST(CppApi, AssessmentProgressCancelsAndExceptionsPropagate) {
