@@ -259,7 +259,8 @@ fn fields<'py>(
     d.set_item("worst_residual_vertex", r.worst_residual_vertex)?;
     let joint_vertices: Vec<u32> = r.joints.iter().map(|j| j.vertex).collect();
     d.set_item("joint_vertices", PyArray1::from_vec(py, joint_vertices))?;
-    d.set_item("joints", matrix(py, &joint_rows(&r.joints)))?;
+    let joints: Vec<[f64; 9]> = r.joints.iter().map(|j| j.row()).collect();
+    d.set_item("joints", matrix(py, &joints))?;
     d.set_item("worst_joint", r.worst_joint.0)?;
     d.set_item("worst_joint_vertex", r.worst_joint.1)?;
     d.set_item("seconds", r.seconds)?;
@@ -375,25 +376,4 @@ pub fn read_load_pattern<'py>(
     let loads = voussoir::io::read_load_pattern(&path, &m.model.welded_ids, n)
         .map_err(|e| from_error("load_pattern", e))?;
     Ok(PyArray1::from_vec(py, loads))
-}
-
-/// The springing joints as rows of the C API's `vsr_assessment_joints`: springing, reach,
-/// H (x, y), V, the point (x, y, z) on the springing plane, its plan offset.
-fn joint_rows(joints: &[voussoir::SpringingJoint]) -> Vec<[f64; 9]> {
-    (joints.iter())
-        .map(|j| {
-            let ([hx, hy], [px, py, pz]) = (j.horizontal, j.point);
-            [
-                j.springing,
-                j.reach,
-                hx,
-                hy,
-                j.vertical,
-                px,
-                py,
-                pz,
-                j.offset,
-            ]
-        })
-        .collect()
 }

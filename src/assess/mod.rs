@@ -147,6 +147,16 @@ pub struct SpringingJoint {
     pub offset: f64,
 }
 
+impl SpringingJoint {
+    /// The joint as one row of numbers, the order of the C API's `vsr_assessment_joints` and
+    /// Python's `joints`: springing, reach, H (x, y), V, point (x, y, z), offset.
+    pub fn row(&self) -> [f64; 9] {
+        let ([hx, hy], [px, py, pz]) = (self.horizontal, self.point);
+        let (s, b, v, o) = (self.springing, self.reach, self.vertical, self.offset);
+        [s, b, hx, hy, v, px, py, pz, o]
+    }
+}
+
 /// The outcome of [`assess`], in physical units.
 #[derive(Debug, Clone)]
 #[non_exhaustive]

@@ -426,23 +426,7 @@ pub unsafe extern "C" fn vsr_assessment_joints(
     boundary!({
         unsafe {
             copy("assessment", assessment, out, len, needed, |a| {
-                Ok((a.result.joints.iter())
-                    .flat_map(|j| {
-                        let [hx, hy] = j.horizontal;
-                        let [px, py, pz] = j.point;
-                        [
-                            j.springing,
-                            j.reach,
-                            hx,
-                            hy,
-                            j.vertical,
-                            px,
-                            py,
-                            pz,
-                            j.offset,
-                        ]
-                    })
-                    .collect())
+                Ok(a.result.joints.iter().flat_map(|j| j.row()).collect())
             })
         }
     })
