@@ -449,7 +449,7 @@ fn envelopes_reject_hostile_input_and_leave_out_untouched() {
     far.1[5] = 10_000;
     let small = shifted(0.05, 0.5);
     let surface_cases: [(&Flat, &Flat, S, &str, &str); 5] = [
-        (&nan, &upper, S::NonFinite, "intrados_positions", "vertex 1"),
+        (&nan, &upper, S::NonFinite, "intrados", "vertex 1"),
         (
             &far,
             &upper,

@@ -485,7 +485,7 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
     fs::write(dir.path("small.obj"), obj_text(&small, &d.triangles)).unwrap();
     fs::write(dir.path("short.json"), "{\"loads\": [1, 2, 3]}").unwrap();
     fs::write(dir.path("far.json"), "{\"loads\": {\"99\": 1}}").unwrap();
-    let cases: [(&[&str], &str); 14] = [
+    let cases: [(&[&str], &str); 16] = [
         (
             &["--thickness", "0"],
             "--thickness: expected a thickness > 0",
@@ -524,8 +524,16 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
         ),
         (&[], "--assess needs the masonry's envelope"),
         (
+            &["--thickness", "0.1", "--unit-weight", "-1"],
+            "--unit-weight: -1 must be >= 0",
+        ),
+        (
             &["--thickness", "0.1", "--unit-weight", "0"],
-            "--unit-weight",
+            "loads: the self-weight and extra loads on the non-anchored vertices average 0e0",
+        ),
+        (
+            &["--thickness", "density", "--unit-weight", "0"],
+            "--unit-weight: 0 must be > 0 with --thickness density",
         ),
         (
             &["--thickness", "0.1", "--method", "paper"],

@@ -277,7 +277,7 @@ pub enum Parsed {
     Help,
 }
 
-fn number(flag: &str, text: &str) -> Result<f64, String> {
+pub fn number(flag: &str, text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         _ => Err(format!("{flag}: expected a number, got `{text}`")),

@@ -13,16 +13,9 @@ use pyo3::types::PyDict;
 use voussoir::report::AssessmentReport;
 use voussoir::{AssessResult, AssessSettings, Envelope, LoadRule, Objective, QBound, Thickness};
 
-/// A flat float64 array of any shape, its entries finite.
-fn floats(name: &str, a: &PyReadonlyArrayDyn<'_, f64>, what: &str) -> PyResult<Vec<f64>> {
-    let values: Vec<f64> = a.as_array().iter().copied().collect();
-    match values.iter().position(|x| !x.is_finite()) {
-        None => Ok(values),
-        Some(k) => Err(invalid(
-            name,
-            format_args!("{what} {k} is {}, not finite", values[k]),
-        )),
-    }
+/// A flat float64 array of any shape (the core checks the values).
+fn floats(a: &PyReadonlyArrayDyn<'_, f64>) -> Vec<f64> {
+    a.as_array().iter().copied().collect()
 }
 
 /// Settings from keyword arguments, on top of the Rust defaults.
@@ -95,7 +88,7 @@ fn surface(name: &str, (v, f): &Surface<'_>) -> PyResult<Rows> {
             ));
         }
     }
-    let flat = floats(name, v, "coordinate")?;
+    let flat = floats(v);
     let n = flat.len() / 3;
     let ids: Vec<i64> = f.as_array().iter().copied().collect();
     if let Some(k) = ids.iter().position(|&i| i < 0 || i as u64 >= n as u64) {
@@ -125,7 +118,7 @@ fn envelope(
 ) -> PyResult<(Envelope, Option<f64>)> {
     match (thickness, intrados, extrados) {
         (Some(t), None, None) => {
-            let values = floats("thickness", &t, "entry")?;
+            let values = floats(&t);
             let uniform = (values.len() == 1).then(|| values[0]);
             let t = match values.len() {
                 1 => Thickness::Uniform(values[0]),
@@ -291,8 +284,8 @@ fn family_member(
                 ),
             )
         })?;
-    let lower = floats("envelope_at", &lower, "lower bound")?;
-    let upper = floats("envelope_at", &upper, "upper bound")?;
+    let lower = floats(&lower);
+    let upper = floats(&upper);
     Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
         .map_err(|e| from_error("envelope_at", e))
 }

@@ -258,6 +258,8 @@ def test_bad_surfaces_name_the_vertex():
         (dict(intrados=(lo, lo_faces + 1000), extrados=(hi, hi_faces)), "intrados",
          "beyond its"),
         (dict(intrados=lo, extrados=(hi, hi_faces)), "intrados", "pair"),
+        (dict(intrados=(np.where(np.arange(len(lo))[:, None] == 3, np.nan, lo), lo_faces),
+              extrados=(hi, hi_faces)), "intrados", "vertex 3 has a coordinate that is not finite"),
     ]
     for kwargs, argument, detail in cases:
         with pytest.raises(voussoir.VoussoirError) as e:
@@ -314,6 +316,25 @@ def test_the_command_line_assesses_as_formfind(files, formfind):
     )
     assert bad.returncode == 2 and "--thickness" in bad.stderr
     assert not (files / "bad.obj").exists()
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--thickness", "0.1", "--unit-weight", "-1"], "-1 must be >= 0"),
+    (["--thickness", "density", "--unit-weight", "0"],
+     "--unit-weight: 0 must be > 0 with --thickness density"),
+])
+def test_both_command_lines_take_the_unit_weight_range_from_the_library(files, formfind, extra,
+                                                                        message):
+    """--unit-weight is checked by the library (>= 0: 0 means no self-weight), and only the
+    density thickness, which divides by it, asks for more."""
+    for command in ([formfind], [sys.executable, "-m", "voussoir"]):
+        run = subprocess.run(
+            [*command, "dome.obj", "--supports", "dome.json", "--assess", "fit", *extra,
+             "--out", "bad.obj"],
+            cwd=files, capture_output=True, text=True,
+        )
+        assert run.returncode == 2 and message in run.stderr, (command, run.stderr)
+        assert not (files / "bad.obj").exists()
 
 
 def test_both_command_lines_read_surfaces_and_load_patterns_alike(files, formfind):

@@ -269,10 +269,12 @@ def _check_assess(a: argparse.Namespace) -> None:
         raise Failure("--assess needs the masonry's envelope: --thickness T, or --intrados A --extrados B")
     if a.thickness is not None and (a.intrados or a.extrados):
         raise Failure("give --thickness or --intrados and --extrados, not both")
-    if a.unit_weight is not None and not (math.isfinite(a.unit_weight) and a.unit_weight > 0):
-        raise Failure(f"--unit-weight: expected a finite number > 0, got `{a.unit_weight}`")
+    # --unit-weight's range is the library's (0: no self-weight); density mode divides by it.
     if a.thickness == "density" and a.unit_weight is None:
         raise Failure("--thickness density needs --unit-weight W (thickness = --density / W)")
+    if a.thickness == "density" and not a.unit_weight > 0:
+        raise Failure(f"--unit-weight: {a.unit_weight:g} must be > 0 with --thickness density "
+                      "(thickness = --density / W)")
     if (a.assess == "max-load") != (a.load_pattern is not None):
         raise Failure("--assess max-load needs --load-pattern L.json (the load to multiply)"
                       if a.assess == "max-load" else

@@ -49,7 +49,7 @@ impl Envelope {
     /// where the surface is vertical or overhangs (n_z ≤ 1e-6), where a normal thickness has
     /// no vertical reading (give intrados and extrados there instead).
     pub fn from_thickness(mesh: &Mesh, thickness: &Thickness) -> Result<Envelope> {
-        let face_thickness = face_values(mesh, thickness)?;
+        let face_thickness = thickness.per_face(mesh.n_faces())?;
         let vertex_thickness = area_mean(mesh, &mesh.positions, &face_thickness);
         let normals = vertex_normals(mesh, &mesh.positions);
         let n = mesh.positions.len();
@@ -175,7 +175,7 @@ impl Envelope {
         let middle = (lower.iter().zip(&upper))
             .map(|(l, u)| 0.5 * (l + u))
             .collect();
-        let face_thickness = face_values(mesh, thickness)?;
+        let face_thickness = thickness.per_face(mesh.n_faces())?;
         Ok(Envelope::with_default_joints(
             mesh,
             middle,
@@ -269,32 +269,6 @@ impl Envelope {
 
 /// Below this normal z-component a thickness along the normal is not read vertically.
 const MIN_NORMAL_Z: f64 = 1e-6;
-
-fn face_values(mesh: &Mesh, thickness: &Thickness) -> Result<Vec<f64>> {
-    let values = match thickness {
-        Thickness::Uniform(t) => vec![*t; mesh.faces.len()],
-        Thickness::PerFace(v) => {
-            if v.len() != mesh.faces.len() {
-                return Err(Error::InvalidArgument {
-                    name: "thickness",
-                    reason: format!(
-                        "has {} entries, expected one per face ({})",
-                        v.len(),
-                        mesh.faces.len()
-                    ),
-                });
-            }
-            v.clone()
-        }
-    };
-    if let Some(f) = values.iter().position(|t| !(t.is_finite() && *t > 0.0)) {
-        return Err(Error::InvalidArgument {
-            name: "thickness",
-            reason: format!("{} at face {f} is not a finite number > 0", values[f]),
-        });
-    }
-    Ok(values)
-}
 
 /// Per-face values to per-vertex ones, weighted by the faces' 3-D areas.
 fn area_mean(mesh: &Mesh, positions: &[[f64; 3]], face: &[f64]) -> Vec<f64> {

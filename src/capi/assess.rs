@@ -25,16 +25,6 @@ pub struct VsrEnvelope {
     pub(crate) envelope: Envelope,
 }
 
-fn finite_values(name: &str, values: &[f64], what: &str) -> CResult {
-    match values.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(k) => Err(Failure::new(
-            VsrStatus::NonFinite,
-            format!("argument `{name}`: {what} {k} is {}, not finite", values[k]),
-        )),
-    }
-}
-
 /// The envelope of a masonry of thickness `thickness` about the mesh as middle surface:
 /// `n_thickness` is 1 (a uniform thickness) or the mesh's face count (one per face, in the
 /// order of its triangles). The masonry extends t/2 to either side along the unit vertex
@@ -77,7 +67,6 @@ pub unsafe extern "C" fn vsr_envelope_from_thickness(
                 ))
             }
         };
-        finite_values("thickness", values, "entry")?;
         let envelope = Envelope::from_thickness(m, &t).map_err(|e| from_error("thickness", e))?;
         // SAFETY: `out` checked above, writable by the caller's contract.
         unsafe { give(out, VsrEnvelope { envelope }) }
@@ -116,15 +105,6 @@ unsafe fn surface(
                  vertices",
                 k / 3,
                 t[k]
-            ),
-        ));
-    }
-    if let Some(k) = p.iter().position(|c| !c.is_finite()) {
-        return Err(Failure::new(
-            VsrStatus::NonFinite,
-            format!(
-                "argument `{p_name}`: vertex {} has a coordinate that is not finite",
-                k / 3
             ),
         ));
     }

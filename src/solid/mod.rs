@@ -35,15 +35,33 @@ impl Thickness {
     /// `density[f] / unit_weight` per face: density is thickness × unit weight (weight per
     /// unit volume). `unit_weight` must be finite and > 0.
     pub fn from_density(density: &[f64], unit_weight: f64) -> Result<Thickness> {
-        if !(unit_weight.is_finite() && unit_weight > 0.0) {
-            return Err(Error::InvalidArgument {
-                name: "unit_weight",
-                reason: format!("{unit_weight} is not a finite number > 0"),
-            });
-        }
+        crate::validate::above("unit_weight", unit_weight, 0.0)?;
         Ok(Thickness::PerFace(
             density.iter().map(|d| d / unit_weight).collect(),
         ))
+    }
+
+    /// The thickness of each of `n_faces` faces: one per face, each finite and > 0 (errors
+    /// name the first face that is not, or the wrong count).
+    pub(crate) fn per_face(&self, n_faces: usize) -> Result<Vec<f64>> {
+        let values = match self {
+            Thickness::Uniform(t) => vec![*t; n_faces],
+            Thickness::PerFace(t) if t.len() != n_faces => {
+                return Err(Error::InvalidArgument {
+                    name: "thickness",
+                    reason: format!("has {} entries, expected one per face ({n_faces})", t.len()),
+                })
+            }
+            Thickness::PerFace(t) => t.clone(),
+        };
+        crate::validate::all_finite("thickness", &values, "face")?;
+        match values.iter().position(|t| *t <= 0.0) {
+            Some(f) => Err(Error::InvalidArgument {
+                name: "thickness",
+                reason: format!("face {f}: {} must be > 0", values[f]),
+            }),
+            None => Ok(values),
+        }
     }
 }
 
@@ -116,7 +134,7 @@ const MIN_OFFSET_AREA: f64 = 1e-2;
 /// along the surface but near in space), naming the two parts that cross.
 pub fn thicken(mesh: &Mesh, positions: &[[f64; 3]], thickness: &Thickness) -> Result<Solid> {
     check_positions(mesh, positions)?;
-    let face_thickness = face_thickness(mesh, thickness)?;
+    let face_thickness = thickness.per_face(mesh.n_faces())?;
     let size = shell_size(mesh, positions);
     check_range(&face_thickness, size, Range::Below)?;
     let thickest = face_thickness.iter().copied().fold(0.0, f64::max);
@@ -268,31 +286,6 @@ fn check_positions(mesh: &Mesh, positions: &[[f64; 3]]) -> Result<()> {
             reason: format!("vertex {v} has a NaN or infinite coordinate"),
         }),
         None => Ok(()),
-    }
-}
-
-/// One finite, positive thickness per face.
-fn face_thickness(mesh: &Mesh, thickness: &Thickness) -> Result<Vec<f64>> {
-    let per_face = match thickness {
-        Thickness::Uniform(t) => vec![*t; mesh.n_faces()],
-        Thickness::PerFace(t) if t.len() != mesh.n_faces() => {
-            return Err(Error::InvalidArgument {
-                name: "thickness",
-                reason: format!(
-                    "has {} entries, expected one per face ({})",
-                    t.len(),
-                    mesh.n_faces()
-                ),
-            })
-        }
-        Thickness::PerFace(t) => t.clone(),
-    };
-    match per_face.iter().position(|t| !(t.is_finite() && *t > 0.0)) {
-        Some(f) => Err(Error::InvalidArgument {
-            name: "thickness",
-            reason: format!("{} at face {f} is not a finite number > 0", per_face[f]),
-        }),
-        None => Ok(per_face),
     }
 }
 

@@ -142,7 +142,8 @@ pub fn flag(
         }
         "--intrados" => a.intrados = Some(value()?.into()),
         "--extrados" => a.extrados = Some(value()?.into()),
-        "--unit-weight" => a.unit_weight = Some(positive(flag, &value()?)?),
+        // The range is the core's (`AssessSettings::validate`); 0 means no self-weight.
+        "--unit-weight" => a.unit_weight = Some(crate::args::number(flag, &value()?)?),
         "--fixed-supports" => a.fixed_supports = true,
         "--load-pattern" => a.load_pattern = Some(value()?.into()),
         "--section" => a.section = Some(section(&value()?)?),
@@ -183,8 +184,19 @@ pub fn check(o: &Options, given: &[String]) -> Result<(), String> {
         (None, None, Some(_)) => return Err("--extrados needs --intrados A".into()),
     }
     let density_thickness = a.thickness == Some(SolidThickness::FromDensity);
-    if density_thickness && a.unit_weight.is_none() {
-        return Err("--thickness density needs --unit-weight W (thickness = --density / W)".into());
+    match a.unit_weight {
+        None if density_thickness => {
+            return Err(
+                "--thickness density needs --unit-weight W (thickness = --density / W)".into(),
+            )
+        }
+        Some(w) if density_thickness && w <= 0.0 => {
+            return Err(format!(
+                "--unit-weight: {w} must be > 0 with --thickness density (thickness = \
+                 --density / W)"
+            ))
+        }
+        _ => {}
     }
     if given.iter().any(|g| g == "--density") && !density_thickness {
         return Err(
