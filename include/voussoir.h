@@ -1563,7 +1563,7 @@ VsrStatus vsr_form_find(const struct VsrMesh *mesh, const struct VsrSettings *se
  * untouched on failure.
  *
  * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a thickness that is NaN or infinite
- * (`VSR_STATUS_NON_FINITE`, naming the entry); `n_thickness` neither 1 nor the face count,
+ * (`VSR_STATUS_NON_FINITE`, naming the face); `n_thickness` neither 1 nor the face count,
  * a thickness <= 0 (naming the face), or a vertex where the mesh is vertical or overhangs
  * (normal z-component <= 1e-6: give intrados and extrados there instead)
  * (`VSR_STATUS_INVALID_ARGUMENT`).

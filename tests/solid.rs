@@ -261,12 +261,9 @@ fn bad_thickness_and_positions_are_refused() {
     let mesh = cap_dome(0.9, 100).unwrap();
     let p = mesh.positions();
     for (t, needle) in [
-        (
-            Thickness::Uniform(0.0),
-            "at face 0 is not a finite number > 0",
-        ),
-        (Thickness::Uniform(-1.0), "at face 0"),
-        (Thickness::Uniform(f64::NAN), "NaN at face 0"),
+        (Thickness::Uniform(0.0), "face 0: 0 must be > 0"),
+        (Thickness::Uniform(-1.0), "face 0: -1 must be > 0"),
+        (Thickness::Uniform(f64::NAN), "face 0: NaN is not finite"),
         (
             Thickness::PerFace(vec![0.1; 3]),
             "has 3 entries, expected one per face",
