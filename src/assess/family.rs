@@ -48,7 +48,7 @@ const MAX_ROUNDS: usize = 12;
 /// thrust surface to that precision (the least thickness is 0), and its analysis is
 /// certified inside `E(t_k)` scaled by s_k. Otherwise returns the least
 /// certified thickness; an error when no round certified one (the message gives the last
-/// round's end) or when `thickness` or `scale_tolerance` is not a finite number > 0.
+/// round's end) or when `thickness` or `scale_tolerance` is not finite and > 0.
 pub fn min_thickness_of_family(
     problem: &Problem,
     mut envelope_at: impl FnMut(f64) -> Result<Envelope>,
@@ -56,17 +56,8 @@ pub fn min_thickness_of_family(
     scale_tolerance: f64,
     settings: &AssessSettings,
 ) -> Result<FamilyThickness> {
-    for (name, value) in [
-        ("thickness", thickness),
-        ("scale_tolerance", scale_tolerance),
-    ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(Error::InvalidArgument {
-                name,
-                reason: format!("{value} is not a finite number > 0"),
-            });
-        }
-    }
+    crate::validate::above("thickness", thickness, 0.0)?;
+    crate::validate::above("scale_tolerance", scale_tolerance, 0.0)?;
     let settings = settings.clone().with_objective(Objective::MinThickness);
     // Aim at the middle of the accepted band [1 − tolerance, 1] of scales.
     let target = 1.0 - 0.5 * scale_tolerance;
