@@ -11,23 +11,14 @@
 //! short of the optimum. ε∞ and the horizontal imbalance (largest, over p̄) are recomputed here
 //! from the returned positions and force densities.
 
-use std::path::{Path, PathBuf};
+#[path = "../tests/common/models.rs"]
+mod models;
+
+use std::path::Path;
 use voussoir::{
     analyse, form_find, io, FormFindSettings, Formulation, Problem, QpSolver, StressResult,
     StressSettings,
 };
-
-const MODELS: [&str; 9] = [
-    "free_vault",
-    "dome_with_doors",
-    "lilium",
-    "cheese",
-    "four_holes",
-    "neumunster",
-    "hex",
-    "three_pillar",
-    "vault_pq",
-];
 
 /// ε∞, largest horizontal imbalance and Σ r², all over powers of p̄, recomputed from the
 /// positions, force densities, loads and external forces of `s`.
@@ -75,11 +66,10 @@ fn settings(solver: QpSolver, formulation: Formulation) -> StressSettings {
 }
 
 fn main() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/models");
-    if !dir.is_dir() {
-        println!("skipped: {} not found", dir.display());
+    let Some(dir) = models::models_dir() else {
+        println!("skipped: the shared models were not found");
         return;
-    }
+    };
     let asked: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with('-'))
@@ -88,12 +78,12 @@ fn main() {
     std::fs::create_dir_all(&out).expect("temporary folder");
     println!("| model | answer | status | solver | its | ε∞ | horizontal | Σr²/p̄² | s |");
     println!("|---|---|---|---|---|---|---|---|---|");
-    for name in MODELS
+    for name in models::MODELS
         .iter()
         .filter(|m| asked.is_empty() || asked.iter().any(|a| a == *m))
     {
         let supports = dir.join(format!("{name}.json"));
-        let problem = io::load_model(&dir.join(format!("{name}.obj")), &supports).expect(name);
+        let problem = models::read_shared(&dir, name).expect(name);
         let r = form_find(&problem, &FormFindSettings::default(), None).expect(name);
         let clarabel = r
             .solvers
