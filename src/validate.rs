@@ -58,6 +58,17 @@ pub(crate) fn all_finite(name: &'static str, values: &[f64], what: &str) -> Resu
     }
 }
 
+/// One entry per vertex of a mesh with `n` vertices: `len` of them.
+pub(crate) fn one_per_vertex(name: &'static str, len: usize, n: usize) -> Result<()> {
+    if len != n {
+        return Err(invalid(
+            name,
+            format!("has {len} entries, expected one per vertex ({n})"),
+        ));
+    }
+    Ok(())
+}
+
 /// A count of at least `min`.
 pub(crate) fn count(name: &'static str, n: usize, min: usize) -> Result<()> {
     if n < min {

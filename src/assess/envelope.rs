@@ -151,15 +151,7 @@ impl Envelope {
     ) -> Result<Envelope> {
         let n = mesh.positions.len();
         for (name, values) in [("lower", &lower), ("upper", &upper)] {
-            if values.len() != n {
-                return Err(Error::InvalidArgument {
-                    name,
-                    reason: format!(
-                        "has {} entries, expected one per vertex ({n})",
-                        values.len()
-                    ),
-                });
-            }
+            crate::validate::one_per_vertex(name, values.len(), n)?;
         }
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
             if !(lower[v].is_finite() && upper[v].is_finite() && lower[v] <= upper[v]) {
@@ -221,15 +213,7 @@ impl Envelope {
     pub fn with_springing(mut self, springing: Vec<f64>, reach: Vec<f64>) -> Result<Envelope> {
         let n = self.lower.len();
         for (name, values) in [("springing", &springing), ("reach", &reach)] {
-            if values.len() != n {
-                return Err(Error::InvalidArgument {
-                    name,
-                    reason: format!(
-                        "has {} entries, expected one per vertex ({n})",
-                        values.len()
-                    ),
-                });
-            }
+            crate::validate::one_per_vertex(name, values.len(), n)?;
         }
         if let Some(v) =
             (0..n).find(|&v| !(springing[v].is_finite() && springing[v] <= self.upper[v]))

@@ -502,11 +502,8 @@ fn check_lengths(problem: &Problem, envelope: &Envelope) -> Result<()> {
 fn live_pattern(problem: &Problem, settings: &AssessSettings) -> Result<Vec<f64>> {
     let n = problem.mesh.positions.len();
     match (&settings.load_pattern, settings.objective) {
-        (Some(p), Objective::MaxLoad) if p.len() != n => Err(Error::InvalidArgument {
-            name: "load_pattern",
-            reason: format!("has {} entries, expected one per vertex ({n})", p.len()),
-        }),
         (Some(p), Objective::MaxLoad) => {
+            crate::validate::one_per_vertex("load_pattern", p.len(), n)?;
             let free = crate::stress::non_anchored(&problem.mesh);
             if free.iter().all(|&v| p[v as usize] == 0.0) {
                 return Err(Error::InvalidArgument {

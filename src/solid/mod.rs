@@ -267,16 +267,7 @@ fn check_range(face_thickness: &[f64], size: f64, side: Range) -> Result<()> {
 }
 
 fn check_positions(mesh: &Mesh, positions: &[[f64; 3]]) -> Result<()> {
-    if positions.len() != mesh.n_vertices() {
-        return Err(Error::InvalidArgument {
-            name: "positions",
-            reason: format!(
-                "has {} entries, expected one per vertex ({})",
-                positions.len(),
-                mesh.n_vertices()
-            ),
-        });
-    }
+    crate::validate::one_per_vertex("positions", positions.len(), mesh.n_vertices())?;
     match positions
         .iter()
         .position(|p| p.iter().any(|c| !c.is_finite()))
