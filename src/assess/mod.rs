@@ -235,7 +235,7 @@ pub fn assess(
     settings.validate()?;
     let model = model::Model::new(problem, envelope, settings)?;
     let (from, fit_iterations) = feasible_start(problem, envelope, settings)?;
-    let mut run = sqp::solve(&model, settings, progress, from)?;
+    let mut run = sqp::solve(&model, settings, progress, from, sqp::Until::Optimal)?;
     run.iterations += fit_iterations;
     let mut result = model.certify(run, settings);
     let cancelled = result.termination == Termination::Cancelled;
@@ -262,7 +262,7 @@ fn feasible_start(
         ..settings.clone()
     };
     let model = model::Model::new(problem, envelope, &fit)?;
-    let run = sqp::solve(&model, &fit, None, None)?;
+    let run = sqp::solve(&model, &fit, None, None, sqp::Until::Certified)?;
     Ok((Some(run.state), run.iterations))
 }
 
@@ -279,7 +279,7 @@ fn needed_scale(
     };
     let model = model::Model::new(problem, envelope, &thinnest)?;
     let (from, _) = feasible_start(problem, envelope, &thinnest)?;
-    let run = sqp::solve(&model, &thinnest, None, from)?;
+    let run = sqp::solve(&model, &thinnest, None, from, sqp::Until::Optimal)?;
     let found = model.certify(run, &thinnest);
     if !found.feasible {
         return Ok(None);

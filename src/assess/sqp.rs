@@ -29,6 +29,16 @@ const POLISH_STEPS: usize = 30;
 /// The search holds the residuals to this fraction of the tolerance.
 const FEASIBILITY_MARGIN: f64 = 0.1;
 
+/// How long a search runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Until {
+    /// Until the objective settles (or the iteration limit).
+    Optimal,
+    /// Until the first certified state: the start of another analysis needs a surface in
+    /// equilibrium inside the envelope, not the best one.
+    Certified,
+}
+
 /// Runs the search from `from` (a state of a search on the same mesh and supports, its
 /// scalar reset), or from the middle surface with its best stress.
 pub(super) fn solve(
@@ -36,6 +46,7 @@ pub(super) fn solve(
     settings: &AssessSettings,
     mut progress: Option<&mut Progress>,
     from: Option<State>,
+    until: Until,
 ) -> Result<Run> {
     let start = Instant::now();
     let layout = Layout::new(model);
@@ -47,6 +58,10 @@ pub(super) fn solve(
     let mut termination = Termination::MaxIterations;
     let mut iterations = 0;
     while iterations < settings.max_iterations {
+        if until == Until::Certified && search.best_feasible.is_some() {
+            termination = Termination::Converged;
+            break;
+        }
         iterations += 1;
         match search.iterate(&layout) {
             Outcome::Continue => {}
@@ -66,7 +81,8 @@ pub(super) fn solve(
             }
         }
     }
-    if termination != Termination::Cancelled {
+    let found = until == Until::Certified && search.best_feasible.is_some();
+    if termination != Termination::Cancelled && !found {
         iterations += search.polish(&layout);
     }
     let state = search.answer();
