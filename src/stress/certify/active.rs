@@ -7,7 +7,7 @@
 use super::kkt::{self, dot2, EdgeQp, Side2};
 
 /// Rounds of the active-set method at most (each a factorisation and its refinement).
-const ROUNDS: usize = 12;
+const ROUNDS: usize = 40;
 /// An unknown within this share of its typical size of a bound starts held on it.
 const ACTIVE_GUESS: f64 = 1e-7;
 /// A held unknown is released when its multiplier has the wrong sign by more than this share
