@@ -67,17 +67,6 @@ fn scratch(name: &str) -> std::path::PathBuf {
     dir
 }
 
-/// Models whose re-analysis still misses ε∞ < 1e-6, with the bound they meet
-/// (docs/solver.md, "Shapes that nearly stand, analysed afresh").
-const SHORT_OF_TARGET: [(&str, f64); 1] = [("holes3-seed2-anchored", 5e-6)];
-
-/// The bound `label`'s re-analysis must meet: 1e-6, or its entry in `SHORT_OF_TARGET`.
-fn bound(label: &str) -> f64 {
-    (SHORT_OF_TARGET.iter())
-        .find(|m| m.0 == label)
-        .map_or(1e-6, |m| m.1)
-}
-
 #[test]
 fn form_found_shared_models_certify_that_they_stand_afresh() {
     let Some(models) = models_dir() else { return };
@@ -90,7 +79,7 @@ fn form_found_shared_models_certify_that_they_stand_afresh() {
             io::load_model(path, &supports).expect("read back")
         });
         println!("{name}: ε∞ {eps:.2e}, horizontal {h:.2e}");
-        if !(eps < bound(name) && h < 1e-9) {
+        if !(eps < 1e-6 && h < 1e-9) {
             failures.push(format!("{name}: ε∞ {eps:.2e}, horizontal {h:.2e}"));
         }
     }
@@ -166,14 +155,14 @@ fn holed_certificate(
     (label, eps, h)
 }
 
-/// Certifies every case of `cases`, each against `bound` and horizontal balance 1e-9 p̄;
+/// Certifies every case of `cases`, each to ε∞ < 1e-6 and horizontal balance < 1e-9 p̄;
 /// panics listing the failures.
 fn certify_all(name: &str, cases: &[(u64, usize, bool)], max_area: f64) {
     let dir = scratch(name);
     let mut failures = Vec::new();
     for &case in cases {
         let (label, eps, h) = holed_certificate(&dir, case, max_area);
-        if !(eps < bound(&label) && h < 1e-9) {
+        if !(eps < 1e-6 && h < 1e-9) {
             failures.push(format!("{label}: ε∞ {eps:.2e}, horizontal {h:.2e}"));
         }
     }
