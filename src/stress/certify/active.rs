@@ -7,7 +7,7 @@
 use super::kkt::{self, dot2, EdgeQp, Side2};
 
 /// Rounds of the active-set method at most (each a factorisation and its refinement).
-const ROUNDS: usize = 12;
+const ROUNDS: usize = 40;
 /// An unknown within this share of its typical size of a bound starts held on it.
 const ACTIVE_GUESS: f64 = 1e-7;
 /// A held unknown is released when its multiplier has the wrong sign by more than this share
@@ -61,15 +61,16 @@ fn guess(qp: &EdgeQp, x0: &[f64]) -> Vec<Side2> {
         .collect()
 }
 
-/// The polished answer from `x0`; None when no active set's solve succeeded.
-pub(super) fn polish(qp: &EdgeQp, x0: &[f64]) -> Option<Polished> {
+/// The polished answer from `x0`, each active set's QP factored with the regularisation
+/// `delta` (`kkt::DELTAS`); None when no active set's solve succeeded.
+pub(super) fn polish(qp: &EdgeQp, x0: &[f64], delta: f64) -> Option<Polished> {
     let tr = qp.transposes();
     let mut side = guess(qp, x0);
     let mut x = x0.to_vec();
     let mut best: Option<(f64, Polished)> = None;
     for _ in 0..ROUNDS {
         crate::interrupt::poll();
-        let sol = kkt::solve(qp, &tr, &side, &x)?;
+        let sol = kkt::solve(qp, &tr, &side, &x, delta)?;
         let z = qp.multipliers(&tr, &sol);
         // Unknowns beyond their bounds are held on them first; only from a feasible answer
         // are held unknowns whose multiplier has the wrong sign released (normwise: by more

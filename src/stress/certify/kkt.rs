@@ -115,16 +115,27 @@ impl EdgeQp {
     }
 }
 
-/// Regularisation of the factored system in scaled unknowns, +δ on x and −δ on λ, against
+/// Regularisations of the factored system in scaled unknowns, +δ on x and −δ on λ, against
 /// dependent rows and directions the objective does not see; refinement against the exact
-/// system removes its effect.
-const DELTA: f64 = 1e-9;
+/// system removes its effect where the system's curvature is well above δ. The first is
+/// stable on plan slivers (four_holes: a 0.0037° corner); in directions that only the
+/// regulariser ε ‖l q‖² bends (curvature ~1e-16 of the scaled system's) refinement with it
+/// stalls, and the second reaches them (a generated vault with three anchored hole rims:
+/// stationarity 2e-6 → its optimum).
+pub(super) const DELTAS: [f64; 2] = [1e-9, 1e-14];
 /// Refinement steps at most; refinement stops earlier once the residual no longer halves.
 const REFINE: usize = 40;
 
 /// The optimum of `qp` with the unknowns of `side` held on their bounds, refined from x0
-/// (whose active unknowns are set to their bounds); None when the factorisation fails.
-pub(super) fn solve(qp: &EdgeQp, tr: &[Csr; 3], side: &[Side2], x0: &[f64]) -> Option<Eqp> {
+/// (whose active unknowns are set to their bounds) on the system factored with the
+/// regularisation `delta`; None when the factorisation fails.
+pub(super) fn solve(
+    qp: &EdgeQp,
+    tr: &[Csr; 3],
+    side: &[Side2],
+    x0: &[f64],
+    delta: f64,
+) -> Option<Eqp> {
     let n = qp.n();
     let mut x: Vec<f64> = (0..n)
         .map(|k| match side[k] {
@@ -134,7 +145,7 @@ pub(super) fn solve(qp: &EdgeQp, tr: &[Csr; 3], side: &[Side2], x0: &[f64]) -> O
         })
         .collect();
     let free: Vec<usize> = (0..n).filter(|&k| side[k] == Side2::Free).collect();
-    let system = System::new(qp, &free)?;
+    let system = System::new(qp, &free, delta)?;
     let (m_a, m_e) = (qp.a.nrows(), qp.eq.nrows());
     let mut r = residual(&qp.a, &x, &qp.t);
     let mut lambda = vec![0.0; m_e];
@@ -219,7 +230,7 @@ struct System {
 }
 
 impl System {
-    fn new(qp: &EdgeQp, free: &[usize]) -> Option<System> {
+    fn new(qp: &EdgeQp, free: &[usize], delta: f64) -> Option<System> {
         let (n_f, m_a, m_e) = (free.len(), qp.a.nrows(), qp.eq.nrows());
         let dim = n_f + m_a + m_e;
         let mut col_of = vec![usize::MAX; qp.n()];
@@ -256,7 +267,7 @@ impl System {
             .collect();
         let mut triplets = Vec::new();
         for j in 0..n_f {
-            triplets.push(Triplet::new(j, j, DELTA));
+            triplets.push(Triplet::new(j, j, delta));
         }
         for i in 0..qp.b.nrows() {
             let row: Vec<(usize, f64)> = (qp.b.row(i).filter(|(c, _)| col_of[*c] != usize::MAX))
@@ -282,7 +293,7 @@ impl System {
                     scale * v * d[col_of[c]],
                 ));
             }
-            triplets.push(Triplet::new(n_f + m_a + i, n_f + m_a + i, -DELTA));
+            triplets.push(Triplet::new(n_f + m_a + i, n_f + m_a + i, -delta));
         }
         // Both triangles: the LU factorisation with partial pivoting reads the whole matrix.
         let upper: Vec<_> = (triplets.iter().filter(|t| t.row != t.col))

@@ -140,15 +140,12 @@ pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certifi
     let x0 = unknowns(inp, &tau_col, n, q0, tau0);
     let balanced = project::balanced(&qp, &x0);
     let mut candidates = Vec::new();
-    let from_answer = active::polish(&qp, balanced.as_deref().unwrap_or(&x0));
-    let optimal = from_answer.as_ref().is_some_and(|p| p.optimal);
-    candidates.extend(from_answer.map(|p| p.x));
+    let optimal = polish_from(&qp, balanced.as_deref().unwrap_or(&x0), &mut candidates);
     candidates.extend(balanced);
     if !optimal {
         if let Some(x) = interior_point(inp, n, &tau_col, &qp) {
-            let polished = active::polish(&qp, &x);
+            polish_from(&qp, &x, &mut candidates);
             candidates.push(x);
-            candidates.extend(polished.map(|p| p.x));
         }
     }
     let before = (
@@ -169,6 +166,21 @@ pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certifi
         .min_by(|a, b| a.0.total_cmp(&b.0))?
         .1;
     Some(answer(inp, &tau_col, &x))
+}
+
+/// The active-set polish from `x`, with each regularisation of `kkt::DELTAS` in turn until
+/// one ends at a verified optimum; its answers are added to `candidates`. Returns whether
+/// one was verified optimal.
+fn polish_from(qp: &EdgeQp, x: &[f64], candidates: &mut Vec<Vec<f64>>) -> bool {
+    for delta in kkt::DELTAS {
+        if let Some(p) = active::polish(qp, x, delta) {
+            candidates.push(p.x);
+            if p.optimal {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 /// The unknowns x = (q, τ) of the edge-based QP `inp` from force densities per edge and τ
