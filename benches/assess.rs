@@ -5,6 +5,7 @@
 //!     cargo bench --bench assess -- --models       # shared models only
 //!     cargo bench --bench assess -- --heyman       # least thickness on Heyman's terms
 //!     cargo bench --bench assess -- --heyman --barrels   # its barrels only
+//!     cargo bench --bench assess -- --large [--budget S] [--only TEXT]   # ~5k vertices
 //!
 //! Hemispheres: radius 1 on `generate::polar_disk` meshes, rim anchored, thickness 0.1 along
 //! the normal (docs/method.md §16.1), every analysis; t_min/R = s × 0.1. Shared models: each
@@ -15,6 +16,12 @@
 //! z = 0, reach t/2: `Envelope::from_bounds`' defaults), against Heyman's t/R ≈ 0.042 and
 //! Milankovitch's 0.1075 (radial joints) and the continuum values of this convention
 //! (docs/benchmarks.md).
+//! Large: a hemispherical dome (4921 vertices) and a cross vault (5041) of radius 1 between
+//! the shells R ± t/2 read vertically (t = 0.1; the cross vault's as compas_tno's
+//! `apply_envelope`: the intersection of two semicircular barrels), classical springing
+//! joints, every analysis but max-load; each search is cancelled after `--budget` seconds
+//! of steps (default 600; the `fit` start of the other analyses is not cancelled), and
+//! `--only` keeps the rows whose "model analysis" contains TEXT.
 
 #[path = "../tests/common/models.rs"]
 mod models;
@@ -203,11 +210,104 @@ fn heyman() {
     }
 }
 
+/// A cross vault over [-1, 1]²: two semicircular barrels of radius 1 intersecting, height
+/// sqrt(1 − min(x², y²)), on an n × n grid whose diagonals run along the groins, anchored
+/// at the four corners.
+fn cross_vault(n: usize) -> Mesh {
+    let at = |i: usize| -1.0 + 2.0 * i as f64 / n as f64;
+    let points: Vec<[f64; 2]> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [at(i), at(j)]))
+        .collect();
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let half = n / 2;
+    let faces: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                // The diagonal through the quad's corner nearest a groin line |x| = |y|.
+                if (i < half) == (j < half) {
+                    [[a, b, c], [a, c, d]]
+                } else {
+                    [[a, b, d], [b, c, d]]
+                }
+            })
+        })
+        .collect();
+    let height = |u: [f64; 2]| (1.0 - (u[0] * u[0]).min(u[1] * u[1])).max(0.0).sqrt();
+    let corner = |u: [f64; 2], _| u[0].abs() > 1.0 - 1e-9 && u[1].abs() > 1.0 - 1e-9;
+    generate::lift(&points, &faces, height, corner).unwrap()
+}
+
+/// One analysis of a large model, cancelled after `budget` seconds of steps.
+fn large_row(name: &str, mesh: &Mesh, envelope: &Envelope, objective: Objective, budget: f64) {
+    let problem = Problem::new(mesh.clone());
+    let settings = AssessSettings::default().with_objective(objective);
+    let start = std::time::Instant::now();
+    let mut within = |_: usize, _: f64| start.elapsed().as_secs_f64() < budget;
+    let r = assess(&problem, envelope, &settings, Some(&mut within)).unwrap();
+    let total: f64 = r.loads.iter().sum();
+    let end = format!("{:?}", r.termination);
+    let t_min = if objective == Objective::MinThickness {
+        format!("{:.4}", r.thickness_scale * 0.1)
+    } else {
+        "—".into()
+    };
+    println!(
+        "| {name} | {} | {} | {} | {} | {} | {t_min} | {:.4} | {:.1e} | {:.1} |",
+        mesh.positions().len(),
+        objective.as_str(),
+        end.split([' ', '{']).next().unwrap_or(""),
+        r.feasible,
+        r.iterations,
+        r.thrust_horizontal / total,
+        r.eps_inf,
+        r.seconds
+    );
+}
+
+fn large() {
+    let args: Vec<String> = std::env::args().collect();
+    let value = |flag: &str| {
+        let k = args.iter().position(|a| a == flag)?;
+        args.get(k + 1).cloned()
+    };
+    let budget: f64 = value("--budget").map_or(600.0, |b| b.parse().unwrap());
+    let only = value("--only").unwrap_or_default();
+    println!(
+        "\nLarge models, shells R ± t/2 read vertically (R = 1, t = 0.1), budget {budget} s\n"
+    );
+    println!("| model | V | analysis | end | certified | steps | t_min / R | thrust / weight | eps_inf | s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let dome = hemisphere_by_angle(40);
+    let dome_envelope = shell_family(&dome, |p| p[0].hypot(p[1]), 0.1).unwrap();
+    let vault = cross_vault(70);
+    let groin = |p: [f64; 3]| p[0].abs().min(p[1].abs());
+    let vault_envelope = shell_family(&vault, groin, 0.1).unwrap();
+    for (name, mesh, envelope) in [
+        ("dome", &dome, &dome_envelope),
+        ("cross vault", &vault, &vault_envelope),
+    ] {
+        for objective in [
+            Objective::Fit,
+            Objective::MinThrust,
+            Objective::MaxThrust,
+            Objective::MinThickness,
+        ] {
+            if format!("{name} {}", objective.as_str()).contains(&only) {
+                large_row(name, mesh, envelope, objective, budget);
+            }
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let has = |f: &str| args.iter().any(|a| a == f);
     if has("--heyman") {
         return heyman();
+    }
+    if has("--large") {
+        return large();
     }
     if !has("--models") {
         hemispheres();

@@ -11,8 +11,12 @@ Arch: z(x) = z0 - k M(x), k = 1/H, M'' = w; feasibility is linear in (z0, k).
 Dome: z'(r) = -W(r) g(r) / 2pi with g = 1/h, h the meridional horizontal thrust per radian;
 compressive hoops mean h non-decreasing outward (g non-increasing); linear in (z0, g).
 Each t is a linear feasibility problem (scipy's HiGHS); t_min is bisected.
+With --rings N N..., the dome on N rings equal in the meridian's angle instead (the rings of
+`cargo bench --bench assess -- --heyman`): straight meridian segments between rings, the
+bounds at the rings only, each band's weight (its frustum of the read middle surface × t)
+lumped half to either ring, compressive hoops, the joint at the support ring.
 
-    python benches/heyman_continuum.py [--true-middle] [--no-joint]
+    python benches/heyman_continuum.py [--true-middle] [--no-joint] [--rings N N...]
 """
 
 import sys
@@ -87,6 +91,36 @@ def dome_fits(t, joint, true_middle):
     return feasible(np.vstack(rows), np.concatenate(rhs), n + 1, bounds)
 
 
+def rings_fit(t, rings, joint):
+    r = np.sin(0.5 * np.pi * np.arange(rings + 1) / rings)
+    lower, upper = shells(r, t)
+    m = 0.5 * (lower + upper)
+    band = np.pi * (r[1:] + r[:-1]) * np.hypot(np.diff(r), np.diff(m)) * t
+    p = np.zeros(rings + 1)
+    p[:-1] += 0.5 * band
+    p[1:] += 0.5 * band
+    carried = np.cumsum(p)[:-1]  # the weight crossing segment k (rings 0..k)
+    n = rings
+    # Unknowns z0, g_0..g_{n-1}: z_i = z0 - sum_{k<i} dr_k W_k g_k / 2pi.
+    drop = np.tril(np.ones((n + 1, n)), -1) * (np.diff(r) * carried / (2.0 * np.pi))
+    ones = np.ones((n + 1, 1))
+    rows = [np.hstack([-ones, drop]), np.hstack([ones, -drop])]
+    rhs = [-lower, upper]
+    mono = np.zeros((n - 1, n + 1))
+    mono[np.arange(n - 1), np.arange(1, n)] = -1.0
+    mono[np.arange(n - 1), np.arange(2, n + 1)] = 1.0
+    rows.append(mono)
+    rhs.append(np.zeros(n - 1))
+    if joint:
+        # The support's reaction: H = h_last, V = the weight carried plus its own load.
+        row = np.hstack([[1.0], -drop[-1]])
+        row[-1] -= 0.5 * t * (carried[-1] + p[-1]) / (2.0 * np.pi)
+        rows.append(row[None, :])
+        rhs.append(np.array([0.0]))
+    bounds = [(None, None)] + [(0, None)] * n
+    return feasible(np.vstack(rows), np.concatenate(rhs), n + 1, bounds)
+
+
 def feasible(a_ub, b_ub, n, bounds):
     result = linprog(np.zeros(n), A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs")
     return result.status == 0
@@ -103,6 +137,11 @@ def least(fits, lo=0.005, hi=0.3, tol=1e-5):
 def main():
     joint = "--no-joint" not in sys.argv
     true_middle = "--true-middle" in sys.argv
+    if "--rings" in sys.argv:
+        for rings in [int(a) for a in sys.argv[sys.argv.index("--rings") + 1:]]:
+            dome = least(lambda t: rings_fit(t, rings, joint), lo=0.001)
+            print(f"dome on {rings} rings, joint {joint}: t_min/R {dome:.4f}")
+        return
     arch = least(lambda t: arch_fits(t, joint, true_middle))
     dome = least(lambda t: dome_fits(t, joint, true_middle))
     print(f"joint {joint}, weight of the {'true' if true_middle else 'read'} middle surface")

@@ -21,6 +21,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -719,12 +720,20 @@ std::vector<double> c_doubles(
     return v;
 }
 
-CAssessment c_assess(const voussoir::Mesh &mesh, VsrObjective objective) {
+// With `joints` (springing, reach per vertex), the envelope's springing joints set first.
+CAssessment c_assess(
+    const voussoir::Mesh &mesh, VsrObjective objective,
+    const std::pair<std::vector<double>, std::vector<double>> *joints = nullptr) {
     const double t = 0.1;
     VsrEnvelope *e = nullptr;
     VsrAssessSettings *s = nullptr;
     VsrAssessment *a = nullptr;
     EXPECT_EQ(vsr_envelope_from_thickness(mesh.get(), &t, 1, &e), VSR_STATUS_OK);
+    if (joints) {
+        EXPECT_EQ(vsr_envelope_set_springing(e, joints->first.data(), joints->first.size(),
+                                             joints->second.data(), joints->second.size()),
+                  VSR_STATUS_OK);
+    }
     EXPECT_EQ(vsr_assess_settings_create(&s), VSR_STATUS_OK);
     EXPECT_EQ(vsr_assess_settings_set_objective(s, objective), VSR_STATUS_OK);
     EXPECT_EQ(vsr_assess(mesh.get(), e, s, &a), VSR_STATUS_OK);
@@ -809,6 +818,51 @@ TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
             EXPECT_DOUBLE_EQ(f.safety_factor, 1.0 / f.thickness_scale);
         }
     }
+}
+
+TEST(CppApi, SpringingJointsReachTheCSetter) {
+    const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
+    voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);
+    const std::vector<double> springing = envelope.springing(), reach = envelope.reach();
+    ASSERT_EQ(springing.size(), 5u);
+    ASSERT_EQ(reach.size(), 5u);
+    // Bad joints throw the C status with its message naming the argument; nothing changes.
+    auto failure = [&](const std::vector<double> &s, const std::vector<double> &r) {
+        try {
+            envelope.set_springing(s, r);
+        } catch (const voussoir::Error &e) {
+            EXPECT_EQ(e.status(), VSR_STATUS_INVALID_ARGUMENT);
+            return e.message();
+        }
+        return std::string("no error");
+    };
+    EXPECT_NE(failure({0, 0}, reach).find("`springing`"), std::string::npos);
+    std::vector<double> negative = reach;
+    negative[2] = -0.5;
+    const std::string message = failure(springing, negative);
+    EXPECT_NE(message.find("`reach`"), std::string::npos) << message;
+    EXPECT_NE(message.find("vertex 2"), std::string::npos) << message;
+    EXPECT_TRUE(same_bits(envelope.reach(), reach));
+    // A narrow joint and no joint: the greatest thrust equals the C API's, bit for bit.
+    std::vector<double> narrow = reach, none(reach.size(), std::numeric_limits<double>::infinity());
+    for (double &b : narrow) b *= 0.2;
+    voussoir::AssessSettings settings;
+    settings.objective(VSR_OBJECTIVE_MAX_THRUST);
+    std::vector<double> thrusts;
+    for (const std::vector<double> &r : {narrow, none}) {
+        EXPECT_EQ(&envelope.set_springing(springing, r), &envelope);
+        EXPECT_TRUE(same_bits(envelope.reach(), r));
+        EXPECT_TRUE(same_bits(envelope.springing(), springing));
+        const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
+        const std::pair<std::vector<double>, std::vector<double>> joints{springing, r};
+        const CAssessment c = c_assess(mesh, VSR_OBJECTIVE_MAX_THRUST, &joints);
+        EXPECT_TRUE(same_bits(c.positions, a.positions()));
+        EXPECT_TRUE(same_bits(c.joints, a.joints()));
+        EXPECT_TRUE(a.outcome().feasible);
+        thrusts.push_back(a.figures().thrust_horizontal);
+    }
+    // The joint binds: without it the reaction leans further.
+    EXPECT_LT(thrusts[0], thrusts[1] * (1 - 1e-3));
 }
 
 TEST(CppApi, AssessmentInputErrorsThrowTheCStatus) {

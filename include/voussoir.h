@@ -547,8 +547,9 @@ typedef struct VsrAssessment VsrAssessment;
  * Opaque handle: the masonry's envelope over a mesh's plan, per vertex an intrados (lower)
  * and an extrados (upper) height and per face the thickness whose weight loads the vault.
  * Create with `vsr_envelope_from_thickness` or `vsr_envelope_from_surfaces`, free with
- * `vsr_envelope_destroy`. Immutable: a `const VsrEnvelope*` may be read from several threads
- * at once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
+ * `vsr_envelope_destroy`. `vsr_envelope_set_springing` changes its springing joints;
+ * nothing else changes it, and a `const VsrEnvelope*` may be read from several threads at
+ * once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
  */
 typedef struct VsrEnvelope VsrEnvelope;
 
@@ -1632,6 +1633,49 @@ VsrStatus vsr_envelope_upper(const struct VsrEnvelope *envelope, double *out, si
  * writable.
  */
 VsrStatus vsr_envelope_face_thickness(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Height of the springing plane per vertex, #V doubles, read at free supports (see
+ * `vsr_envelope_set_springing` for its meaning and defaults).
+ *
+ * # Safety
+ * `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_envelope_springing(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Reach of the springing joint per vertex, #V doubles (`INFINITY` where there is no joint),
+ * read at free supports (see `vsr_envelope_set_springing`).
+ *
+ * # Safety
+ * `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_envelope_reach(const struct VsrEnvelope *envelope, double *out, size_t len, size_t *needed);
+
+/**
+ * Sets the springing joints (docs/method.md §16.1), read at the free supports (those whose
+ * height the assessment chooses; not with fixed supports): per vertex the height of the
+ * springing plane and the joint's reach, #V doubles each (copied; entries at other vertices
+ * are checked but not read). A free support lies on or above its plane, and its reaction's
+ * line of action, followed down to the plane, meets it within `reach` (in plan) of the
+ * support's plan point. A reach of `INFINITY` drops the joint: the support's height is then
+ * bounded by the envelope alone (the vertical reading). Defaults: from a thickness, the
+ * plane through the middle surface's vertex and reach t / (2 |n_h|) (the slab's horizontal
+ * section, n_h the normal's plan part); from surfaces, the plane at the intrados and half
+ * the vertex's thickness.
+ *
+ * Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a length other than the mesh's vertex
+ * count, a springing height that is not finite or lies above the extrados, a reach that is
+ * NaN or < 0 (`VSR_STATUS_INVALID_ARGUMENT`, naming the argument and the vertex). The
+ * envelope is unchanged on failure.
+ *
+ * # Safety
+ * `envelope`: a valid handle with exclusive access; `springing`: `n_springing` readable
+ * doubles; `reach`: `n_reach` readable doubles.
+ */
+VsrStatus vsr_envelope_set_springing(struct VsrEnvelope *envelope, const double *springing, size_t n_springing, const double *reach, size_t n_reach);
 
 /**
  * Creates assessment settings with the documented defaults (those of the Rust

@@ -630,6 +630,25 @@ class Envelope {
     VOUSSOIR_DETAIL_GETTER(double, lower, vsr_envelope_lower, VsrEnvelope)
     VOUSSOIR_DETAIL_GETTER(double, upper, vsr_envelope_upper, VsrEnvelope)
     VOUSSOIR_DETAIL_GETTER(double, face_thickness, vsr_envelope_face_thickness, VsrEnvelope)
+    /// Springing plane's height and joint's reach per vertex, read at free supports
+    /// (vsr_envelope_springing, vsr_envelope_reach; INFINITY: no joint).
+    VOUSSOIR_DETAIL_GETTER(double, springing, vsr_envelope_springing, VsrEnvelope)
+    VOUSSOIR_DETAIL_GETTER(double, reach, vsr_envelope_reach, VsrEnvelope)
+
+    /// Sets the springing joints of free supports, one value per vertex each
+    /// (vsr_envelope_set_springing): the plane's height and the joint's reach, INFINITY for
+    /// no joint (the support's height bounded by the envelope alone). Throws Error naming
+    /// the argument and vertex; the envelope is unchanged then.
+    Envelope &set_springing(const std::vector<double> &springing,
+                            const std::vector<double> &reach) {
+        check(try_set_springing(springing.data(), springing.size(), reach.data(), reach.size()));
+        return *this;
+    }
+    [[nodiscard]] VsrStatus try_set_springing(const double *springing, std::size_t n_springing,
+                                              const double *reach,
+                                              std::size_t n_reach) noexcept {
+        return vsr_envelope_set_springing(get(), springing, n_springing, reach, n_reach);
+    }
 
   private:
     detail::Owner<VsrEnvelope, vsr_envelope_destroy> owner_;

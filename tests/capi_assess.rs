@@ -946,3 +946,144 @@ fn the_least_thickness_of_a_family_is_the_rust_api_s() {
         vsr_mesh_destroy(mesh);
     }
 }
+
+/// The C envelope's springing joints, read back and run through `vsr_assess`, against the
+/// Rust `Envelope::with_springing`: defaults copied out, a narrow joint, and no joint.
+#[test]
+fn springing_joints_set_in_c_assess_as_the_rust_api_does() {
+    let d = Dome::new(3, 12);
+    let mesh = d.create();
+    let rust = Problem::new(rust_mesh(&d));
+    let env = Envelope::from_thickness(&rust.mesh, &Thickness::Uniform(0.1)).unwrap();
+    let e = envelope_of(mesh, &[0.1]);
+    assert_eq!(
+        bits(&envelope_doubles(e, vsr_envelope_springing)),
+        bits(&env.springing)
+    );
+    assert_eq!(
+        bits(&envelope_doubles(e, vsr_envelope_reach)),
+        bits(&env.reach)
+    );
+    let s = assess_settings();
+    let objective = VsrObjective::MaxThrust as u32;
+    assert_ok(unsafe { vsr_assess_settings_set_objective(s, objective) });
+    let settings = AssessSettings::default().with_objective(Objective::MaxThrust);
+    let default = assess(&rust, &env, &settings, None).unwrap();
+    let narrow: Vec<f64> = env.reach.iter().map(|b| 0.2 * b).collect();
+    let none = vec![f64::INFINITY; env.reach.len()];
+    let mut thrusts = Vec::new();
+    // Without a joint, the plane (0.01 below the middle surface) only bounds the support.
+    let lowered: Vec<f64> = env.springing.iter().map(|z| z - 0.01).collect();
+    for (springing, reach) in [(env.springing.clone(), narrow), (lowered, none)] {
+        assert_ok(unsafe {
+            vsr_envelope_set_springing(
+                e,
+                springing.as_ptr(),
+                springing.len(),
+                reach.as_ptr(),
+                reach.len(),
+            )
+        });
+        assert_eq!(
+            bits(&envelope_doubles(e, vsr_envelope_springing)),
+            bits(&springing)
+        );
+        assert_eq!(bits(&envelope_doubles(e, vsr_envelope_reach)), bits(&reach));
+        let a = run(mesh, e, s);
+        let joints = env.clone().with_springing(springing, reach).unwrap();
+        let r = assess(&rust, &joints, &settings, None).unwrap();
+        assert!(r.feasible);
+        assert_same(a, &r);
+        check_certificate(a, &d.anchored);
+        thrusts.push(r.thrust_horizontal);
+        unsafe { vsr_assessment_destroy(a) };
+    }
+    // A narrow joint holds the greatest thrust below the default joint's; without a joint
+    // the reaction may lean further, above it.
+    let most = default.thrust_horizontal;
+    assert!(thrusts[0] < most * (1.0 - 1e-3), "{thrusts:?} vs {most}");
+    assert!(thrusts[1] > most * (1.0 + 1e-3), "{thrusts:?} vs {most}");
+    unsafe {
+        vsr_assess_settings_destroy(s);
+        vsr_envelope_destroy(e);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
+/// Bad springing joints get the right status and a message naming the argument and the
+/// vertex; the envelope keeps its joints.
+#[test]
+fn bad_springing_joints_are_named_and_leave_the_envelope_unchanged() {
+    let d = Dome::new(3, 12);
+    let mesh = d.create();
+    let e = envelope_of(mesh, &[0.1]);
+    let (springing, reach) = (
+        envelope_doubles(e, vsr_envelope_springing),
+        envelope_doubles(e, vsr_envelope_reach),
+    );
+    let n = springing.len();
+    let upper = envelope_doubles(e, vsr_envelope_upper);
+    let with = |k: usize, v: f64, of: &[f64]| {
+        let mut out = of.to_vec();
+        out[k] = v;
+        out
+    };
+    let cases: [(Vec<f64>, Vec<f64>, &str, &str); 6] = [
+        (
+            springing[..n - 1].to_vec(),
+            reach.clone(),
+            "springing",
+            "entries",
+        ),
+        (
+            springing.clone(),
+            reach[..n - 1].to_vec(),
+            "reach",
+            "entries",
+        ),
+        (
+            with(4, f64::NAN, &springing),
+            reach.clone(),
+            "springing",
+            "vertex 4",
+        ),
+        (
+            with(5, upper[5] + 0.01, &springing),
+            reach.clone(),
+            "springing",
+            "vertex 5",
+        ),
+        (
+            springing.clone(),
+            with(6, -0.1, &reach),
+            "reach",
+            "vertex 6",
+        ),
+        (
+            springing.clone(),
+            with(7, f64::NAN, &reach),
+            "reach",
+            "vertex 7",
+        ),
+    ];
+    for (s, r, name, what) in cases {
+        let status =
+            unsafe { vsr_envelope_set_springing(e, s.as_ptr(), s.len(), r.as_ptr(), r.len()) };
+        assert_failed(status, S::InvalidArgument, name);
+        assert!(last_error().contains(what), "{}", last_error());
+        assert_eq!(
+            bits(&envelope_doubles(e, vsr_envelope_springing)),
+            bits(&springing)
+        );
+        assert_eq!(bits(&envelope_doubles(e, vsr_envelope_reach)), bits(&reach));
+    }
+    let status =
+        unsafe { vsr_envelope_set_springing(null_mut(), springing.as_ptr(), n, reach.as_ptr(), n) };
+    assert_failed(status, S::NullPointer, "envelope");
+    let status = unsafe { vsr_envelope_set_springing(e, null(), n, reach.as_ptr(), n) };
+    assert_failed(status, S::NullPointer, "springing");
+    unsafe {
+        vsr_envelope_destroy(e);
+        vsr_mesh_destroy(mesh);
+    }
+}

@@ -149,14 +149,59 @@ fn envelope(
     }
 }
 
+/// Per-vertex values from a number (the same at every vertex) or an (n,) array; `None`
+/// keeps `default`. Not checked here: `Envelope::with_springing` checks them.
+fn per_vertex(
+    name: &str,
+    value: Option<&PyReadonlyArrayDyn<'_, f64>>,
+    default: &[f64],
+) -> PyResult<Vec<f64>> {
+    let Some(a) = value else {
+        return Ok(default.to_vec());
+    };
+    match a.shape().len() {
+        0 => Ok(vec![
+            a.as_array().iter().copied().next().unwrap_or(0.0);
+            default.len()
+        ]),
+        1 => Ok(a.as_array().iter().copied().collect()),
+        _ => Err(invalid(
+            name,
+            format_args!(
+                "has shape {}, expected (n,) or a number",
+                shape_text(a.shape())
+            ),
+        )),
+    }
+}
+
+/// The envelope with the springing joints given (each a number or one per vertex; the
+/// envelope's own where `None`).
+fn with_joints(
+    env: Envelope,
+    springing: Option<&PyReadonlyArrayDyn<'_, f64>>,
+    reach: Option<&PyReadonlyArrayDyn<'_, f64>>,
+) -> PyResult<Envelope> {
+    if springing.is_none() && reach.is_none() {
+        return Ok(env);
+    }
+    let s = per_vertex("springing", springing, &env.springing)?;
+    let r = per_vertex("reach", reach, &env.reach)?;
+    env.with_springing(s, r)
+        .map_err(|e| from_error("springing", e))
+}
+
 /// The input files a report's settings name: intrados, extrados and load pattern.
 type ReportFiles = (Option<String>, Option<String>, Option<String>);
 
-/// `assess(mesh, thickness, intrados, extrados, settings, progress, report)`: the result's
-/// fields; with `report` (the input files to name), also the library's report as JSON text
-/// (`voussoir::report::AssessmentReport`, formfind's schema) under `"report"`.
+/// `assess(mesh, thickness, intrados, extrados, settings, progress, report, springing,
+/// reach)`: the result's fields; with `report` (the input files to name), also the
+/// library's report as JSON text (`voussoir::report::AssessmentReport`, formfind's schema)
+/// under `"report"`; `springing` and `reach` (a number or one per vertex) replace the
+/// envelope's springing joints.
 #[pyfunction]
-#[pyo3(signature = (mesh, thickness, intrados, extrados, settings, progress=None, report=None))]
+#[pyo3(signature = (mesh, thickness, intrados, extrados, settings, progress=None, report=None,
+                    springing=None, reach=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn assess<'py>(
     py: Python<'py>,
@@ -167,10 +212,13 @@ pub fn assess<'py>(
     settings: &Bound<'py, PyDict>,
     progress: Option<Bound<'py, PyAny>>,
     report: Option<ReportFiles>,
+    springing: Option<PyReadonlyArrayDyn<'py, f64>>,
+    reach: Option<PyReadonlyArrayDyn<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let s = settings_from(settings)?;
     let m: &Mesh = mesh.get();
     let (env, uniform) = envelope(&m.problem().mesh, thickness, intrados, extrados)?;
+    let env = with_joints(env, springing.as_ref(), reach.as_ref())?;
     if let Some(p) = &progress {
         if !p.is_none() && !p.is_callable() {
             return Err(invalid("progress", "is not callable"));
@@ -267,7 +315,9 @@ fn fields<'py>(
     Ok(d)
 }
 
-/// Per-vertex bounds from `envelope_at(t)`: a pair (lower, upper) of n floats each.
+/// Per-vertex bounds from `envelope_at(t)`: a pair (lower, upper) of n floats each, or
+/// (lower, upper, springing, reach) with the springing joints too (each a number or n
+/// floats; `None` keeps the default).
 fn family_member(
     py: Python<'_>,
     mesh: &voussoir::Mesh,
@@ -275,19 +325,27 @@ fn family_member(
     t: f64,
 ) -> PyResult<Envelope> {
     let answer = envelope_at.call1(py, (t,))?;
-    let (lower, upper): (PyReadonlyArrayDyn<'_, f64>, PyReadonlyArrayDyn<'_, f64>) =
-        answer.bind(py).extract().map_err(|_| {
+    let parts: Vec<Option<PyReadonlyArrayDyn<'_, f64>>> = (answer.bind(py).extract().ok())
+        .filter(|p: &Vec<Option<PyReadonlyArrayDyn<'_, f64>>>| {
+            matches!(p.len(), 2 | 4) && p[0].is_some() && p[1].is_some()
+        })
+        .ok_or_else(|| {
             invalid(
                 "envelope_at",
                 format_args!(
-                    "envelope_at({t}) did not return a pair (lower, upper) of float arrays"
+                    "envelope_at({t}) did not return a pair (lower, upper) or (lower, upper, \
+                     springing, reach) of float arrays"
                 ),
             )
         })?;
-    let lower = floats(&lower);
-    let upper = floats(&upper);
-    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
-        .map_err(|e| from_error("envelope_at", e))
+    let bound = |k: usize| parts[k].as_ref().map_or_else(Vec::new, floats);
+    let (lower, upper) = (bound(0), bound(1));
+    let env = Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
+        .map_err(|e| from_error("envelope_at", e))?;
+    match parts.get(2..4) {
+        Some([springing, reach]) => with_joints(env, springing.as_ref(), reach.as_ref()),
+        _ => Ok(env),
+    }
 }
 
 /// `min_thickness_of_family(mesh, envelope_at, thickness, scale_tolerance, settings)`: the

@@ -433,3 +433,88 @@ def test_a_bad_family_is_named_and_its_exceptions_propagate():
 
     with pytest.raises(ZeroDivisionError, match="no shell"):
         voussoir.min_thickness_of_family(mesh, failing, 0.1)
+
+
+def test_springing_and_reach_set_the_joints_of_free_supports():
+    """A narrow joint lowers the greatest thrust, no joint (an infinite reach: the vertical
+    reading) raises it; each certificate, the joint's condition with the given plane and reach
+    included, recomputed from the outputs."""
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    default = voussoir.assess(mesh, 0.1, objective="max-thrust")
+    check_certificate(default, rim)
+    reach = np.zeros(len(v))
+    reach[default.joint_vertices] = 0.2 * default.joints[:, 1]
+    springing = v[:, 2] - 0.01
+    narrow = voussoir.assess(mesh, 0.1, objective="max-thrust", springing=springing, reach=reach)
+    check_certificate(narrow, rim)
+    assert narrow.thickness_scale == 1.0
+    assert np.array_equal(narrow.joint_vertices, default.joint_vertices)
+    # As given (to the rounding of the solver's unit of length).
+    assert np.allclose(narrow.joints[:, 0], springing[narrow.joint_vertices], rtol=1e-13)
+    assert np.allclose(narrow.joints[:, 1], reach[narrow.joint_vertices], rtol=1e-13)
+    assert narrow.thrust_horizontal < default.thrust_horizontal * (1 - 1e-3)
+    free = voussoir.assess(mesh, 0.1, objective="max-thrust", reach=math.inf)
+    check_certificate(free, rim)
+    assert len(free.joint_vertices) == 0 and free.worst_joint == 0.0
+    assert free.thrust_horizontal > default.thrust_horizontal * (1 + 1e-3)
+    # Without a joint the plane is not read: any springing gives the same surface.
+    other = voussoir.assess(mesh, 0.1, objective="max-thrust", springing=-5.0, reach=math.inf)
+    assert np.array_equal(other.positions, free.positions)
+    # The default joint keeps the least thrust's supports at the middle surface or above;
+    # without it they may drop towards the intrados, and the least thrust falls.
+    least = voussoir.assess(mesh, 0.1, objective="min-thrust")
+    lower = voussoir.assess(mesh, 0.1, objective="min-thrust", reach=math.inf)
+    check_certificate(lower, rim)
+    assert lower.positions[rim, 2].min() < v[rim, 2].min() - 1e-3
+    assert lower.thrust_horizontal < least.thrust_horizontal * (1 - 1e-3)
+
+
+@pytest.mark.parametrize(
+    "joints, argument, detail",
+    [
+        ({"springing": [0.0, 0.0, 0.0]}, "springing", "has 3 entries"),
+        ({"reach": np.zeros((37, 2))}, "reach", "expected (n,)"),
+        ({"reach": -0.1}, "reach", "vertex 0"),
+        ({"reach": float("nan")}, "reach", "not a number >= 0"),
+        ({"springing": float("nan")}, "springing", "must be finite"),
+        ({"springing": 5.0}, "springing", "upper bound"),
+    ],
+)
+def test_bad_springing_joints_name_the_argument(joints, argument, detail):
+    v, f, rim = dome()
+    mesh = voussoir.Mesh(v, f, rim)
+    with pytest.raises(voussoir.VoussoirError) as e:
+        voussoir.assess(mesh, 0.1, **joints)
+    message = str(e.value)
+    assert f"argument `{argument}`" in message and detail in message, message
+    assert "\n" not in message
+
+
+def test_a_family_may_give_its_springing_joints():
+    """(lower, upper, springing, reach) with the defaults spelled out (the plane at the
+    intrados, reach t / 2) gives what (lower, upper) gives; without joints the family's least
+    thickness falls."""
+    v, f, rim = dome(rings=4, angle=math.radians(85))
+    mesh = voussoir.Mesh(v, f, anchored=rim)
+    nz = vertex_normals_z(v, f)
+
+    def bounds(t):
+        return v[:, 2] - t / (2 * nz), v[:, 2] + t / (2 * nz)
+
+    plain = voussoir.min_thickness_of_family(mesh, bounds, 0.1)
+    spelled = voussoir.min_thickness_of_family(
+        mesh, lambda t: (*bounds(t), bounds(t)[0], t / 2), 0.1
+    )
+    # Equal to rounding: the default reach is the area-weighted mean of t / 2 over the faces.
+    assert spelled.thickness_min == pytest.approx(plain.thickness_min, rel=1e-9)
+    check_certificate(spelled, rim)
+    free = voussoir.min_thickness_of_family(mesh, lambda t: (*bounds(t), None, math.inf), 0.1)
+    check_certificate(free, rim)
+    assert len(free.joint_vertices) == 0
+    assert free.thickness_min < plain.thickness_min * (1 - 1e-3), (free.thickness_min,
+                                                                   plain.thickness_min)
+    with pytest.raises(voussoir.VoussoirError, match="`reach`"):
+        voussoir.min_thickness_of_family(mesh, lambda t: (*bounds(t), None, -1.0), 0.1)
+    with pytest.raises(voussoir.VoussoirError, match="pair"):
+        voussoir.min_thickness_of_family(mesh, lambda t: (*bounds(t), None), 0.1)

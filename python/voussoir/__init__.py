@@ -351,6 +351,8 @@ def assess(
     fixed_supports: bool = False,
     unit_weight: float = 1.0,
     load_pattern: Any = None,
+    springing: Any = None,
+    reach: Any = None,
     progress: Optional[Progress] = None,
     **settings: Any,
 ) -> AssessmentResult:
@@ -377,6 +379,14 @@ def assess(
             thickness; docs/method.md §16.1).
         unit_weight: weight per unit volume (>= 0; 0: the mesh's extra loads alone).
         load_pattern: (n,) downward load per vertex that "max-load" multiplies.
+        springing, reach: the springing joints of free supports (docs/method.md section
+            16.1), each one number or (n,) per vertex (read at free supports only): the
+            height of the springing plane, on or below which no free support may sit, and the
+            joint's reach, how far in plan from the support its reaction's line may meet the
+            plane. ``reach=math.inf`` drops the joint (the vertical reading: the support's
+            height bounded by the envelope alone). None keeps the envelope's default (from a
+            thickness: the plane through the middle surface's vertex, reach t / (2 |n_h|);
+            from surfaces: the intrados, half the vertex's thickness).
         progress: called as ``progress(step, infeasibility)`` after every step (1-based;
             infeasibility: the largest vertical residual over the mean load). Returning False
             stops the search (``termination == "cancelled"``); an exception it raises stops
@@ -390,7 +400,9 @@ def assess(
     Raises:
         VoussoirError: a bad envelope (thickness <= 0 or not finite, intrados above extrados,
             a surface that does not cover a vertex: the message names the vertex or face), a
-            bad setting, or a load pattern of the wrong length.
+            bad setting, a load pattern of the wrong length, or bad springing joints (a length
+            other than n, a springing height not finite or above the extrados, a reach that is
+            NaN or negative: the message names the argument and vertex).
     """
     native = _check_mesh(mesh)
     kwargs: Dict[str, Any] = dict(settings)
@@ -404,7 +416,14 @@ def assess(
         if np.ndim(thickness) == 0:
             uniform = float(t[0])
     fields = _native.assess(
-        native, t, _surface("intrados", intrados), _surface("extrados", extrados), kwargs, progress
+        native,
+        t,
+        _surface("intrados", intrados),
+        _surface("extrados", extrados),
+        kwargs,
+        progress,
+        springing=_floats("springing", springing),
+        reach=_floats("reach", reach),
     )
     least = None if uniform is None else fields["thickness_scale"] * uniform
     return AssessmentResult._from_native(fields, least)
@@ -430,7 +449,9 @@ def min_thickness_of_family(
     Args:
         mesh: the vault; its plan is the form diagram.
         envelope_at: called with a thickness t, returns ``(lower, upper)``, the (n,) intrados
-            and extrados heights per vertex of that thickness.
+            and extrados heights per vertex of that thickness, or ``(lower, upper, springing,
+            reach)`` with the springing joints of that thickness too (as for `assess`; None
+            keeps the default: the plane at `lower`, half of t).
         thickness: the first thickness tried (the vault's own, say).
         scale_tolerance: the search ends when the least scale lies in [1 - this, 1].
         fixed_supports, unit_weight, **settings: as for `assess`.
@@ -449,15 +470,18 @@ def min_thickness_of_family(
     if not callable(envelope_at):
         raise VoussoirError("argument `envelope_at`: is not callable")
 
-    def member(t: float) -> Tuple[np.ndarray, np.ndarray]:
+    def member(t: float) -> Tuple[Optional[np.ndarray], ...]:
         answer = envelope_at(t)
         try:
-            lower, upper = answer
-        except (TypeError, ValueError):
+            parts = tuple(answer)
+        except TypeError:
+            parts = ()
+        if len(parts) not in (2, 4):
             raise VoussoirError(
-                f"argument `envelope_at`: envelope_at({t}) did not return a pair (lower, upper)"
-            ) from None
-        return _floats("envelope_at", lower), _floats("envelope_at", upper)
+                f"argument `envelope_at`: envelope_at({t}) did not return a pair (lower, upper) or "
+                "(lower, upper, springing, reach)"
+            )
+        return tuple(_floats("envelope_at", part) for part in parts)
 
     kwargs: Dict[str, Any] = dict(settings)
     kwargs.update(fixed_supports=fixed_supports, unit_weight=unit_weight)

@@ -1,6 +1,6 @@
 """Type stub of the native module (python/src). Use the wrappers in `voussoir` instead."""
 
-from typing import Any, Callable, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -82,10 +82,12 @@ def assess(
     settings: Dict[str, Any],
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
     report: Optional[Tuple[Optional[str], Optional[str], Optional[str]]] = ...,
+    springing: Optional[np.ndarray] = ...,
+    reach: Optional[np.ndarray] = ...,
 ) -> Dict[str, Any]: ...
 def min_thickness_of_family(
     mesh: Mesh,
-    envelope_at: Callable[[float], Tuple[np.ndarray, np.ndarray]],
+    envelope_at: Callable[[float], Tuple[Optional[np.ndarray], ...]],
     thickness: float,
     scale_tolerance: float,
     settings: Dict[str, Any],

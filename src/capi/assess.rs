@@ -4,8 +4,8 @@
 
 use super::assessment::VsrAssessment;
 use super::boundary::{
-    boundary, checked_len, copy_out, free, from_error, give, handle, input, out_ptr, CResult,
-    Failure,
+    boundary, checked_len, copy_out, free, from_error, give, handle, handle_mut, input, out_ptr,
+    CResult, Failure,
 };
 use super::enum_args;
 use super::mesh::VsrMesh;
@@ -19,8 +19,9 @@ use std::ffi::c_void;
 /// Opaque handle: the masonry's envelope over a mesh's plan, per vertex an intrados (lower)
 /// and an extrados (upper) height and per face the thickness whose weight loads the vault.
 /// Create with `vsr_envelope_from_thickness` or `vsr_envelope_from_surfaces`, free with
-/// `vsr_envelope_destroy`. Immutable: a `const VsrEnvelope*` may be read from several threads
-/// at once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
+/// `vsr_envelope_destroy`. `vsr_envelope_set_springing` changes its springing joints;
+/// nothing else changes it, and a `const VsrEnvelope*` may be read from several threads at
+/// once. It belongs to the mesh it was made for (`vsr_assess` checks the sizes).
 pub struct VsrEnvelope {
     pub(crate) envelope: Envelope,
 }
@@ -252,6 +253,85 @@ pub unsafe extern "C" fn vsr_envelope_face_thickness(
 ) -> VsrStatus {
     // SAFETY: forwarded caller's contract.
     boundary!({ unsafe { copy_envelope(envelope, out, len, needed, |e| &e.face_thickness) } })
+}
+
+/// Height of the springing plane per vertex, #V doubles, read at free supports (see
+/// `vsr_envelope_set_springing` for its meaning and defaults).
+///
+/// # Safety
+/// `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_envelope_springing(
+    envelope: *const VsrEnvelope,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy_envelope(envelope, out, len, needed, |e| &e.springing) } })
+}
+
+/// Reach of the springing joint per vertex, #V doubles (`INFINITY` where there is no joint),
+/// read at free supports (see `vsr_envelope_set_springing`).
+///
+/// # Safety
+/// `envelope`: a valid handle; `out`: NULL or `len` writable doubles; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_envelope_reach(
+    envelope: *const VsrEnvelope,
+    out: *mut f64,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({ unsafe { copy_envelope(envelope, out, len, needed, |e| &e.reach) } })
+}
+
+/// Sets the springing joints (docs/method.md §16.1), read at the free supports (those whose
+/// height the assessment chooses; not with fixed supports): per vertex the height of the
+/// springing plane and the joint's reach, #V doubles each (copied; entries at other vertices
+/// are checked but not read). A free support lies on or above its plane, and its reaction's
+/// line of action, followed down to the plane, meets it within `reach` (in plan) of the
+/// support's plan point. A reach of `INFINITY` drops the joint: the support's height is then
+/// bounded by the envelope alone (the vertical reading). Defaults: from a thickness, the
+/// plane through the middle surface's vertex and reach t / (2 |n_h|) (the slab's horizontal
+/// section, n_h the normal's plan part); from surfaces, the plane at the intrados and half
+/// the vertex's thickness.
+///
+/// Errors: NULL arguments (`VSR_STATUS_NULL_POINTER`); a length other than the mesh's vertex
+/// count, a springing height that is not finite or lies above the extrados, a reach that is
+/// NaN or < 0 (`VSR_STATUS_INVALID_ARGUMENT`, naming the argument and the vertex). The
+/// envelope is unchanged on failure.
+///
+/// # Safety
+/// `envelope`: a valid handle with exclusive access; `springing`: `n_springing` readable
+/// doubles; `reach`: `n_reach` readable doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_envelope_set_springing(
+    envelope: *mut VsrEnvelope,
+    springing: *const f64,
+    n_springing: usize,
+    reach: *const f64,
+    n_reach: usize,
+) -> VsrStatus {
+    boundary!({
+        // SAFETY: caller's contract.
+        let e = unsafe { handle_mut("envelope", envelope)? };
+        // SAFETY: caller's contract.
+        let (springing, reach) = unsafe {
+            (
+                input("springing", springing, n_springing)?,
+                input("reach", reach, n_reach)?,
+            )
+        };
+        let changed = (e.envelope.clone())
+            .with_springing(springing.to_vec(), reach.to_vec())
+            .map_err(|err| from_error("springing", err))?;
+        e.envelope = changed;
+        Ok(())
+    })
 }
 
 /// Opaque handle: the options of `vsr_assess`. Create with `vsr_assess_settings_create`

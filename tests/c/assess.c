@@ -76,6 +76,34 @@ int main(void) {
     EXPECT(vsr_envelope_lower(envelope, buffer, 64, &needed), VSR_STATUS_OK, "");
     TRUE(needed == 5 && fabs(buffer[4] - 0.25) < 1e-12);
 
+    /* Springing joints: NULL, wrong length, a negative reach (named with its vertex); the
+     * envelope keeps its joints; then no joint (an infinite reach) read back, and the
+     * defaults restored. */
+    {
+        double springing[5], reach[5], bad[5], back[5];
+        EXPECT(vsr_envelope_springing(envelope, springing, 5, &needed), VSR_STATUS_OK, "");
+        EXPECT(vsr_envelope_reach(envelope, reach, 5, &needed), VSR_STATUS_OK, "");
+        TRUE(needed == 5 && springing[0] == buffer[0] && reach[0] > 0 && isfinite(reach[0]));
+        EXPECT(vsr_envelope_set_springing(NULL, springing, 5, reach, 5), VSR_STATUS_NULL_POINTER,
+               "envelope");
+        EXPECT(vsr_envelope_set_springing(envelope, NULL, 5, reach, 5), VSR_STATUS_NULL_POINTER,
+               "springing");
+        EXPECT(vsr_envelope_set_springing(envelope, springing, 4, reach, 5),
+               VSR_STATUS_INVALID_ARGUMENT, "springing");
+        memcpy(bad, reach, sizeof bad);
+        bad[3] = -1.0;
+        EXPECT(vsr_envelope_set_springing(envelope, springing, 5, bad, 5),
+               VSR_STATUS_INVALID_ARGUMENT, "reach");
+        TRUE(strstr(vsr_last_error_message(), "vertex 3") != NULL);
+        EXPECT(vsr_envelope_reach(envelope, back, 5, &needed), VSR_STATUS_OK, "");
+        TRUE(memcmp(back, reach, sizeof back) == 0);
+        for (i = 0; i < 5; ++i) bad[i] = INFINITY;
+        EXPECT(vsr_envelope_set_springing(envelope, springing, 5, bad, 5), VSR_STATUS_OK, "");
+        EXPECT(vsr_envelope_reach(envelope, back, 5, &needed), VSR_STATUS_OK, "");
+        TRUE(isinf(back[0]) && isinf(back[4]));
+        EXPECT(vsr_envelope_set_springing(envelope, springing, 5, reach, 5), VSR_STATUS_OK, "");
+    }
+
     /* Settings: NULL, bad enums, NaN, out of range; the previous values stay. */
     EXPECT(vsr_assess_settings_create(NULL), VSR_STATUS_NULL_POINTER, "out");
     EXPECT(vsr_assess_settings_create(&settings), VSR_STATUS_OK, "");
