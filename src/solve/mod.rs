@@ -260,8 +260,8 @@ pub fn form_find(
     }
 }
 
-/// Form finding after a small edit, started from `previous`, a result on the same mesh (same
-/// vertices, faces and edges): the same answer as [`form_find`] on the edited problem (the
+/// Form finding after a small edit (docs/method.md §13.4), started from `previous`, a result
+/// on the same mesh (same vertices, faces and edges): the same answer as [`form_find`] on the edited problem (the
 /// nearest self-supporting shape to `problem`'s heights as they are now, the same tolerance,
 /// terminations and best-state rule), reached in fewer stress steps where the edit is small.
 ///
@@ -285,7 +285,7 @@ pub fn form_find(
 ///
 /// The nearest shape is a local optimum: a cold run and a warm one of the same edited
 /// problem may end at different ones (measured on the shared models: the warm answer within
-/// 4.1% of the cold one's RMS change and mostly nearer, in 35–70% of its stress steps).
+/// 4.1% of the cold one's RMS change and mostly nearer, in 37–77% of its stress steps).
 ///
 /// Errors: [`crate::Error::InvalidArgument`] for `previous` when its vertex or edge count or
 /// its faces differ from `problem`'s mesh, or a height of it is not finite; for `method`
