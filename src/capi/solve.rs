@@ -90,7 +90,7 @@ pub unsafe extern "C" fn vsr_form_find(
 /// `vsr_mesh_create`). Reused: `previous`'s heights as the start (anchored vertices at their
 /// heights in `mesh`), its force densities, and its nearest method's penalty state and stress
 /// solver cache (taken by the first re-solve from `previous`; later ones build their own).
-/// See docs/solver.md, "Warm re-solve after an edit".
+/// See docs/method.md §13.4.
 ///
 /// Errors: `VSR_STATUS_INVALID_ARGUMENT` naming `previous` when it comes from `vsr_analyse`,
 /// when its vertex or edge count or its triangles differ from `mesh`'s, or when a height of
