@@ -227,3 +227,21 @@ fn an_unedited_problem_resolves_in_fewer_steps() {
         previous.iterations
     );
 }
+
+/// A previous result whose input hung (read upside down) is re-solved from scratch, as a cold
+/// run of the edited problem: the same answer, mirrored.
+#[test]
+fn a_hanging_input_is_resolved_from_scratch() {
+    let settings = FormFindSettings::default();
+    let dome = generate::cap_dome(1.0, 300).unwrap();
+    let heights: Vec<f64> = dome.positions().iter().map(|p| -p[2]).collect();
+    let problem = Problem::new(dome.with_heights(&heights).unwrap());
+    let previous = form_find(&problem, &settings, None).unwrap();
+    assert!(previous.mirrored);
+    let edited = moved(&problem);
+    let warm = form_find_from(&edited, &settings, &previous, None).unwrap();
+    let cold = form_find(&edited, &settings, None).unwrap();
+    assert!(warm.mirrored && warm.termination == Termination::Converged);
+    assert_eq!(warm.iterations, cold.iterations);
+    assert_eq!(warm.positions, cold.positions);
+}
