@@ -88,7 +88,7 @@ pkg-config --modversion voussoir
 flags=$(pkg-config --cflags --libs voussoir)
 libdir=$(pkg-config --variable=libdir voussoir)
 mkdir -p "$work/pkgconfig"
-for prog in examples/c/dome.c tests/c/hostile.c tests/c/assess.c; do
+for prog in examples/c/dome.c tests/c/hostile.c tests/c/assess.c tests/c/warm.c; do
   exe="$work/pkgconfig/$(basename "$prog" .c)"
   # shellcheck disable=SC2086
   cc -std=c11 -Wall -Wextra -Wpedantic -Werror "$prog" -o "$exe" $flags -lm -Wl,-rpath,"$libdir"

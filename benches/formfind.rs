@@ -5,6 +5,8 @@
 //!     cargo bench --bench formfind -- --models      # shared models only
 //!     cargo bench --bench formfind -- --seeds 5     # more seeds per known-answer case
 //!     cargo bench --bench formfind -- --large       # also the 97k-vertex dome
+//!     cargo bench --bench formfind -- --warm        # warm re-solves only
+//!     cargo bench --bench formfind -- --warm lilium # ... of the models whose names contain it
 //!
 //! Known-answer cases: a self-supporting vault (the truth, `generate::self_supporting`) is
 //! perturbed (`generate::perturb`); the truth is a feasible answer for the perturbed input, so
@@ -16,7 +18,10 @@ mod models;
 
 use std::time::Instant;
 use voussoir::generate::{self, KnownPlan, Perturbation};
-use voussoir::{form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem, QpSolver};
+use voussoir::{
+    form_find, form_find_from, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem,
+    QpSolver,
+};
 
 /// Area-weighted RMS and largest height difference between two position sets of `mesh`,
 /// non-anchored vertices only (plan area shares as weights), computed here independently of
@@ -212,6 +217,89 @@ fn models(large: bool) {
     }
 }
 
+/// The non-anchored vertex nearest the plan centroid of the referenced vertices.
+fn central_vertex(mesh: &Mesh) -> usize {
+    let referenced: Vec<usize> = (0..mesh.positions().len())
+        .filter(|&v| mesh.referenced()[v])
+        .collect();
+    let n = referenced.len() as f64;
+    let c = referenced.iter().fold([0.0; 2], |c, &v| {
+        let p = mesh.positions()[v];
+        [c[0] + p[0] / n, c[1] + p[1] / n]
+    });
+    let d = |v: usize| {
+        let p = mesh.positions()[v];
+        (p[0] - c[0]).hypot(p[1] - c[1])
+    };
+    (referenced.into_iter())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+        .expect("a non-anchored vertex")
+}
+
+/// The two edits of the warm table: the central vertex raised by 1% of the plan diagonal, and
+/// one more support (the lowest-numbered free vertex beside one).
+fn edits(problem: &Problem) -> [(&'static str, Problem); 2] {
+    let mesh = &problem.mesh;
+    let v = central_vertex(mesh);
+    let mut heights: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
+    heights[v] += 0.01 * plan_diagonal(mesh);
+    let mut moved = problem.clone();
+    moved.mesh = mesh.clone().with_heights(&heights).expect("heights");
+    let s = (0..mesh.positions().len())
+        .find(|&v| {
+            mesh.is_non_anchored(v)
+                && mesh.edges_at(v).iter().any(|&e| {
+                    let [a, b] = mesh.edges()[e as usize].v;
+                    mesh.anchored()[a as usize] || mesh.anchored()[b as usize]
+                })
+        })
+        .expect("a free vertex beside a support");
+    let mut anchored = mesh.anchored_ids();
+    anchored.push(s as u32);
+    let mut supported = problem.clone();
+    supported.mesh =
+        Mesh::new(mesh.positions().to_vec(), mesh.faces().to_vec(), &anchored).expect("mesh");
+    [("1% vertex", moved), ("+1 support", supported)]
+}
+
+/// Warm re-solves (`form_find_from`) from the cold answer after each edit, against a cold
+/// form finding of the edited problem: seconds over one cold stress step of the input, stress
+/// steps and RMS changes.
+fn warm(large: bool, only: Option<&str>) {
+    println!("\nWarm re-solve after an edit, default settings (\"/ cold step\": seconds over one cold stress step of the input)\n");
+    println!("| model | V | cold step s | edit | warm end | warm steps | warm solvers | warm s | warm / cold step | cold steps | cold / cold step | warm RMS | cold RMS |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let s = FormFindSettings::default();
+    for (name, problem) in model_list(large) {
+        if only.is_some_and(|o| !name.contains(o)) {
+            continue;
+        }
+        let (cold_step, _) = cold_step(&problem);
+        let previous = form_find(&problem, &s, None).expect("form finding");
+        for (edit, edited) in edits(&problem) {
+            let t = Instant::now();
+            let w = form_find_from(&edited, &s, &previous, None).expect("warm re-solve");
+            let warm_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let c = form_find(&edited, &s, None).expect("form finding");
+            let cold_s = t.elapsed().as_secs_f64();
+            println!(
+                "| {name} | {} | {cold_step:.4} | {edit} | {} | {} | {} | {warm_s:.2} | {:.1} | {} | {:.1} | {:.4} | {:.4} |",
+                problem.mesh.positions().len(),
+                outcome(&w),
+                w.iterations,
+                solver_counts(&w),
+                warm_s / cold_step,
+                c.iterations,
+                cold_s / cold_step,
+                w.rms_change,
+                c.rms_change,
+            );
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let has = |f: &str| args.iter().any(|a| a == f);
@@ -221,11 +309,17 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .and_then(|s| s.parse().ok())
         .unwrap_or(2);
+    if let Some(i) = args.iter().position(|a| a == "--warm") {
+        let only = args.get(i + 1).filter(|a| !a.starts_with("--"));
+        warm(has("--large"), only.map(String::as_str));
+        return;
+    }
     let (only_known, only_models) = (has("--known"), has("--models"));
     if !only_models {
         known(seeds, &[400, 1500]);
     }
     if !only_known {
         models(has("--large"));
+        warm(has("--large"), None);
     }
 }

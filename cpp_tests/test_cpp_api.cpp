@@ -530,6 +530,48 @@ TEST(CppApi, FormFindingEqualsTheCApiBitForBit) {
     EXPECT_FALSE(r.termination_message().empty());
 }
 
+// A warm re-solve after raising one free vertex by 1% of the plan diagonal: converged, in
+// equilibrium, supports where the edited mesh has them, in fewer stress steps than a cold form
+// finding of the edited mesh; a previous result of another mesh is refused naming `previous`.
+TEST(CppApi, AWarmResolveAfterAnEditTakesFewerSteps) {
+    const vsrt::MeshData m = vsrt::generated("disk_cap");
+    const voussoir::Settings settings;
+    const voussoir::Result previous = voussoir::form_find(vsrt::make_mesh(m), settings);
+    ASSERT_TRUE(previous.termination().converged());
+    vsrt::MeshData edited = m;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (std::size_t v = 0; v < m.n_vertices(); ++v)
+        for (int d = 0; d < 2; ++d) {
+            lo[d] = std::min(lo[d], m.positions[3 * v + d]);
+            hi[d] = std::max(hi[d], m.positions[3 * v + d]);
+        }
+    std::size_t free_vertex = 0;
+    while (std::find(m.anchored.begin(), m.anchored.end(), free_vertex) != m.anchored.end())
+        ++free_vertex;
+    edited.positions[3 * free_vertex + 2] += 0.01 * std::hypot(hi[0] - lo[0], hi[1] - lo[1]);
+    const voussoir::Mesh mesh = vsrt::make_mesh(edited);
+    const voussoir::Result warm = voussoir::form_find_from(mesh, settings, previous);
+    const voussoir::Result cold = voussoir::form_find(mesh, settings);
+    ASSERT_TRUE(warm.termination().converged()) << warm.termination_message();
+    ASSERT_TRUE(cold.termination().converged()) << cold.termination_message();
+    EXPECT_LT(warm.termination().iterations, cold.termination().iterations);
+    EXPECT_LT(warm.stress_summary().eps_inf, 1e-6);
+    const std::vector<double> p = warm.positions();
+    for (uint32_t a : edited.anchored) EXPECT_EQ(p[3 * a + 2], edited.positions[3 * a + 2]);
+
+    voussoir::Result untouched;
+    const voussoir::Mesh square(kPositions, kTriangles, kAnchored);
+    EXPECT_EQ(voussoir::try_form_find_from(square, settings, previous, untouched),
+              VSR_STATUS_INVALID_ARGUMENT);
+    EXPECT_FALSE(untouched);
+    try {
+        (void)voussoir::form_find_from(square, settings, previous);
+        ADD_FAILURE() << "another mesh was accepted";
+    } catch (const voussoir::Error &e) {
+        EXPECT_NE(std::string(e.what()).find("`previous`"), std::string::npos) << e.what();
+    }
+}
+
 TEST(CppApi, AHangingMeshIsReadUpsideDown) {
     std::vector<double> hanging = kPositions;
     hanging[14] = -0.3;  // the apex below the supports' plane

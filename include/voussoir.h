@@ -1553,6 +1553,31 @@ VsrStatus vsr_analyse(const struct VsrMesh *mesh, const struct VsrSettings *sett
 VsrStatus vsr_form_find(const struct VsrMesh *mesh, const struct VsrSettings *settings, struct VsrResult **out);
 
 /**
+ * Form finding after a small edit, started from `previous`, a result of `vsr_form_find` or
+ * `vsr_form_find_from` on a mesh with the same vertices and triangles: the same answer as
+ * `vsr_form_find` on `mesh` (the nearest self-supporting shape to its heights as they are
+ * now, with the same tolerance, terminations and best state), in fewer stress steps where
+ * the edit is small. Between the calls the heights of any vertices, the anchored vertices,
+ * the loads and every setting but the method may change (build the edited mesh with
+ * `vsr_mesh_create`). Reused: `previous`'s heights as the start (anchored vertices at their
+ * heights in `mesh`), its force densities, and its nearest method's penalty state and stress
+ * solver cache (taken by the first re-solve from `previous`; later ones build their own).
+ * See docs/method.md §13.4.
+ *
+ * Errors: `VSR_STATUS_INVALID_ARGUMENT` naming `previous` when it comes from `vsr_analyse`,
+ * when its vertex or edge count or its triangles differ from `mesh`'s, or when a height of
+ * it is not finite; naming `method` when `settings` ask for the paper's loop. Otherwise as
+ * `vsr_form_find`: `out` receives a new result owned by the caller, untouched on failure;
+ * `mesh`, `settings` and `previous` are only read (`previous` stays valid and unchanged
+ * but for the cache it lends).
+ *
+ * # Safety
+ * `mesh`, `settings`, `previous`: valid handles; `out` writable; the callback and its `user`
+ * pointer valid for the duration of the call.
+ */
+VsrStatus vsr_form_find_from(const struct VsrMesh *mesh, const struct VsrSettings *settings, const struct VsrResult *previous, struct VsrResult **out);
+
+/**
  * The envelope of a masonry of thickness `thickness` about the mesh as middle surface:
  * `n_thickness` is 1 (a uniform thickness) or the mesh's face count (one per face, in the
  * order of its triangles). The masonry extends t/2 to either side along the unit vertex

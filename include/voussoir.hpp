@@ -858,6 +858,32 @@ inline Result form_find(const Mesh &mesh, const Settings &settings = Settings())
     return result;
 }
 
+/// Form finding after a small edit, started from `previous` (vsr_form_find_from): the same
+/// answer as form_find(mesh, settings), in fewer stress steps where `mesh` differs from the
+/// one `previous` was found on by a few heights, supports, loads or settings (same vertices
+/// and triangles; not the paper's loop). `previous` stays valid. Errors and the progress
+/// callback as form_find; the try_ twin returns the status.
+[[nodiscard]] inline VsrStatus try_form_find_from(const Mesh &mesh, const Settings &settings,
+                                                  const Result &previous, Result &out) noexcept {
+    VsrResult *raw = nullptr;
+    detail::progress_exception() = nullptr;
+    const VsrStatus status = vsr_form_find_from(mesh.get(), settings.get(), previous.get(), &raw);
+    detail::progress_exception() = nullptr;
+    if (status == VSR_STATUS_OK) out = Result(raw);
+    return status;
+}
+inline Result form_find_from(const Mesh &mesh, const Settings &settings,
+                             const Result &previous) {
+    VsrResult *raw = nullptr;
+    detail::progress_exception() = nullptr;
+    const VsrStatus status = vsr_form_find_from(mesh.get(), settings.get(), previous.get(), &raw);
+    Result result(raw);
+    if (std::exception_ptr thrown = std::exchange(detail::progress_exception(), nullptr))
+        std::rethrow_exception(thrown);
+    check(status);
+    return result;
+}
+
 /// Masonry assessment (vsr_assess): a compression-only thrust surface in equilibrium with the
 /// envelope's self-weight, between intrados and extrados, optimal for the settings'
 /// objective. A search that certifies none is not an error: read Assessment::outcome().

@@ -48,7 +48,9 @@ pub use mesh::{BoundaryLoop, Edge, Mesh, Side, MAX_COORDINATE, MIN_PLAN_EXTENT};
 pub use problem::Problem;
 pub use shape::Schedule;
 pub use solid::{signed_volume, thicken, Solid, Thickness};
-pub use solve::{form_find, FormFindResult, FormFindSettings, FormMethod, Progress, Termination};
+pub use solve::{
+    form_find, form_find_from, FormFindResult, FormFindSettings, FormMethod, Progress, Termination,
+};
 pub use stress::airy::HoleMode;
 pub use stress::{
     analyse, EdgeScope, Formulation, QBound, QpSolver, StressResult, StressSettings, StressStatus,

@@ -23,6 +23,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("VoussoirError", m.py().get_type::<errors::VoussoirError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<mesh::Mesh>()?;
+    m.add_class::<solve::Warm>()?;
     m.add("WELD_TOLERANCE", voussoir::io::DEFAULT_WELD_TOLERANCE)?;
     m.add("REPAIR_TOLERANCE", voussoir::DEFAULT_REPAIR_TOLERANCE)?;
     m.add_function(wrap_pyfunction!(settings::defaults, m)?)?;

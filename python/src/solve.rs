@@ -87,17 +87,34 @@ fn progress_step(
     Ok(answer.is_none() || answer.is_truthy()?)
 }
 
+/// A form-finding result kept whole for a warm re-solve (`form_find(..., start=...)`): the
+/// penalty state and solver cache that the Python fields do not carry.
+#[pyclass(frozen, module = "voussoir._voussoir")]
+pub struct Warm {
+    pub result: voussoir::FormFindResult,
+}
+
 /// Form finding; `progress(iteration, eps_inf)` is called after every stress step. The
-/// library's JSON report is added under "report" when `report` is true.
+/// library's JSON report is added under "report" when `report` is true. With `start` (the
+/// "_warm" field of an earlier result), a warm re-solve from it (`voussoir::form_find_from`).
 #[pyfunction]
-#[pyo3(signature = (mesh, settings=None, progress=None, report=false))]
+#[pyo3(signature = (mesh, settings=None, progress=None, report=false, start=None))]
 pub fn form_find<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, Mesh>,
     settings: Option<&Bound<'py, PyDict>>,
     progress: Option<Bound<'py, PyAny>>,
     report: bool,
+    start: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let start: Option<Bound<'py, Warm>> = match start.filter(|s| !s.is_none()) {
+        None => None,
+        Some(s) => Some(
+            s.cast_into::<Warm>()
+                .map_err(|_| invalid("start", "is not a result of form_find (a FormFindResult)"))?,
+        ),
+    };
+    let previous = start.as_ref().map(|w| &w.get().result);
     let form = settings_of(settings)?;
     if let Some(p) = &progress {
         if !p.is_none() && !p.is_callable() {
@@ -117,17 +134,27 @@ pub fn form_find<'py>(
                 }
             })
         };
-        voussoir::form_find(m.problem(), &form, Some(&mut hook))
+        match previous {
+            Some(p) => voussoir::form_find_from(m.problem(), &form, p, Some(&mut hook)),
+            None => voussoir::form_find(m.problem(), &form, Some(&mut hook)),
+        }
     })?;
     if let Some(e) = raised {
         return Err(e);
     }
-    let found = found.map_err(|e| from_error("mesh", e))?;
+    let found = found.map_err(|e| match e {
+        voussoir::Error::InvalidArgument {
+            name: "previous",
+            reason,
+        } => invalid("start", reason),
+        e => from_error("mesh", e),
+    })?;
     let d = results::form_found(py, &m.problem().mesh, &found)?;
     if report {
         let run = voussoir::report::Run::FormFinding(&found);
         d.set_item("report", Report::new(&m.model, &form, run).to_json())?;
     }
+    d.set_item("_warm", Warm { result: found })?;
     Ok(d)
 }
 

@@ -112,6 +112,8 @@ class FormFindResult(StressResult):
     stress_seconds: float = 0.0
     shape_seconds: float = 0.0
     total_seconds: float = 0.0
+    _warm: Any = dataclasses.field(default=None, repr=False, compare=False)
+    """The whole native result, for a warm re-solve (``form_find(..., start=result)``)."""
 
     @property
     def converged(self) -> bool:

@@ -73,6 +73,7 @@ def form_find(
     settings: Optional[Dict[str, Any]] = ...,
     progress: Optional[Callable[[int, float], Optional[bool]]] = ...,
     report: bool = ...,
+    start: Optional[Any] = ...,
 ) -> Dict[str, Any]: ...
 def assess(
     mesh: Mesh,

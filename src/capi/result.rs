@@ -53,6 +53,20 @@ impl VsrResult {
         }
     }
 
+    /// The form finding this result holds, for the argument `name` of a warm re-solve.
+    pub(crate) fn form_found(&self, name: &str) -> CResult<&FormFindResult> {
+        match &self.outcome {
+            Outcome::FormFinding(f) => Ok(f),
+            Outcome::Analysis { .. } => Err(Failure::new(
+                VsrStatus::InvalidArgument,
+                format!(
+                    "argument `{name}`: a warm re-solve starts from a result of vsr_form_find, \
+                     and this one comes from vsr_analyse"
+                ),
+            )),
+        }
+    }
+
     fn form(&self, what: &str) -> CResult<&FormFindResult> {
         match &self.outcome {
             Outcome::FormFinding(f) => Ok(f),

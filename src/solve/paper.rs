@@ -166,6 +166,7 @@ pub(super) fn paper_within(
             mirrored: false,
             stress_seconds: stress_s,
             shape_seconds: shape_s,
+            warm: None,
         },
         start,
     ))
