@@ -215,7 +215,7 @@ pub struct AssessResult {
     /// least thickness scale at which one was found (above 1: the envelope is too thin), and
     /// the vertex where that surface leaves the given envelope the most. None otherwise.
     pub needed_scale: Option<(f64, Option<u32>)>,
-    /// Wall time, seconds.
+    /// Wall time of the whole analysis (its start included), seconds.
     pub seconds: f64,
 }
 
@@ -233,10 +233,13 @@ pub fn assess(
     progress: Option<&mut Progress>,
 ) -> Result<AssessResult> {
     settings.validate()?;
+    let start = std::time::Instant::now();
     let model = model::Model::new(problem, envelope, settings)?;
     let (from, fit_iterations) = feasible_start(problem, envelope, settings)?;
     let mut run = sqp::solve(&model, settings, progress, from, sqp::Until::Optimal)?;
     run.iterations += fit_iterations;
+    // The start's search counts, as its steps do.
+    run.seconds = start.elapsed().as_secs_f64();
     let mut result = model.certify(run, settings);
     let cancelled = result.termination == Termination::Cancelled;
     if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {

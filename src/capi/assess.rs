@@ -26,6 +26,17 @@ pub struct VsrEnvelope {
     pub(crate) envelope: Envelope,
 }
 
+/// The core's error about an envelope's input, with `VSR_STATUS_NON_FINITE` where a value
+/// is NaN or infinite (as the envelope functions document).
+fn envelope_error(arg: &str, e: crate::Error) -> Failure {
+    let non_finite = crate::validate::is_not_finite(&e);
+    let mut failure = from_error(arg, e);
+    if non_finite {
+        failure.status = VsrStatus::NonFinite;
+    }
+    failure
+}
+
 /// The envelope of a masonry of thickness `thickness` about the mesh as middle surface:
 /// `n_thickness` is 1 (a uniform thickness) or the mesh's face count (one per face, in the
 /// order of its triangles). The masonry extends t/2 to either side along the unit vertex
@@ -68,7 +79,8 @@ pub unsafe extern "C" fn vsr_envelope_from_thickness(
                 ))
             }
         };
-        let envelope = Envelope::from_thickness(m, &t).map_err(|e| from_error("thickness", e))?;
+        let envelope =
+            Envelope::from_thickness(m, &t).map_err(|e| envelope_error("thickness", e))?;
         // SAFETY: `out` checked above, writable by the caller's contract.
         unsafe { give(out, VsrEnvelope { envelope }) }
     })
@@ -174,7 +186,7 @@ pub unsafe extern "C" fn vsr_envelope_from_surfaces(
             (&lower.0, &lower.1),
             (&upper.0, &upper.1),
         )
-        .map_err(|e| from_error("intrados", e))?;
+        .map_err(|e| envelope_error("intrados", e))?;
         // SAFETY: `out` checked above, writable by the caller's contract.
         unsafe { give(out, VsrEnvelope { envelope }) }
     })

@@ -322,12 +322,10 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
     let (status, arg) = match &e {
         // Its own wording starts "invalid argument `name`": said once.
         InvalidArgument { name, reason } => {
-            let status = if crate::validate::is_not_finite(&e) {
-                VsrStatus::NonFinite
-            } else {
-                VsrStatus::InvalidArgument
-            };
-            return Failure::new(status, format!("argument `{name}`: {reason}"));
+            return Failure::new(
+                VsrStatus::InvalidArgument,
+                format!("argument `{name}`: {reason}"),
+            )
         }
         EmptyMesh => (VsrStatus::EmptyMesh, "positions"),
         IndexOutOfRange { .. } => (VsrStatus::IndexOutOfRange, "triangles"),
