@@ -94,6 +94,23 @@ pub struct Warm {
     pub result: voussoir::FormFindResult,
 }
 
+/// Immutable, so copies share it (`copy`, `dataclasses.asdict`); a pickled result drops it
+/// (the solver state lives in this process), becoming a result without a warm start.
+#[pymethods]
+impl Warm {
+    fn __copy__(slf: PyRef<'_, Self>) -> PyRef<'_, Self> {
+        slf
+    }
+
+    fn __deepcopy__<'py>(slf: PyRef<'py, Self>, _memo: &Bound<'py, PyAny>) -> PyRef<'py, Self> {
+        slf
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, ())> {
+        Ok((py.None().into_bound(py).get_type().into_any(), ()))
+    }
+}
+
 /// Form finding; `progress(iteration, eps_inf)` is called after every stress step. The
 /// library's JSON report is added under "report" when `report` is true. With `start` (the
 /// "_warm" field of an earlier result), a warm re-solve from it (`voussoir::form_find_from`).

@@ -95,3 +95,24 @@ def test_what_does_not_fit_is_refused() -> None:
         voussoir.form_find(dome(), start=voussoir.analyse(dome()))
     with pytest.raises(voussoir.VoussoirError, match="argument `method`"):
         voussoir.form_find(dome(), start=previous, method="paper")
+
+
+def test_a_result_copies_and_pickles_with_its_warm_state_or_without_it():
+    """Copies (``copy``, ``dataclasses.asdict``) share the immutable warm state and still
+    start a warm re-solve; a pickled result keeps its fields but not the process's solver
+    state, and is refused as a start naming ``start``."""
+    import copy
+    import dataclasses
+    import pickle
+
+    mesh = dome()
+    first = voussoir.form_find(mesh)
+    for twin in (copy.copy(first), copy.deepcopy(first)):
+        again = voussoir.form_find(mesh, start=twin)
+        assert again.termination == "converged"
+    fields = dataclasses.asdict(first)
+    assert np.array_equal(fields["positions"], first.positions)
+    back = pickle.loads(pickle.dumps(first))
+    assert np.array_equal(back.positions, first.positions) and back._warm is None
+    with pytest.raises(voussoir.VoussoirError, match="argument `start`: .*unpickled"):
+        voussoir.form_find(mesh, start=back)

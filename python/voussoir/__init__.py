@@ -338,7 +338,8 @@ def form_find(
     if start is not None:
         warm = getattr(start, "_warm", None) if isinstance(start, FormFindResult) else None
         if warm is None:
-            raise VoussoirError("argument `start`: is not a result of form_find (a FormFindResult)")
+            raise VoussoirError("argument `start`: is not a result of form_find in this process "
+                                "(a FormFindResult; an unpickled one carries no warm state)")
     fields = _native.form_find(_check_mesh(mesh), settings, progress, False, warm)
     return FormFindResult._from_native(fields)
 
