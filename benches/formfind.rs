@@ -217,31 +217,11 @@ fn models(large: bool) {
     }
 }
 
-/// The non-anchored vertex nearest the plan centroid of the referenced vertices.
-fn central_vertex(mesh: &Mesh) -> usize {
-    let referenced: Vec<usize> = (0..mesh.positions().len())
-        .filter(|&v| mesh.referenced()[v])
-        .collect();
-    let n = referenced.len() as f64;
-    let c = referenced.iter().fold([0.0; 2], |c, &v| {
-        let p = mesh.positions()[v];
-        [c[0] + p[0] / n, c[1] + p[1] / n]
-    });
-    let d = |v: usize| {
-        let p = mesh.positions()[v];
-        (p[0] - c[0]).hypot(p[1] - c[1])
-    };
-    (referenced.into_iter())
-        .filter(|&v| mesh.is_non_anchored(v))
-        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
-        .expect("a non-anchored vertex")
-}
-
 /// The two edits of the warm table: the central vertex raised by 1% of the plan diagonal, and
 /// one more support (the lowest-numbered free vertex beside one).
 fn edits(problem: &Problem) -> [(&'static str, Problem); 2] {
     let mesh = &problem.mesh;
-    let v = central_vertex(mesh);
+    let v = models::central_vertex(mesh);
     let mut heights: Vec<f64> = mesh.positions().iter().map(|p| p[2]).collect();
     heights[v] += 0.01 * plan_diagonal(mesh);
     let mut moved = problem.clone();

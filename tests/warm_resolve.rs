@@ -5,7 +5,7 @@
 //! (area-weighted RMS height change measured here), in fewer stress steps.
 
 mod common;
-use common::{load_model, plan_diagonal, recomputed_eps_inf};
+use common::{central_vertex, load_model, plan_diagonal, recomputed_eps_inf};
 use voussoir::generate::{self, KnownPlan, Perturbation};
 use voussoir::*;
 
@@ -32,26 +32,6 @@ fn rms_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
         total += share[v];
     }
     (sum / total).sqrt()
-}
-
-/// The non-anchored vertex nearest the plan centroid of the referenced vertices.
-fn central_vertex(mesh: &Mesh) -> usize {
-    let referenced: Vec<usize> = (0..mesh.positions().len())
-        .filter(|&v| mesh.referenced()[v])
-        .collect();
-    let n = referenced.len() as f64;
-    let c = referenced.iter().fold([0.0; 2], |c, &v| {
-        let p = mesh.positions()[v];
-        [c[0] + p[0] / n, c[1] + p[1] / n]
-    });
-    let d = |v: usize| {
-        let p = mesh.positions()[v];
-        (p[0] - c[0]).hypot(p[1] - c[1])
-    };
-    (referenced.into_iter())
-        .filter(|&v| mesh.is_non_anchored(v))
-        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
-        .expect("a non-anchored vertex")
 }
 
 /// `problem` with the input height of `central_vertex` raised by 1% of the plan diagonal.

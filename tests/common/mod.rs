@@ -4,7 +4,7 @@
 
 mod models;
 #[allow(unused_imports)] // each test binary uses its own part
-pub use models::{find_models, models_dir, models_required, MODELS};
+pub use models::{central_vertex, find_models, models_dir, models_required, MODELS};
 use voussoir::generate::{self, Domain};
 use voussoir::Mesh;
 

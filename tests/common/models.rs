@@ -60,3 +60,23 @@ pub fn find_models(dir: PathBuf, required: bool) -> Option<PathBuf> {
     println!("skipped: {} not found", dir.display());
     None
 }
+
+/// The non-anchored vertex nearest the plan centroid of the referenced vertices.
+pub fn central_vertex(mesh: &voussoir::Mesh) -> usize {
+    let referenced: Vec<usize> = (0..mesh.positions().len())
+        .filter(|&v| mesh.referenced()[v])
+        .collect();
+    let n = referenced.len() as f64;
+    let c = referenced.iter().fold([0.0; 2], |c, &v| {
+        let p = mesh.positions()[v];
+        [c[0] + p[0] / n, c[1] + p[1] / n]
+    });
+    let d = |v: usize| {
+        let p = mesh.positions()[v];
+        (p[0] - c[0]).hypot(p[1] - c[1])
+    };
+    (referenced.into_iter())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+        .expect("a non-anchored vertex")
+}
