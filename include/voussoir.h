@@ -1810,9 +1810,10 @@ VsrStatus vsr_assess_settings_set_tolerance(struct VsrAssessSettings *settings, 
 VsrStatus vsr_assess_settings_set_max_iterations(struct VsrAssessSettings *settings, size_t max_iterations);
 
 /**
- * Sets the progress callback of `vsr_assess` (a `VsrProgressFn`, called once per step with
- * the 1-based step and, in place of ε∞, the infeasibility of the state reached: its largest
- * vertical residual over the mean load) and the `user` pointer passed back to it unchanged.
+ * Sets the progress callback of `vsr_assess` (a `VsrProgressFn`, called once per step, the
+ * steps of its start and of its `needed_scale` search included, with the 1-based step and,
+ * in place of ε∞, the infeasibility of the state reached: its largest vertical residual over
+ * the mean load) and the `user` pointer passed back to it unchanged.
  * A non-zero return cancels (`VSR_TERMINATION_CANCELLED`). `callback` NULL removes it
  * (default: none). As `vsr_settings_set_progress` otherwise.
  *

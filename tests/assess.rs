@@ -351,6 +351,8 @@ fn cancelling_returns_a_state_with_its_termination() {
     let result = assess(&problem, &envelope, &settings, Some(&mut cancel)).unwrap();
     assert_eq!(result.termination, Termination::Cancelled);
     assert_eq!(calls, 3);
+    // The start's steps are seen and counted as well: the analysis ends after three.
+    assert_eq!(result.iterations, 3);
     assert_eq!(result.positions.len(), problem.mesh.positions().len());
 }
 

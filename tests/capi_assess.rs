@@ -799,22 +799,10 @@ fn the_progress_callback_sees_each_step_and_can_cancel() {
     assert!(seen.iter().all(|s| s.1.is_finite() && s.1 >= 0.0));
     let (mut f, mut t, mut i, mut sec) = (0, VsrTermination::Converged, 0, 0.0);
     assert_ok(unsafe { vsr_assessment_outcome(a, &mut f, &mut t, &mut i, &mut sec) });
-    // The search starts from the first certified surface of fit's search (found without the
-    // callback, which runs on to its optimum): its steps count too.
-    let env = Envelope::from_thickness(&rust_mesh(&d), &Thickness::Uniform(0.1)).unwrap();
-    let fit = assess(
-        &Problem::new(rust_mesh(&d)),
-        &env,
-        &AssessSettings::default(),
-        None,
-    )
-    .unwrap();
+    // The callback sees the start's steps too (the first certified surface of fit's
+    // search), numbered with the main search's as one sequence: three steps in all.
     assert_eq!(t, VsrTermination::Cancelled);
-    assert!(
-        i > 3 && i < 3 + fit.iterations,
-        "{i} steps, fit {}",
-        fit.iterations
-    );
+    assert_eq!(i, 3);
     unsafe {
         vsr_assessment_destroy(a);
         vsr_assess_settings_destroy(s);

@@ -406,7 +406,8 @@ def assess(
             height bounded by the envelope alone). None keeps the envelope's default (from a
             thickness: the plane through the middle surface's vertex, reach t / (2 |n_h|);
             from surfaces: the intrados, half the vertex's thickness).
-        progress: called as ``progress(step, infeasibility)`` after every step (1-based;
+        progress: called as ``progress(step, infeasibility)`` after every step, the start's
+            and the ``needed_scale`` search's included (1-based, one sequence;
             infeasibility: the largest vertical residual over the mean load). Returning False
             stops the search (``termination == "cancelled"``); an exception it raises stops
             it too and propagates.

@@ -226,6 +226,10 @@ pub struct AssessResult {
 /// replaced by the envelope's thickness × `unit_weight` on the middle surface. Without a
 /// certified surface the result has `feasible == false` with the best state reached (least
 /// infeasibility) and where it fails.
+///
+/// `progress` sees every step, those of the start's `fit` search and of the search for
+/// [`AssessResult::needed_scale`] included, numbered as one sequence; returning false
+/// cancels the analysis (during the `needed_scale` search: that figure alone is left out).
 pub fn assess(
     problem: &Problem,
     envelope: &Envelope,
@@ -234,30 +238,66 @@ pub fn assess(
 ) -> Result<AssessResult> {
     settings.validate()?;
     let start = std::time::Instant::now();
+    let mut steps = Steps {
+        progress,
+        before: 0,
+    };
     let model = model::Model::new(problem, envelope, settings)?;
-    let (from, fit_iterations) = feasible_start(problem, envelope, settings)?;
-    let mut run = sqp::solve(&model, settings, progress, from, sqp::Until::Optimal)?;
-    run.iterations += fit_iterations;
+    let begun = feasible_start(problem, envelope, settings, &mut steps)?;
+    let mut run = match begun {
+        Some(run) if run.termination == Termination::Cancelled => {
+            sqp::stopped(&model, settings, run)
+        }
+        begun => {
+            let from = begun.map(|run| run.state);
+            steps.search(|p| sqp::solve(&model, settings, p, from, sqp::Until::Optimal))?
+        }
+    };
+    run.iterations = steps.before;
     // The start's search counts, as its steps do.
     run.seconds = start.elapsed().as_secs_f64();
     let mut result = model.certify(run, settings);
     let cancelled = result.termination == Termination::Cancelled;
     if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {
-        result.needed_scale = needed_scale(problem, envelope, settings)?;
+        result.needed_scale = needed_scale(problem, envelope, settings, &mut steps)?;
     }
     Ok(result)
 }
 
-/// For every analysis but `fit`: the `fit` search's answer, a surface inside the envelope
-/// (when one is found), to start from, so that the objective is pursued from equilibrium
-/// rather than traded against it; and the steps it took.
+/// The caller's progress callback across successive searches, their steps numbered as one
+/// sequence.
+struct Steps<'p, 'a> {
+    progress: Option<&'p mut Progress<'a>>,
+    /// Steps taken by the searches so far.
+    before: usize,
+}
+
+impl Steps<'_, '_> {
+    /// Runs one search with the callback shifted by the steps before it.
+    fn search(
+        &mut self,
+        run: impl FnOnce(Option<&mut Progress>) -> Result<model::Run>,
+    ) -> Result<model::Run> {
+        let before = self.before;
+        let mut shifted =
+            (self.progress.as_deref_mut()).map(|p| move |k: usize, eps: f64| p(before + k, eps));
+        let done = run(shifted.as_mut().map(|f| f as &mut Progress))?;
+        self.before += done.iterations;
+        Ok(done)
+    }
+}
+
+/// For every analysis but `fit`: the `fit` search's run up to its first certified surface
+/// inside the envelope (when one is found), to start from, so that the objective is
+/// pursued from equilibrium rather than traded against it.
 fn feasible_start(
     problem: &Problem,
     envelope: &Envelope,
     settings: &AssessSettings,
-) -> Result<(Option<model::State>, usize)> {
+    steps: &mut Steps,
+) -> Result<Option<model::Run>> {
     if settings.objective == Objective::Fit {
-        return Ok((None, 0));
+        return Ok(None);
     }
     let fit = AssessSettings {
         objective: Objective::Fit,
@@ -265,8 +305,8 @@ fn feasible_start(
         ..settings.clone()
     };
     let model = model::Model::new(problem, envelope, &fit)?;
-    let run = sqp::solve(&model, &fit, None, None, sqp::Until::Certified)?;
-    Ok((Some(run.state), run.iterations))
+    let run = steps.search(|p| sqp::solve(&model, &fit, p, None, sqp::Until::Certified))?;
+    Ok(Some(run))
 }
 
 /// The least thickness scale with a certified surface, and where that surface leaves the
@@ -275,14 +315,21 @@ fn needed_scale(
     problem: &Problem,
     envelope: &Envelope,
     settings: &AssessSettings,
+    steps: &mut Steps,
 ) -> Result<Option<(f64, Option<u32>)>> {
     let thinnest = AssessSettings {
         objective: Objective::MinThickness,
         ..settings.clone()
     };
     let model = model::Model::new(problem, envelope, &thinnest)?;
-    let (from, _) = feasible_start(problem, envelope, &thinnest)?;
-    let run = sqp::solve(&model, &thinnest, None, from, sqp::Until::Optimal)?;
+    let from = match feasible_start(problem, envelope, &thinnest, steps)? {
+        Some(run) if run.termination == Termination::Cancelled => return Ok(None),
+        begun => begun.map(|run| run.state),
+    };
+    let run = steps.search(|p| sqp::solve(&model, &thinnest, p, from, sqp::Until::Optimal))?;
+    if run.termination == Termination::Cancelled {
+        return Ok(None);
+    }
     let found = model.certify(run, &thinnest);
     if !found.feasible {
         return Ok(None);

@@ -94,6 +94,18 @@ pub(super) fn solve(
     })
 }
 
+/// The answer of a search cancelled before its first step: `run`'s state (a search's on the
+/// same mesh and supports) with `model`'s scalar at its start.
+pub(super) fn stopped(model: &Model, settings: &AssessSettings, run: Run) -> Run {
+    let mut search = Search::new(model, settings);
+    search.restart_from(run.state);
+    Run {
+        state: search.answer(),
+        termination: Termination::Cancelled,
+        ..run
+    }
+}
+
 enum Outcome {
     Continue,
     Stationary,
