@@ -485,7 +485,12 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
     fs::write(dir.path("small.obj"), obj_text(&small, &d.triangles)).unwrap();
     fs::write(dir.path("short.json"), "{\"loads\": [1, 2, 3]}").unwrap();
     fs::write(dir.path("far.json"), "{\"loads\": {\"99\": 1}}").unwrap();
-    let cases: [(&[&str], &str); 16] = [
+    assert_eq!(
+        dome().anchored[0],
+        25,
+        "the messages name the first support"
+    );
+    let cases: [(&[&str], &str); 20] = [
         (
             &["--thickness", "0"],
             "--thickness: expected a thickness > 0",
@@ -551,6 +556,22 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
             &["--thickness", "density"],
             "--thickness density needs --unit-weight",
         ),
+        (
+            &["--thickness", "0.1", "--reach", "-1"],
+            "--reach: vertex 25 has -1, not a number >= 0",
+        ),
+        (
+            &["--thickness", "0.1", "--reach", "nan"],
+            "--reach: expected a length or `inf`",
+        ),
+        (
+            &["--thickness", "0.1", "--springing", "5"],
+            "--springing: vertex 25 has 5: it must be finite and at most the upper bound",
+        ),
+        (
+            &["--thickness", "0.1", "--reach", "inf", "--fixed-supports"],
+            "--reach sets the joint of free supports: it does not go with --fixed-supports",
+        ),
     ];
     let before = dir.snapshot();
     for (extra, message) in cases {
@@ -591,6 +612,40 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
     let (code, err) = run_dome(&dir, &["--thickness", "0.1"]);
     assert_eq!(code, 2);
     assert!(err.contains("--thickness needs --assess"), "{err}");
+}
+
+/// `--springing` and `--reach` set the joint of every free support: the report's joints
+/// carry them, and `--reach inf` drops the joints (the supports read vertically).
+#[test]
+fn springing_and_reach_set_the_joint_of_every_free_support() {
+    let supports = dome().anchored.len();
+    let joints = |extra: &[&str]| -> Vec<Value> {
+        let dir = with_dome("assess-joint");
+        let mut args = vec!["--assess", "min-thrust", "--thickness", "0.1"];
+        args.extend_from_slice(extra);
+        let (code, err) = run_dome(&dir, &args);
+        assert_eq!(code, 0, "{extra:?}: {err}");
+        let r = read_json(&dir.path("r.json"));
+        check_certificate(&dir.path("t.obj"), &r);
+        r["assessment"]["joints"]
+            .as_array()
+            .expect("joints")
+            .clone()
+    };
+    let default = joints(&[]);
+    assert_eq!(default.len(), supports);
+    let set = joints(&["--springing", "-0.02", "--reach", "0.03"]);
+    assert_eq!(set.len(), supports);
+    for j in set.iter().chain(&default) {
+        assert!(j["offset"].as_f64().expect("offset") <= j["reach"].as_f64().unwrap() + 1e-9);
+    }
+    for j in &set {
+        let (springing, reach) = (j["springing"].as_f64(), j["reach"].as_f64());
+        assert!((springing.unwrap() + 0.02).abs() < 1e-12, "{j}");
+        assert!((reach.unwrap() - 0.03).abs() < 1e-12, "{j}");
+    }
+    assert_ne!(default[0]["reach"], set[0]["reach"]);
+    assert!(joints(&["--reach", "inf"]).is_empty());
 }
 
 /// The dome with its crown vertex pushed below its neighbours: under a downward load no

@@ -108,6 +108,14 @@ Assessment (instead of form finding; MESH is the masonry's middle surface):
   --unit-weight W        weight per unit volume: self-weight = area x thickness x W      [1]
   --fixed-supports       keep the supports at MESH's heights (by default the thrust meets
                          each support anywhere within the envelope)
+  --springing Z          free supports: the springing plane's height at every support; the
+                         support lies on or above it, and its reaction's line of action,
+                         followed down to it, meets it within the reach   [the intrados,
+                         or the middle surface's height with --thickness]
+  --reach B              free supports: the springing joint's reach (half its width), a
+                         length, at every support; `inf`: no joint, the support's height
+                         bounded by the envelope alone   [half the vertex's thickness, read
+                         horizontally: T / (2 |n_h|) with --thickness]
   --load-pattern L.json  max-load: a downward load per vertex of MESH (ids before welding;
                          loads of merged vertices add): {{\"loads\": [..]}}, [..] or
                          {{\"loads\": {{\"ID\": load, ..}}}}

@@ -149,23 +149,17 @@ fn envelope(
     }
 }
 
-/// Per-vertex values from a number (the same at every vertex) or an (n,) array; `None`
-/// keeps `default`. Not checked here: `Envelope::with_springing` checks them.
+/// Per-vertex values from an (n,) array; `None` or a number (applied at the supports by
+/// `with_joints`) keeps `default`. Not checked here: `Envelope::with_springing` checks them.
 fn per_vertex(
     name: &str,
     value: Option<&PyReadonlyArrayDyn<'_, f64>>,
     default: &[f64],
 ) -> PyResult<Vec<f64>> {
-    let Some(a) = value else {
-        return Ok(default.to_vec());
-    };
-    match a.shape().len() {
-        0 => Ok(vec![
-            a.as_array().iter().copied().next().unwrap_or(0.0);
-            default.len()
-        ]),
-        1 => Ok(a.as_array().iter().copied().collect()),
-        _ => Err(invalid(
+    match value.map(|a| (a.shape().len(), a)) {
+        None | Some((0, _)) => Ok(default.to_vec()),
+        Some((1, a)) => Ok(a.as_array().iter().copied().collect()),
+        Some((_, a)) => Err(invalid(
             name,
             format_args!(
                 "has shape {}, expected (n,) or a number",
@@ -175,16 +169,28 @@ fn per_vertex(
     }
 }
 
-/// The envelope with the springing joints given (each a number or one per vertex; the
-/// envelope's own where `None`).
+/// The value of a 0-d array.
+fn number(value: Option<&PyReadonlyArrayDyn<'_, f64>>) -> Option<f64> {
+    value
+        .filter(|a| a.shape().is_empty())
+        .and_then(|a| a.as_array().iter().copied().next())
+}
+
+/// The envelope with the springing joints given: a number holds at every support of `mesh`
+/// (`Envelope::with_joint_at_supports`), an array gives one value per vertex; `None` keeps
+/// the envelope's own.
 fn with_joints(
     env: Envelope,
+    mesh: &voussoir::Mesh,
     springing: Option<&PyReadonlyArrayDyn<'_, f64>>,
     reach: Option<&PyReadonlyArrayDyn<'_, f64>>,
 ) -> PyResult<Envelope> {
     if springing.is_none() && reach.is_none() {
         return Ok(env);
     }
+    let env = env
+        .with_joint_at_supports(mesh, number(springing), number(reach))
+        .map_err(|e| from_error("springing", e))?;
     let s = per_vertex("springing", springing, &env.springing)?;
     let r = per_vertex("reach", reach, &env.reach)?;
     env.with_springing(s, r)
@@ -218,7 +224,7 @@ pub fn assess<'py>(
     let s = settings_from(settings)?;
     let m: &Mesh = mesh.get();
     let (env, uniform) = envelope(&m.problem().mesh, thickness, intrados, extrados)?;
-    let env = with_joints(env, springing.as_ref(), reach.as_ref())?;
+    let env = with_joints(env, &m.problem().mesh, springing.as_ref(), reach.as_ref())?;
     if let Some(p) = &progress {
         if !p.is_none() && !p.is_callable() {
             return Err(invalid("progress", "is not callable"));
@@ -343,7 +349,7 @@ fn family_member(
     let env = Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
         .map_err(|e| from_error("envelope_at", e))?;
     match parts.get(2..4) {
-        Some([springing, reach]) => with_joints(env, springing.as_ref(), reach.as_ref()),
+        Some([springing, reach]) => with_joints(env, mesh, springing.as_ref(), reach.as_ref()),
         _ => Ok(env),
     }
 }

@@ -338,6 +338,60 @@ def test_both_command_lines_take_the_unit_weight_range_from_the_library(files, f
         assert not (files / "bad.obj").exists()
 
 
+@pytest.mark.parametrize("extra, message", [
+    (["--reach", "-1"], "has -1, not a number >= 0"),
+    (["--reach", "nan"], "--reach: expected a length or `inf`"),
+    (["--springing", "5"], "has 5: it must be finite and at most the upper bound"),
+    (["--reach", "inf", "--fixed-supports"],
+     "--reach sets the joint of free supports: it does not go with --fixed-supports"),
+])
+def test_both_command_lines_check_the_springing_joint_alike(files, formfind, extra, message):
+    """--springing and --reach are checked by the library (`Envelope::with_springing`)."""
+    for command in ([formfind], [sys.executable, "-m", "voussoir"]):
+        run = subprocess.run(
+            [*command, "dome.obj", "--supports", "dome.json", "--assess", "min-thrust",
+             "--thickness", "0.1", *extra, "--out", "bad.obj"],
+            cwd=files, capture_output=True, text=True,
+        )
+        assert run.returncode == 2 and message in run.stderr, (command, run.stderr)
+        assert not (files / "bad.obj").exists()
+
+
+@pytest.mark.parametrize("extra", [["--springing", "-0.02", "--reach", "0.03"],
+                                   ["--reach", "inf"]])
+def test_both_command_lines_set_the_springing_joint_at_every_support(files, formfind, extra):
+    """The same joint at every support in both command lines and in `assess`: the same
+    thrust surface, its joints carrying the values given (none with an infinite reach)."""
+    runs = [subprocess.run([*cmd, "dome.obj", "--supports", "dome.json", "--assess",
+                            "min-thrust", "--thickness", "0.1", *extra, "--out", f"{name}.obj",
+                            "--report", f"{name}.json"],
+                           cwd=files, capture_output=True, text=True)
+            for name, cmd in (("rust", [formfind]), ("py", [sys.executable, "-m", "voussoir"]))]
+    for r in runs:
+        assert r.returncode == 0, r.stderr
+    py, rust = read_obj_vertices(files / "py.obj"), read_obj_vertices(files / "rust.obj")
+    assert np.array_equal(py, rust)
+    joints = [json.loads((files / f"{n}.json").read_text())["assessment"]["joints"]
+              for n in ("py", "rust")]
+    assert joints[0] == joints[1]
+    v, f, rim = dome()
+    values = dict(zip(extra[::2], extra[1::2]))
+    if values.get("--reach") == "inf":
+        assert joints[0] == []
+    else:
+        assert sorted(j["vertex"] for j in joints[0]) == sorted(rim)
+        for j in joints[0]:
+            assert j["springing"] == pytest.approx(-0.02, abs=1e-12)
+            assert j["reach"] == pytest.approx(0.03, abs=1e-12)
+            assert j["offset"] <= j["reach"] + 1e-9
+    mesh = voussoir.Mesh(v, f, rim)
+    library = voussoir.assess(mesh, 0.1, objective="min-thrust",
+                              springing=float(values.get("--springing", "nan"))
+                              if "--springing" in values else None,
+                              reach=float(values["--reach"]))
+    assert np.array_equal(library.positions, rust)
+
+
 def test_both_command_lines_read_surfaces_and_load_patterns_alike(files, formfind):
     """--intrados, --extrados and --load-pattern are read by the library's `io::read_surface`
     and `io::read_load_pattern` in both command lines: the same answer, the same errors."""
@@ -475,7 +529,7 @@ def test_springing_and_reach_set_the_joints_of_free_supports():
     [
         ({"springing": [0.0, 0.0, 0.0]}, "springing", "has 3 entries"),
         ({"reach": np.zeros((37, 2))}, "reach", "expected (n,)"),
-        ({"reach": -0.1}, "reach", "vertex 0"),
+        ({"reach": -0.1}, "reach", "vertex 25"),  # the first support: a number holds there
         ({"reach": float("nan")}, "reach", "not a number >= 0"),
         ({"springing": float("nan")}, "springing", "must be finite"),
         ({"springing": 5.0}, "springing", "upper bound"),

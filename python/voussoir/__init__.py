@@ -399,7 +399,8 @@ def assess(
         unit_weight: weight per unit volume (>= 0; 0: the mesh's extra loads alone).
         load_pattern: (n,) downward load per vertex that "max-load" multiplies.
         springing, reach: the springing joints of free supports (docs/method.md section
-            16.1), each one number or (n,) per vertex (read at free supports only): the
+            16.1), each one number (at every support) or (n,) per vertex (read at free
+            supports only): the
             height of the springing plane, on or below which no free support may sit, and the
             joint's reach, how far in plan from the support its reaction's line may meet the
             plane. ``reach=math.inf`` drops the joint (the vertical reading: the support's

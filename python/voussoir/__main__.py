@@ -141,6 +141,12 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--extrados", type=Path, help="and the extrados as a mesh file")
     a.add_argument("--unit-weight", type=float, help="weight per unit volume [1]")
     a.add_argument("--fixed-supports", action="store_true", help="keep the supports at MESH's heights")
+    a.add_argument("--springing", type=float,
+                   help="free supports: the springing plane's height at every support [the "
+                   "intrados; the middle surface's height with --thickness]")
+    a.add_argument("--reach",
+                   help="free supports: the springing joint's reach (half its width) at every "
+                   "support, or `inf` (no joint) [half the vertex's thickness, horizontally]")
     a.add_argument("--load-pattern", type=Path,
                    help='max-load: {"loads": [..]}, [..] or {"loads": {"ID": load}}, ids of MESH\'s own vertices')
     return p
@@ -248,7 +254,8 @@ def _write_all(files: Sequence[Tuple[Path, Any]]) -> None:
                 os.remove(temp)
 
 
-ASSESS_ONLY = ("thickness", "intrados", "extrados", "unit_weight", "load_pattern")
+ASSESS_ONLY = ("thickness", "intrados", "extrados", "unit_weight", "load_pattern", "springing",
+               "reach")
 FORM_FINDING_ONLY = ("stress_only", "fairness", "max_height_change", "solver", "qp", "qmin_scope",
                      "qmax", "tau", "holes", "dual_smoothing", "smoothing_decay", "odt")
 
@@ -265,6 +272,10 @@ def _check_assess(a: argparse.Namespace) -> None:
     for name in FORM_FINDING_ONLY:
         if getattr(a, name) not in (None, False):
             raise Failure(f"{flag(name)} is an option of form finding, not of --assess")
+    joint = next((n for n in ("springing", "reach") if getattr(a, n) is not None), None)
+    if a.fixed_supports and joint:
+        raise Failure(f"{flag(joint)} sets the joint of free supports: it does not go with "
+                      "--fixed-supports")
     if a.thickness is None and (a.intrados is None or a.extrados is None):
         raise Failure("--assess needs the masonry's envelope: --thickness T, or --intrados A --extrados B")
     if a.thickness is not None and (a.intrados or a.extrados):
@@ -279,6 +290,19 @@ def _check_assess(a: argparse.Namespace) -> None:
         raise Failure("--assess max-load needs --load-pattern L.json (the load to multiply)"
                       if a.assess == "max-load" else
                       f"--load-pattern goes with --assess max-load, not with --assess {a.assess}")
+
+
+def _reach(a: argparse.Namespace) -> Optional[float]:
+    """--reach: a length (its range is the library's) or `inf`."""
+    if a.reach is None:
+        return None
+    try:
+        b = float(a.reach)
+    except ValueError:
+        b = math.nan
+    if math.isnan(b):
+        raise Failure(f"--reach: expected a length or `inf`, got `{a.reach}`")
+    return b
 
 
 def _thickness(a: argparse.Namespace) -> float:
@@ -344,7 +368,9 @@ def run_assess(a: argparse.Namespace) -> int:
         envelope = ((np.array([thickness]), None, None) if thickness is not None
                     else (None, _surface("--intrados", a.intrados, a.up), _surface("--extrados", a.extrados, a.up)))
         # The natives, asked for the library's report (the formfind example's schema).
-        fields = _native.assess(mesh._native, *envelope, settings, None, files)
+        joint = {name: None if value is None else np.array(value)
+                 for name, value in (("springing", a.springing), ("reach", _reach(a)))}
+        fields = _native.assess(mesh._native, *envelope, settings, None, files, **joint)
     except voussoir.VoussoirError as e:
         raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
     least = None if thickness is None else fields["thickness_scale"] * thickness

@@ -236,6 +236,24 @@ impl Envelope {
         Ok(self)
     }
 
+    /// This envelope with one springing height and one reach at every support of `mesh`
+    /// (`None` keeps the envelope's own), the values the joints of free supports read; as
+    /// [`Envelope::with_springing`] otherwise (its errors name the support).
+    pub fn with_joint_at_supports(
+        self,
+        mesh: &Mesh,
+        springing: Option<f64>,
+        reach: Option<f64>,
+    ) -> Result<Envelope> {
+        crate::validate::one_per_vertex("mesh", mesh.positions.len(), self.lower.len())?;
+        let (mut s, mut r) = (self.springing.clone(), self.reach.clone());
+        for v in mesh.anchored_ids() {
+            s[v as usize] = springing.unwrap_or(s[v as usize]);
+            r[v as usize] = reach.unwrap_or(r[v as usize]);
+        }
+        self.with_springing(s, r)
+    }
+
     /// Positions of the middle surface over the mesh's plan.
     pub fn middle_positions(&self, mesh: &Mesh) -> Vec<[f64; 3]> {
         (mesh.positions.iter().zip(&self.middle))

@@ -20,6 +20,10 @@ pub struct AssessOptions {
     pub fixed_supports: bool,
     pub load_pattern: Option<PathBuf>,
     pub section: Option<Section>,
+    /// `--springing Z`: the springing plane's height at every free support.
+    pub springing: Option<f64>,
+    /// `--reach B`: the springing joint's reach at every free support (`inf`: none).
+    pub reach: Option<f64>,
 }
 
 /// The vertical plane of the section picture: `axis` = `at` (`None`: the plan's centre).
@@ -63,7 +67,7 @@ const FORM_FINDING_ONLY: [&str; 15] = [
 ];
 
 /// The options that only an assessment uses.
-const ASSESSMENT_ONLY: [&str; 7] = [
+const ASSESSMENT_ONLY: [&str; 9] = [
     "--thickness",
     "--intrados",
     "--extrados",
@@ -71,6 +75,8 @@ const ASSESSMENT_ONLY: [&str; 7] = [
     "--fixed-supports",
     "--load-pattern",
     "--section",
+    "--springing",
+    "--reach",
 ];
 
 fn positive(flag: &str, text: &str) -> Result<f64, String> {
@@ -147,6 +153,15 @@ pub fn flag(
         "--fixed-supports" => a.fixed_supports = true,
         "--load-pattern" => a.load_pattern = Some(value()?.into()),
         "--section" => a.section = Some(section(&value()?)?),
+        "--springing" => a.springing = Some(crate::args::number(flag, &value()?)?),
+        // `inf` drops the joint; the range (>= 0) is the core's (`Envelope::with_springing`).
+        "--reach" => {
+            let text = value()?;
+            a.reach = Some(match text.trim().parse::<f64>() {
+                Ok(b) if !b.is_nan() => b,
+                _ => return Err(format!("--reach: expected a length or `inf`, got `{text}`")),
+            });
+        }
         _ => return Ok(false),
     }
     Ok(true)
@@ -182,6 +197,16 @@ pub fn check(o: &Options, given: &[String]) -> Result<(), String> {
         }
         (None, Some(_), None) => return Err("--intrados needs --extrados B".into()),
         (None, None, Some(_)) => return Err("--extrados needs --intrados A".into()),
+    }
+    if a.fixed_supports {
+        if let Some(f) = ["--springing", "--reach"]
+            .iter()
+            .find(|f| given.iter().any(|g| g == *f))
+        {
+            return Err(format!(
+                "{f} sets the joint of free supports: it does not go with --fixed-supports"
+            ));
+        }
     }
     let density_thickness = a.thickness == Some(SolidThickness::FromDensity);
     match a.unit_weight {

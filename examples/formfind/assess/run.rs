@@ -31,6 +31,8 @@ pub fn message(e: &voussoir::Error, fallback: &str) -> String {
                 "unit_weight" => "--unit-weight",
                 "fixed_supports" => "--fixed-supports",
                 "load_pattern" => "--load-pattern",
+                "springing" => "--springing",
+                "reach" => "--reach",
                 "q_min" => "--qmin",
                 "tolerance" => "--tol",
                 "max_iterations" => "--max-iter",
@@ -47,8 +49,21 @@ fn surface(flag: &str, path: &Path, up: UpAxis) -> Result<io::RawMesh, String> {
     io::read_surface(path, up).map_err(|e| format!("{flag}: {e}"))
 }
 
-/// The envelope of `--thickness` or `--intrados` / `--extrados` over the model's plan.
+/// The envelope of `--thickness` or `--intrados` / `--extrados` over the model's plan, with
+/// the springing joint of `--springing` and `--reach` at the supports.
 pub fn envelope(model: &Model, o: &Options) -> Result<Envelope, String> {
+    let envelope = bounds(model, o)?;
+    let a = &o.assess;
+    if a.springing.is_none() && a.reach.is_none() {
+        return Ok(envelope);
+    }
+    envelope
+        .with_joint_at_supports(model.mesh(), a.springing, a.reach)
+        .map_err(|e| message(&e, "--springing"))
+}
+
+/// The envelope of `--thickness` or `--intrados` / `--extrados` over the model's plan.
+fn bounds(model: &Model, o: &Options) -> Result<Envelope, String> {
     let a = &o.assess;
     if let Some(thickness) = crate::assess::args::thickness(o) {
         return Envelope::from_thickness(model.mesh(), &thickness)
