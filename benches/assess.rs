@@ -25,6 +25,10 @@
 
 #[path = "../tests/common/models.rs"]
 mod models;
+#[path = "../tests/common/assess.rs"]
+mod shells;
+
+use shells::{barrel, hemisphere_by_angle};
 
 use voussoir::{
     assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
@@ -69,6 +73,7 @@ fn hemispheres() {
     for rings in [6, 10, 14, 20] {
         let mesh = hemisphere(rings);
         for objective in [
+            Objective::Fit,
             Objective::MinThickness,
             Objective::MinThrust,
             Objective::MaxThrust,
@@ -127,31 +132,6 @@ fn shell_family(
     Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
 }
 
-/// A semicircular barrel of unit radius and depth 0.1, its voussoirs equal in angle.
-fn barrel(nx: usize, ny: usize) -> Mesh {
-    let points: Vec<[f64; 2]> = (0..=ny)
-        .flat_map(|j| {
-            (0..=nx).map(move |i| {
-                [
-                    -(std::f64::consts::PI * i as f64 / nx as f64).cos(),
-                    0.1 * j as f64 / ny as f64,
-                ]
-            })
-        })
-        .collect();
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let faces: Vec<[u32; 3]> = (0..ny)
-        .flat_map(|j| {
-            (0..nx).flat_map(move |i| {
-                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                [[a, b, c], [a, c, d]]
-            })
-        })
-        .collect();
-    let height = |u: [f64; 2]| (1.0 - u[0] * u[0]).max(0.0).sqrt();
-    generate::lift(&points, &faces, height, |u, _| u[0].abs() > 1.0 - 1e-9).unwrap()
-}
-
 fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classical: f64) {
     let problem = Problem::new(mesh.clone());
     let settings = AssessSettings::default();
@@ -169,25 +149,6 @@ fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classic
         ),
         Err(e) => println!("| {name} | {} | error: {e} |", mesh.positions().len()),
     }
-}
-
-/// A hemisphere whose rings are equally spaced in the meridian's angle (plan radius sin φ),
-/// so that the steep rows near the springing are as fine as the crown's.
-fn hemisphere_by_angle(rings: usize) -> Mesh {
-    let (p, t) = generate::polar_disk(rings);
-    let p: Vec<[f64; 2]> = (p.iter())
-        .map(|&[x, y]| {
-            let r = x.hypot(y);
-            let s = if r > 0.0 {
-                (0.5 * std::f64::consts::PI * r).sin() / r
-            } else {
-                0.0
-            };
-            [x * s, y * s]
-        })
-        .collect();
-    let height = |u: [f64; 2]| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt();
-    generate::lift(&p, &t, height, |_, outer| outer).unwrap()
 }
 
 fn heyman() {

@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::assess::{check_certificate, shell};
+
 use voussoir::generate::{self, KnownPlan};
 use voussoir::{
     assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error, Mesh,
@@ -38,66 +40,6 @@ fn shifted_envelope(mesh: &Mesh, below: f64, above: f64) -> Envelope {
 
 fn run(mesh: Mesh, envelope: &Envelope, settings: AssessSettings) -> AssessResult {
     assess(&Problem::new(mesh), envelope, &settings, None).unwrap()
-}
-
-/// Recomputes the certificate from the outputs alone: residuals from positions, force
-/// densities and loads over the mesh's edges; q ≥ 0; heights within the reported bounds,
-/// which are the envelope's scaled about its middle by the reported scale.
-fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, tolerance: f64) {
-    assert!(r.feasible, "not certified: {:?}", r.termination);
-    let n = mesh.positions().len();
-    let mut residual = vec![0.0; n];
-    for (e, edge) in mesh.edges().iter().enumerate() {
-        let [i, j] = edge.v.map(|v| v as usize);
-        let q = r.force_densities[e];
-        assert!(q >= 0.0, "edge {e} in tension: q = {q}");
-        let dz = r.positions[i][2] - r.positions[j][2];
-        residual[i] += q * dz;
-        residual[j] -= q * dz;
-    }
-    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored()[v]).collect();
-    let mean = free.iter().map(|&v| r.loads[v]).sum::<f64>() / free.len() as f64;
-    let eps = free
-        .iter()
-        .map(|&v| (residual[v] - r.loads[v]).abs() / mean)
-        .fold(0.0, f64::max);
-    assert!(eps < tolerance, "recomputed eps_inf {eps:e}");
-    assert!(
-        (eps - r.eps_inf).abs() <= 1e-9,
-        "{eps:e} vs {:e}",
-        r.eps_inf
-    );
-    let diag = plan_diagonal(mesh);
-    for v in 0..n {
-        let (m, h) = (
-            envelope.middle[v],
-            0.5 * (envelope.upper[v] - envelope.lower[v]),
-        );
-        let (lo, hi) = (m - r.thickness_scale * h, m + r.thickness_scale * h);
-        assert!((lo - r.lower[v]).abs() <= 1e-12 * (1.0 + lo.abs()));
-        assert!((hi - r.upper[v]).abs() <= 1e-12 * (1.0 + hi.abs()));
-        let z = r.positions[v][2];
-        assert!(
-            z >= lo - 1e-9 * diag && z <= hi + 1e-9 * diag,
-            "vertex {v} at {z} outside [{lo}, {hi}]"
-        );
-        assert_eq!(
-            &r.positions[v][..2],
-            &mesh.positions()[v][..2],
-            "plan moved"
-        );
-    }
-}
-
-fn plan_diagonal(mesh: &Mesh) -> f64 {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in mesh.positions() {
-        for d in 0..2 {
-            lo[d] = lo[d].min(p[d]);
-            hi[d] = hi[d].max(p[d]);
-        }
-    }
-    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }
 
 /// On a fan every compressive stress balances the centre, so the extreme thrusts are closed
@@ -455,16 +397,6 @@ fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
         }
     }
     faces
-}
-
-/// The shell between radii 1 ± t/2 read on the vertical at plan radius `r`; below the
-/// intrados' footprint the springing plane z = 0 bounds it.
-fn shell(mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, t: f64) -> voussoir::Result<Envelope> {
-    let at = |rho: f64, r: f64| (rho * rho - r * r).max(0.0).sqrt();
-    let (lower, upper) = (mesh.positions().iter())
-        .map(|&p| (at(1.0 - 0.5 * t, radius(p)), at(1.0 + 0.5 * t, radius(p))))
-        .unzip();
-    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
 }
 
 /// A family whose bounds scale linearly about a fixed middle (a normal thickness read by the

@@ -2,6 +2,7 @@
 //! path to the shared real models.
 #![allow(dead_code)]
 
+pub mod assess;
 mod models;
 #[allow(unused_imports)] // each test binary uses its own part
 pub use models::{central_vertex, find_models, models_dir, models_required, MODELS};
