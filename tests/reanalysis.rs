@@ -271,3 +271,30 @@ fn polished_forces_and_their_force_diagram_agree() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The holed family on the fine mesh (triangles of at most 0.0015): seeds 30 to 41, the hole
+/// counts of `FAMILY_HOLES` in turn, free and anchored hole rims; 24 vaults.
+fn fine_family() -> Vec<(u64, usize, bool)> {
+    (30..42u64)
+        .map(|seed| (seed, FAMILY_HOLES[seed as usize % FAMILY_HOLES.len()]))
+        .flat_map(|(seed, holes)| [(seed, holes, false), (seed, holes, true)])
+        .collect()
+}
+
+/// The vaults of the fine family whose fresh analysis stops short of the QP's optimum
+/// (docs/solver.md, "Not every holed vault certifies yet"); ~30 s in a release build.
+#[test]
+#[ignore = "fails: the polish stops short (issue 46); cargo test --release -- --ignored"]
+fn form_found_anchored_vaults_that_stop_short_certify_afresh() {
+    let cases = [(32, 4, true), (33, 8, true), (36, 1, true)];
+    certify_all("reanalysis-short", &cases, 0.0015);
+}
+
+/// The whole fine family; ~5 min in a release build.
+#[test]
+#[ignore = "fails on three anchored vaults (issue 46); cargo test --release -- --ignored"]
+fn form_found_fine_holed_family_certifies_that_it_stands_afresh() {
+    let cases = fine_family();
+    assert_eq!(cases.len(), 24);
+    certify_all("reanalysis-fine", &cases, 0.0015);
+}
