@@ -384,7 +384,7 @@ fn sample(
     Ok(out)
 }
 
-fn plan_diagonal(mesh: &Mesh) -> f64 {
+pub(super) fn plan_diagonal(mesh: &Mesh) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for (p, _) in mesh.positions.iter().zip(&mesh.referenced).filter(|x| *x.1) {
         for d in 0..2 {

@@ -227,9 +227,13 @@ pub struct AssessResult {
 /// certified surface the result has `feasible == false` with the best state reached (least
 /// infeasibility) and where it fails.
 ///
-/// `progress` sees every step, those of the start's `fit` search and of the search for
-/// [`AssessResult::needed_scale`] included, numbered as one sequence; returning false
-/// cancels the analysis (during the `needed_scale` search: that figure alone is left out).
+/// A search that ends without a certified surface proves nothing: the analysis then runs
+/// again from surfaces of a stricter problem and of the least thickness (docs/method.md
+/// §16.3) before it answers `feasible == false`.
+///
+/// `progress` sees every step of every search (the start's `fit` search, the retries and the
+/// search for [`AssessResult::needed_scale`]), numbered as one sequence; returning false
+/// cancels the analysis.
 pub fn assess(
     problem: &Problem,
     envelope: &Envelope,
@@ -241,27 +245,114 @@ pub fn assess(
     let mut steps = Steps {
         progress,
         before: 0,
+        cancelled: false,
     };
     let model = model::Model::new(problem, envelope, settings)?;
-    let begun = feasible_start(problem, envelope, settings, &mut steps)?;
-    let mut run = match begun {
+    let run = analyse(&model, problem, envelope, settings, &mut steps)?;
+    let mut result = finish(&model, run, settings, &steps, start);
+    if result.feasible || result.termination == Termination::Cancelled {
+        return Ok(result);
+    }
+    // A search that stalls proves nothing: from a surface certified for a stricter problem
+    // (the same analysis with form finding's floor on the force densities) the analysis
+    // runs again.
+    let floored = floored_surface(problem, envelope, settings, &mut steps)?;
+    if steps.cancelled {
+        result.termination = Termination::Cancelled;
+        return Ok(result);
+    }
+    if let Some(again) = floored.map(|state| retry(&model, settings, &mut steps, state, start)) {
+        let again = again?;
+        if again.feasible || again.termination == Termination::Cancelled {
+            return Ok(again);
+        }
+    }
+    if settings.objective != Objective::MinThickness {
+        let thinnest = needed_scale(problem, envelope, settings, &mut steps)?;
+        if steps.cancelled {
+            result.termination = Termination::Cancelled;
+            return Ok(result);
+        }
+        if let Some(found) = thinnest.as_ref().filter(|t| t.fits) {
+            // The thinnest surface fits this envelope: the analysis runs again from it.
+            let again = retry(&model, settings, &mut steps, found.state.clone(), start)?;
+            if again.feasible || again.termination == Termination::Cancelled {
+                return Ok(again);
+            }
+        }
+        result.needed_scale = thinnest.map(|t| (t.scale, t.outside));
+    }
+    Ok(result)
+}
+
+/// The analysis' start (see [`feasible_start`]) and its search.
+fn analyse(
+    model: &model::Model,
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+    steps: &mut Steps,
+) -> Result<model::Run> {
+    match feasible_start(problem, envelope, settings, steps)? {
         Some(run) if run.termination == Termination::Cancelled => {
-            sqp::stopped(&model, settings, run)
+            Ok(sqp::stopped(model, settings, run))
         }
         begun => {
             let from = begun.map(|run| run.state);
-            steps.search(|p| sqp::solve(&model, settings, p, from, sqp::Until::Optimal))?
+            steps.search(|p| sqp::solve(model, settings, p, from, sqp::Until::Optimal))
         }
-    };
-    run.iterations = steps.before;
-    // The start's search counts, as its steps do.
-    run.seconds = start.elapsed().as_secs_f64();
-    let mut result = model.certify(run, settings);
-    let cancelled = result.termination == Termination::Cancelled;
-    if !result.feasible && !cancelled && settings.objective != Objective::MinThickness {
-        result.needed_scale = needed_scale(problem, envelope, settings, &mut steps)?;
     }
-    Ok(result)
+}
+
+/// The analysis' search again, from `state` (a state of a search on the same mesh).
+fn retry(
+    model: &model::Model,
+    settings: &AssessSettings,
+    steps: &mut Steps,
+    state: model::State,
+    start: std::time::Instant,
+) -> Result<AssessResult> {
+    let from = Some(state);
+    let run = steps.search(|p| sqp::solve(model, settings, p, from, sqp::Until::Optimal))?;
+    Ok(finish(model, run, settings, steps, start))
+}
+
+/// The certified figures of a run, its steps and seconds those of the whole analysis so far.
+fn finish(
+    model: &model::Model,
+    mut run: model::Run,
+    settings: &AssessSettings,
+    steps: &Steps,
+    start: std::time::Instant,
+) -> AssessResult {
+    run.iterations = steps.before;
+    run.seconds = start.elapsed().as_secs_f64();
+    model.certify(run, settings)
+}
+
+/// With compression only (no floor on q), the certified state of the same analysis with
+/// every force density at least form finding's default floor, 0.05 p̄/L₀: a stricter problem,
+/// so its surface is certified here too, and its search does not stall where a region loses
+/// all stress (a stationary point of the penalty that compression only allows).
+fn floored_surface(
+    problem: &Problem,
+    envelope: &Envelope,
+    settings: &AssessSettings,
+    steps: &mut Steps,
+) -> Result<Option<model::State>> {
+    let (QBound::Absolute(q) | QBound::Relative(q)) = settings.q_min;
+    if q > 0.0 {
+        return Ok(None);
+    }
+    let floored = AssessSettings {
+        q_min: crate::stress::StressSettings::default().q_min,
+        ..settings.clone()
+    };
+    let model = model::Model::new(problem, envelope, &floored)?;
+    let run = analyse(&model, problem, envelope, &floored, steps)?;
+    let state = run.state.clone();
+    let found = model.certify(run, &floored);
+    Ok((found.feasible && found.termination != Termination::Cancelled).then_some(state))
 }
 
 /// The caller's progress callback across successive searches, their steps numbered as one
@@ -270,6 +361,8 @@ struct Steps<'p, 'a> {
     progress: Option<&'p mut Progress<'a>>,
     /// Steps taken by the searches so far.
     before: usize,
+    /// Whether a search was cancelled.
+    cancelled: bool,
 }
 
 impl Steps<'_, '_> {
@@ -283,6 +376,7 @@ impl Steps<'_, '_> {
             (self.progress.as_deref_mut()).map(|p| move |k: usize, eps: f64| p(before + k, eps));
         let done = run(shifted.as_mut().map(|f| f as &mut Progress))?;
         self.before += done.iterations;
+        self.cancelled |= done.termination == Termination::Cancelled;
         Ok(done)
     }
 }
@@ -309,16 +403,27 @@ fn feasible_start(
     Ok(Some(run))
 }
 
-/// The least thickness scale with a certified surface, and where that surface leaves the
+/// The least thickness scale with a certified surface: the surface and where it leaves the
 /// envelope at scale 1 the most.
+struct Thinnest {
+    scale: f64,
+    /// Whether the surface lies inside the envelope at scale 1 (its joints not checked).
+    fits: bool,
+    outside: Option<u32>,
+    state: model::State,
+}
+
+/// The least thickness search (the start's `fit` search first) for an analysis that found
+/// no certified surface.
 fn needed_scale(
     problem: &Problem,
     envelope: &Envelope,
     settings: &AssessSettings,
     steps: &mut Steps,
-) -> Result<Option<(f64, Option<u32>)>> {
+) -> Result<Option<Thinnest>> {
     let thinnest = AssessSettings {
         objective: Objective::MinThickness,
+        load_pattern: None,
         ..settings.clone()
     };
     let model = model::Model::new(problem, envelope, &thinnest)?;
@@ -330,18 +435,24 @@ fn needed_scale(
     if run.termination == Termination::Cancelled {
         return Ok(None);
     }
+    let state = run.state.clone();
     let found = model.certify(run, &thinnest);
     if !found.feasible {
         return Ok(None);
     }
-    let outside = (0..found.positions.len())
+    let diag = envelope::plan_diagonal(&problem.mesh);
+    let (excess, vertex) = (0..found.positions.len())
         .filter(|&v| problem.mesh.referenced[v])
         .map(|v| {
             let z = found.positions[v][2];
             ((envelope.lower[v] - z).max(z - envelope.upper[v]), v as u32)
         })
         .max_by(|a, b| a.0.total_cmp(&b.0))
-        .filter(|(excess, _)| *excess > 0.0)
-        .map(|(_, v)| v);
-    Ok(Some((found.thickness_scale, outside)))
+        .unwrap_or((0.0, 0));
+    Ok(Some(Thinnest {
+        scale: found.thickness_scale,
+        fits: found.thickness_scale <= 1.0 && excess <= 1e-9 * diag,
+        outside: (excess > 0.0).then_some(vertex),
+        state,
+    }))
 }
