@@ -446,7 +446,7 @@ def assess(
         springing=_floats("springing", springing),
         reach=_floats("reach", reach),
     )
-    least = None if uniform is None else fields["thickness_scale"] * uniform
+    least = None if uniform is None or not fields["feasible"] else fields["thickness_scale"] * uniform
     return AssessmentResult._from_native(fields, least)
 
 

@@ -373,7 +373,7 @@ def run_assess(a: argparse.Namespace) -> int:
         fields = _native.assess(mesh._native, *envelope, settings, None, files, **joint)
     except voussoir.VoussoirError as e:
         raise Failure(str(e), 1 if "numerical failure" in str(e) else BAD_INPUT) from None
-    least = None if thickness is None else fields["thickness_scale"] * thickness
+    least = None if thickness is None or not fields["feasible"] else fields["thickness_scale"] * thickness
     r = voussoir.AssessmentResult._from_native(fields, least)
     text = fields["report"]
     try:
@@ -383,8 +383,10 @@ def run_assess(a: argparse.Namespace) -> int:
         raise Failure(str(e), 1) from None
     verdict = "a thrust surface fits" if r.feasible else "no certified thrust surface"
     print(f"{name}: {len(mesh.vertices)} vertices, {len(mesh.faces)} faces, {len(mesh.anchored)} anchored")
+    # A safety factor is proven only by a certified surface.
+    safety = f"safety factor {r.safety_factor:.4g}, " if r.feasible else ""
     print(f"assessment {r.objective}: {verdict} ({r.termination.replace('_', ' ')} after "
-          f"{r.iterations} steps); safety factor {r.safety_factor:.4g}, thrust {r.thrust_horizontal:.6g}")
+          f"{r.iterations} steps); {safety}thrust {r.thrust_horizontal:.6g}")
     print(f"wrote: {out} (thrust surface), {report_path} (report)")
     if not r.converged:
         print("voussoir: no certified optimum: the outputs hold the best state reached", file=sys.stderr)

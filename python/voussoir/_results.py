@@ -207,7 +207,7 @@ class AssessmentResult:
     thickness_min: Optional[float] = None
     """thickness_scale x the thickness when one uniform thickness was given (the least
     thickness for "min-thickness"); the least thickness of `min_thickness_of_family`; None
-    for per-face thicknesses and surfaces."""
+    for per-face thicknesses and surfaces, and when the surface is not certified."""
     rounds: Optional[int] = None
     """`min_thickness_of_family`: the least-thickness analyses run; None otherwise."""
     family_converged: Optional[bool] = None

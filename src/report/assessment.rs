@@ -89,7 +89,8 @@ pub struct AssessmentFigures {
     pub seconds: f64,
     /// The uniform thickness the envelope was made from (null for other envelopes).
     pub thickness: Option<f64>,
-    /// The thickness of `bounds` (the least one for `min-thickness`), when uniform.
+    /// The thickness of `bounds` (the least one for `min-thickness`), when uniform and the
+    /// surface is certified (null otherwise: no thickness is proven).
     pub thickness_min: Option<f64>,
     /// The scale of the envelope's half extents that `bounds` holds.
     pub thickness_scale: f64,
@@ -255,7 +256,9 @@ fn figures(
         iterations: r.iterations,
         seconds: r.seconds,
         thickness,
-        thickness_min: thickness.map(|t| r.thickness_scale * t),
+        thickness_min: thickness
+            .filter(|_| r.feasible)
+            .map(|t| r.thickness_scale * t),
         thickness_scale: r.thickness_scale,
         safety_factor: r.safety_factor,
         thrust_horizontal: r.thrust_horizontal,

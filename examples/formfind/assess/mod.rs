@@ -107,6 +107,10 @@ fn summary(a: &run::Assessed) {
         );
     }
     match r.objective {
+        Objective::MinThickness if !r.feasible => say!(
+            "no least thickness proven: the search ended at scale {:.6} of the envelope",
+            r.thickness_scale
+        ),
         Objective::MinThickness => {
             let t_min = a.thickness.map_or(String::new(), |t| {
                 format!("least thickness {:.6e}, ", r.thickness_scale * t)
