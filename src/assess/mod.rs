@@ -62,8 +62,8 @@ pub struct AssessSettings {
     /// How a face's weight is shared among its corners (on the middle surface). Default
     /// barycentric.
     pub load_rule: LoadRule,
-    /// Downward load per vertex for [`Objective::MaxLoad`], multiplied by λ; ignored
-    /// otherwise. Default none.
+    /// Downward load per vertex for [`Objective::MaxLoad`], multiplied by λ (every entry
+    /// >= 0, one at least > 0); ignored otherwise. Default none.
     pub load_pattern: Option<Vec<f64>>,
     /// Lower bound on the force densities (compression only: 0). Default `Absolute(0)`.
     pub q_min: QBound,
@@ -88,6 +88,22 @@ impl Default for AssessSettings {
     }
 }
 
+/// A live load pattern pushes down (>= 0 at every vertex) and somewhere: λ multiplies it.
+fn downward(pattern: &[f64]) -> Result<()> {
+    let reason = match pattern.iter().position(|&p| p < 0.0) {
+        Some(v) => format!(
+            "vertex {v}: {} is upward; the pattern's loads push down (>= 0)",
+            pattern[v]
+        ),
+        None if pattern.iter().all(|&p| p == 0.0) => "every load is 0: nothing to multiply".into(),
+        None => return Ok(()),
+    };
+    Err(crate::Error::InvalidArgument {
+        name: "load_pattern",
+        reason,
+    })
+}
+
 impl AssessSettings {
     /// Checks every setting; errors name it, worded as `FormFindSettings::validate` words
     /// its own (the C API and Python report these reasons under their argument names).
@@ -101,6 +117,7 @@ impl AssessSettings {
         at_least("q_min", q, 0.0)?;
         if let Some(pattern) = &self.load_pattern {
             all_finite("load_pattern", pattern, "vertex")?;
+            downward(pattern)?;
         }
         Ok(())
     }

@@ -69,18 +69,34 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
     let why = if r.feasible {
         format!(
             "{}: the thrust surface written is certified, its {} not proven optimal",
-            r.termination,
+            ending(&r.termination),
             r.objective.as_str()
         )
     } else {
         format!(
             "no thrust surface found inside the envelope ({}): the outputs hold the least \
              infeasible state",
-            r.termination
+            ending(&r.termination)
         )
     };
     eprintln!("formfind: {why}");
     Ok(ExitCode::from(NOT_CONVERGED))
+}
+
+/// The termination in an assessment's words: a stalled search lists the vertices with the
+/// largest residuals of its least infeasible state (retries with a floor on q included, so
+/// form finding's advice to raise q_min does not apply).
+fn ending(termination: &Termination) -> String {
+    match termination {
+        Termination::Stalled { vertices } if !vertices.is_empty() => {
+            let ids: Vec<String> = vertices.iter().map(|v| v.to_string()).collect();
+            format!(
+                "stalled: no step lowers the infeasibility; the largest residuals at vertices {}",
+                ids.join(", ")
+            )
+        }
+        other => other.to_string(),
+    }
 }
 
 fn summary(a: &run::Assessed) {
