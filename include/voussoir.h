@@ -1802,7 +1802,9 @@ VsrStatus vsr_assess_settings_set_q_min(struct VsrAssessSettings *settings, doub
 VsrStatus vsr_assess_settings_set_tolerance(struct VsrAssessSettings *settings, double tolerance);
 
 /**
- * Sets the most sequential QP steps of the search (>= 1). Default 200.
+ * Sets the most sequential QP steps of each search (>= 1): the start's, the analysis' own
+ * and each retry's count their own (the assessment's iteration count sums them all). Default
+ * 200.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

@@ -407,14 +407,15 @@ def assess(
             height bounded by the envelope alone). None keeps the envelope's default (from a
             thickness: the plane through the middle surface's vertex, reach t / (2 |n_h|);
             from surfaces: the intrados, half the vertex's thickness).
-        progress: called as ``progress(step, infeasibility)`` after every step, the start's
-            and the ``needed_scale`` search's included (1-based, one sequence;
+        progress: called as ``progress(step, infeasibility)`` after every step of every
+            search, the start's, the retries' and the ``needed_scale`` one's (1-based, one sequence;
             infeasibility: the largest vertical residual over the mean load). Returning False
             stops the search (``termination == "cancelled"``); an exception it raises stops
             it too and propagates.
         **settings: ``load_rule`` ("barycentric", "voronoi", "plan_area"), ``q_min`` and
             ``q_min_kind`` (default 0, "absolute": compression only), ``tolerance`` (on
-            eps_inf, default 1e-6), ``max_iterations`` (default 200).
+            eps_inf, default 1e-6), ``max_iterations`` (per search: the start's, the analysis'
+            own and each retry's; default 200).
 
     The GIL is released while it searches; Ctrl-C stops it within one step and propagates.
 

@@ -69,7 +69,9 @@ pub struct AssessSettings {
     pub q_min: QBound,
     /// Largest ε∞ (relative to the mean load) of a certified surface. Default 1e-6.
     pub tolerance: f64,
-    /// Sequential QP iterations at most. Default 200.
+    /// Sequential QP iterations at most, per search: the start's, the analysis' own and each
+    /// retry's (docs/method.md §16.3) count their own, [`AssessResult::iterations`] sums them
+    /// all. Default 200.
     pub max_iterations: usize,
 }
 
@@ -186,7 +188,7 @@ pub struct AssessResult {
     pub feasible: bool,
     /// Converged; or how the search ended (the best state reached is returned).
     pub termination: Termination,
-    /// Sequential QP iterations (the starting `fit` search's included).
+    /// Sequential QP iterations of every search (the start's and the retries' included).
     pub iterations: usize,
     /// The thrust surface: the mesh's plan with the found heights.
     pub positions: Vec<[f64; 3]>,

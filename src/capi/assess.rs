@@ -556,7 +556,9 @@ pub unsafe extern "C" fn vsr_assess_settings_set_tolerance(
     })
 }
 
-/// Sets the most sequential QP steps of the search (>= 1). Default 200.
+/// Sets the most sequential QP steps of each search (>= 1): the start's, the analysis' own
+/// and each retry's count their own (the assessment's iteration count sums them all). Default
+/// 200.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.
