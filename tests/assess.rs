@@ -312,8 +312,16 @@ fn a_vault_too_thin_says_how_much_thicker() {
     .unwrap();
     let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.005)).unwrap();
     let settings = AssessSettings::default().with_max_iterations(60);
-    let result = run(mesh.clone(), &envelope, settings);
+    let mut last = 0;
+    let mut seen = |k: usize, _: f64| {
+        last = k;
+        true
+    };
+    let problem = Problem::new(mesh.clone());
+    let result = assess(&problem, &envelope, &settings, Some(&mut seen)).unwrap();
     assert!(!result.feasible);
+    // Its steps count every search's: the retries' and needed_scale's too.
+    assert!(last <= result.iterations, "{last} > {}", result.iterations);
     let (scale, at) = result.needed_scale.expect("a least thickness");
     assert!(scale > 1.0, "scale {scale}");
     let v = at.expect("where the thinnest surface leaves the envelope") as usize;

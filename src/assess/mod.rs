@@ -301,6 +301,9 @@ pub fn assess(
         }
         result.needed_scale = thinnest.map(|t| (t.scale, t.outside));
     }
+    // The answer is the first search's; its figures of effort count every search.
+    result.iterations = steps.before;
+    result.seconds = start.elapsed().as_secs_f64();
     Ok(result)
 }
 
