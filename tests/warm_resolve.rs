@@ -208,10 +208,10 @@ fn an_unedited_problem_resolves_in_fewer_steps() {
     );
 }
 
-/// A previous result whose input hung (read upside down) is re-solved from scratch, as a cold
+/// A previous result whose input hung (read upside down) is re-solved as a cold
 /// run of the edited problem: the same answer, mirrored.
 #[test]
-fn a_hanging_input_is_resolved_from_scratch() {
+fn a_hanging_input_is_resolved_cold() {
     let settings = FormFindSettings::default();
     let dome = generate::cap_dome(1.0, 300).unwrap();
     let heights: Vec<f64> = dome.positions().iter().map(|p| -p[2]).collect();

@@ -281,7 +281,7 @@ pub fn form_find(
 /// equilibrium starts over for the edited input; a `previous` of the paper's loop starts it
 /// as a cold run does. A `previous` whose forces are not a solved stress step's gives no
 /// proximal centre. A `previous` whose input hung (`mirrored`), or an edited input that
-/// hangs, is re-solved from scratch (the mirror image depends on the input's forces).
+/// hangs, is re-solved cold (the mirror image depends on the input's forces).
 ///
 /// The nearest shape is a local optimum: a cold run and a warm one of the same edited
 /// problem may end at different ones (measured on the shared models: the warm answer within
