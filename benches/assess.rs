@@ -1,7 +1,7 @@
 //! Masonry assessment (docs/method.md §16). Prints tables; asserts nothing.
 //!
 //!     cargo bench --bench assess                   # hemispheres by mesh size, shared models
-//!     cargo bench --bench assess -- --hemisphere   # hemispheres only
+//!     cargo bench --bench assess -- --hemisphere [--only TEXT]   # hemispheres only
 //!     cargo bench --bench assess -- --models       # shared models only
 //!     cargo bench --bench assess -- --heyman       # least thickness on Heyman's terms
 //!     cargo bench --bench assess -- --heyman --barrels   # its barrels only
@@ -20,8 +20,9 @@
 //! the shells R ± t/2 read vertically (t = 0.1; the cross vault's as compas_tno's
 //! `apply_envelope`: the intersection of two semicircular barrels), classical springing
 //! joints, every analysis but max-load; each search is cancelled after `--budget` seconds
-//! of steps (default 600; the `fit` start of the other analyses is not cancelled), and
-//! `--only` keeps the rows whose "model analysis" contains TEXT.
+//! of steps (default 600; the `fit` start of the other analyses is not cancelled).
+//! `--only TEXT` (with `--hemisphere`, `--models` or `--large`) keeps the rows whose
+//! "model analysis" contains TEXT.
 
 #[path = "../tests/common/models.rs"]
 mod models;
@@ -41,7 +42,17 @@ fn hemisphere(rings: usize) -> Mesh {
     generate::lift(&p, &t, height, |_, outer| outer).unwrap()
 }
 
+/// The value of `--only`: rows whose "model analysis" does not contain it are skipped.
+fn only() -> String {
+    let args: Vec<String> = std::env::args().collect();
+    let k = args.iter().position(|a| a == "--only");
+    k.and_then(|k| args.get(k + 1).cloned()).unwrap_or_default()
+}
+
 fn row(name: &str, mesh: &Mesh, thickness: f64, objective: Objective) {
+    if !format!("{name} {}", objective.as_str()).contains(&only()) {
+        return;
+    }
     let envelope = Envelope::from_thickness(mesh, &Thickness::Uniform(thickness)).unwrap();
     let problem = Problem::new(mesh.clone());
     let settings = AssessSettings::default().with_objective(objective);
@@ -233,7 +244,7 @@ fn large() {
         args.get(k + 1).cloned()
     };
     let budget: f64 = value("--budget").map_or(600.0, |b| b.parse().unwrap());
-    let only = value("--only").unwrap_or_default();
+    let only = only();
     println!(
         "\nLarge models, shells R ± t/2 read vertically (R = 1, t = 0.1), budget {budget} s\n"
     );

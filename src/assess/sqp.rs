@@ -4,8 +4,9 @@
 //! last accepted step) and a proximal weight ρ (Levenberg–Marquardt): a step is accepted
 //! only when φ falls by at least a tenth of what its model predicts, else once retried with
 //! a second-order correction (the constraints are bilinear, so their second-order term is
-//! known exactly) and then ρ grows. ν grows while the linearised residuals cannot be met
-//! at its price and otherwise follows the step's multipliers (ten times the largest).
+//! known exactly) and then ρ grows; accepted steps update ρ by Nielsen's rule. ν grows while
+//! the linearised residuals cannot be met at its price and otherwise follows the step's
+//! multipliers (ten times the largest).
 
 use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
@@ -118,6 +119,8 @@ struct Search<'m, 'a> {
     /// max |c_i| at `state`.
     residual: f64,
     rho: f64,
+    /// The factor of ρ's next rise: 2, doubling with every rejection in a row up to 10.
+    grow: f64,
     nu: f64,
     nu_max: f64,
     feasible_below: f64,
@@ -158,6 +161,7 @@ impl<'m, 'a> Search<'m, 'a> {
             state,
             residual,
             rho: RHO_START,
+            grow: 2.0,
             nu,
             nu_max: nu * NU_RANGE,
             feasible_below: FEASIBILITY_MARGIN * settings.tolerance,
@@ -259,9 +263,12 @@ impl<'m, 'a> Search<'m, 'a> {
         }
         self.residual = self.model.violation(&self.state).0;
         self.record();
-        // Steps the model predicts well need less damping.
         let ratio = (phi - self.merit(&self.state)) / predicted;
-        self.rho = (self.rho / if ratio > 0.75 { 10.0 } else { 2.0 }).max(RHO_MIN);
+        // Nielsen's update: ρ follows how well the model predicted, without the swing
+        // between a rejected and an accepted ρ that a fixed tenfold fall brings.
+        let shrink = (1.0 - (2.0 * ratio - 1.0).powi(3)).max(1.0 / 3.0);
+        self.rho = (self.rho * shrink).max(RHO_MIN);
+        self.grow = 2.0;
         let after = self.model.objective_value(&self.state);
         if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
             eprintln!(
@@ -304,7 +311,8 @@ impl<'m, 'a> Search<'m, 'a> {
     }
 
     fn reject(&mut self) -> Outcome {
-        self.rho *= 10.0;
+        self.rho *= self.grow;
+        self.grow = (self.grow * 2.0).min(10.0);
         if self.rho > RHO_MAX {
             Outcome::Stationary
         } else {
