@@ -124,8 +124,11 @@ pub struct StressResult {
     /// previous step's active set alone (form finding reuses it between steps).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
-    /// every reduced attempt failed numerically, or when the native solver answered a mesh with
-    /// a vertex of more than 64 edges (same optimum; see `docs/method.md` §9).
+    /// every reduced attempt failed numerically, when the native solver answered a mesh with
+    /// a vertex of more than 64 edges, or when its reduced attempt failed and its edge-based
+    /// one answered (same optimum; see `docs/method.md` §9). The Airy values, hole jumps and
+    /// force diagram of a native edge-based answer to a reduced request are the reduced
+    /// operator's where that attempt built it (fitted to the forces).
     pub formulation: Formulation,
     /// The solver that produced the answer (clarabel after a fallback from the native one).
     pub solver: QpSolver,
