@@ -15,7 +15,8 @@ use Formulation::{EdgeBased, Reduced};
 /// The attempts of a stress step in order: (solver, formulation, lifted, factor on ε).
 ///
 /// The native solver goes first, in `native` form, then (with `edge_fallback`) natively in
-/// the edge-based form, whose optimum is the same (see `native_fallback`). Interior-point
+/// the edge-based form, whose optimum is the same (see `native_fallback`); with `edge_first`
+/// (the last step's answer came from that fallback) the edge-based form goes first. Interior-point
 /// methods can fail on degenerate problems (straight free edges force q = 0: no strictly
 /// feasible point), and only clarabel certifies infeasibility, so when the native attempts
 /// do not converge clarabel takes over: the plain reduced QP is fastest; the lifted one (q
@@ -26,7 +27,7 @@ pub(super) fn attempt_list(
     settings: &StressSettings,
     lifted_first: bool,
     native: Formulation,
-    edge_fallback: bool,
+    (edge_fallback, edge_first): (bool, bool),
 ) -> Vec<(QpSolver, Formulation, bool, f64)> {
     use QpSolver::{Clarabel, Native};
     let (a, b) = (lifted_first, !lifted_first);
@@ -34,7 +35,8 @@ pub(super) fn attempt_list(
     if settings.solver == Native {
         attempts.push((Native, native, false, 1.0));
         if edge_fallback && native == Reduced {
-            attempts.push((Native, EdgeBased, false, 1.0));
+            let at = if edge_first { 0 } else { 1 };
+            attempts.insert(at, (Native, EdgeBased, false, 1.0));
         }
     }
     match settings.formulation {
@@ -126,7 +128,7 @@ pub(super) fn run_attempts(
         settings,
         prior.is_some_and(|p| p.lifted_first),
         native,
-        native_fallback(mesh, settings),
+        (native_fallback(mesh, settings), cache.native_fallback_first),
     );
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
@@ -209,8 +211,12 @@ pub(super) fn run_attempts(
             break;
         }
     }
+    let best = best.expect("at least one attempt");
+    // Consecutive QPs of a form finding differ little: the form that answered goes first.
+    cache.native_fallback_first =
+        best.solver == Native && best.formulation != native && best.out.status.is_solved();
     Ok(Attempts {
-        best: best.expect("at least one attempt"),
+        best,
         models,
         kept_key,
     })

@@ -36,6 +36,9 @@ pub struct StressCache {
     pub(super) normal: ipm::PatternCache,
     /// The same for the native fallback form (edge-based, after a failed reduced attempt).
     pub(super) fallback: ipm::PatternCache,
+    /// The last step's answer came from the native fallback form: the next step tries it
+    /// first (`attempts::attempt_list`).
+    pub(super) native_fallback_first: bool,
     pub(super) reduced: Option<(PlanKey, AiryOperator)>,
     /// Solve native QPs to `ipm::Tolerances::for_form_finding` (coarse when large).
     pub(super) coarse: bool,
