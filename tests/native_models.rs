@@ -2,10 +2,8 @@
 //! native interior-point solver: none falls back to clarabel (docs/solver.md §5).
 //!
 //! The models are required here whatever the environment says: a missing folder fails the
-//! test instead of letting it pass without checking anything. Release-only (ignored in debug
-//! builds, where the nine form findings take minutes):
-//!
-//!     cargo test --release --test native_models -- --include-ignored
+//! test instead of letting it pass without checking anything. The nine form findings take
+//! about 10 s in a debug build and 7 s in a release one.
 
 mod common;
 use common::{find_models, MODELS};
@@ -19,7 +17,6 @@ fn shared_models() -> PathBuf {
 }
 
 #[test]
-#[cfg_attr(debug_assertions, ignore = "release build: nine form findings")]
 fn default_form_finding_of_every_shared_model_is_answered_by_the_native_solver() {
     let dir = shared_models();
     let settings = FormFindSettings::default();
