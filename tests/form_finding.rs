@@ -107,10 +107,6 @@ fn run(label: &str, problem: &Problem) -> FormFindResult {
     r
 }
 
-/// The shared models some of whose late form-finding QPs the native method does not solve
-/// within its iteration limit with the default affine hole jumps: clarabel answers them.
-const NATIVE_FALLS_BACK: [&str; 2] = ["four_holes", "cheese"];
-
 #[test]
 fn every_shared_model_converges_with_default_settings() {
     for name in MODELS {
@@ -125,9 +121,9 @@ fn every_shared_model_converges_with_default_settings() {
         certify(name, &problem, &p);
         // Every step of the paper's loop is the native solver's own answer (four_holes' late,
         // nearly degenerate QPs need the Krylov cycles where refinement cannot resolve a
-        // direction), except where late QPs with affine jumps exceed its iteration limit.
+        // direction; cheese's late reduced QPs the native edge-based fallback).
         assert!(
-            p.solvers.iter().all(|&s| s == QpSolver::Native) || NATIVE_FALLS_BACK.contains(&name),
+            p.solvers.iter().all(|&s| s == QpSolver::Native),
             "{name}: paper steps answered by {:?}",
             p.solvers
         );

@@ -14,22 +14,30 @@ use Formulation::{EdgeBased, Reduced};
 
 /// The attempts of a stress step in order: (solver, formulation, lifted, factor on ε).
 ///
-/// The native solver goes first. Interior-point methods can fail on degenerate problems
-/// (straight free edges force q = 0: no strictly feasible point), and only clarabel
-/// certifies infeasibility, so when it does not converge clarabel takes over: the plain
-/// reduced QP is fastest; the lifted one (q as variables) copes with problems where the
-/// plain one reaches only reduced accuracy. Then ε is raised, then the edge-based
-/// formulation (same optimum) is used; the result says which solver, formulation and ε.
+/// The native solver goes first, in `native` form, then (with `edge_fallback`) natively in
+/// the edge-based form, whose optimum is the same (see `native_fallback`); with `edge_first`
+/// (the last step's answer came from that fallback) the edge-based form goes first. Interior-point
+/// methods can fail on degenerate problems (straight free edges force q = 0: no strictly
+/// feasible point), and only clarabel certifies infeasibility, so when the native attempts
+/// do not converge clarabel takes over: the plain reduced QP is fastest; the lifted one (q
+/// as variables) copes with problems where the plain one reaches only reduced accuracy.
+/// Then ε is raised, then the edge-based formulation (same optimum) is used; the result
+/// says which solver, formulation and ε.
 pub(super) fn attempt_list(
     settings: &StressSettings,
     lifted_first: bool,
     native: Formulation,
+    (edge_fallback, edge_first): (bool, bool),
 ) -> Vec<(QpSolver, Formulation, bool, f64)> {
     use QpSolver::{Clarabel, Native};
     let (a, b) = (lifted_first, !lifted_first);
     let mut attempts: Vec<(QpSolver, Formulation, bool, f64)> = Vec::new();
     if settings.solver == Native {
         attempts.push((Native, native, false, 1.0));
+        if edge_fallback && native == Reduced {
+            let at = if edge_first { 0 } else { 1 };
+            attempts.insert(at, (Native, EdgeBased, false, 1.0));
+        }
     }
     match settings.formulation {
         Reduced => attempts.extend_from_slice(&[
@@ -61,13 +69,33 @@ const HUB_EDGES: usize = 64;
 /// active: on a wheel of 1000 spokes the interior-point iterations stalled short of the
 /// tolerances, while in the edge-based form each bound is a force density of its own.
 fn native_formulation(mesh: &Mesh, settings: &StressSettings) -> Formulation {
-    let same_optimum = settings.holes == airy::HoleMode::Affine || mesh.holes().next().is_none();
     let hub = (0..mesh.positions.len()).any(|v| mesh.edges_at(v).len() > HUB_EDGES);
-    if settings.formulation == Reduced && same_optimum && hub {
+    if settings.formulation == Reduced && same_optimum(mesh, settings) && hub {
         EdgeBased
     } else {
         settings.formulation
     }
+}
+
+/// Whether the reduced QP's optimum is the edge-based one (§9 of docs/method.md): with
+/// affine hole jumps, or without holes.
+fn same_optimum(mesh: &Mesh, settings: &StressSettings) -> bool {
+    settings.holes == airy::HoleMode::Affine || mesh.holes().next().is_none()
+}
+
+/// Whether a reduced native attempt that fails is followed by a native edge-based one, before
+/// clarabel: where both forms have the same optimum. The reduced unknowns are Airy values,
+/// about (L/h)² larger than the force densities they are differences of (L the extent of
+/// the mesh, h an edge length), and near balance, where the optimum is flat and tiny and
+/// many bounds are nearly active, the interior-point directions carry that cancellation's
+/// rounding: on cheese's last nearest-method QP (3 987 unknowns, Airy values ~1e5 in the
+/// scaled units, the objective computed to ±5e-6 where it is ~1e-11) the dual residual
+/// stalls at 1–30 times its tolerance, steps are cut short by rows whose slacks the
+/// directions move by a hundred times their size, and the gap stays near 1e-9 (its
+/// tolerance 1e-12) through the whole iteration budget. In the edge-based form each bound
+/// is a force density of its own and the same QP solves cold in 25 iterations.
+fn native_fallback(mesh: &Mesh, settings: &StressSettings) -> bool {
+    settings.formulation == Reduced && same_optimum(mesh, settings)
 }
 
 /// The index of a formulation's force model in `Attempts::models`.
@@ -96,7 +124,12 @@ pub(super) fn run_attempts(
     let mesh = &problem.mesh;
     let plan = &step.plan;
     let native = native_formulation(mesh, settings);
-    let attempts = attempt_list(settings, prior.is_some_and(|p| p.lifted_first), native);
+    let attempts = attempt_list(
+        settings,
+        prior.is_some_and(|p| p.lifted_first),
+        native,
+        (native_fallback(mesh, settings), cache.native_fallback_first),
+    );
     let base = prior.map_or(settings.regularisation, |p| p.weight);
     let prior_frame: Option<Vec<f64>> =
         prior.map(|p| p.force_densities.iter().map(|q| q / step.unit).collect());
@@ -145,7 +178,16 @@ pub(super) fn run_attempts(
             lift_forces,
         };
         let out = match solver {
-            Native => qp::solve_native(&input, &mut cache.normal, cache.coarse, cache.inexact),
+            Native => {
+                // The fallback form keeps its own structure and last answer, so that the
+                // native form's warm start carries on at the next step.
+                let normal = if formulation == native {
+                    &mut cache.normal
+                } else {
+                    &mut cache.fallback
+                };
+                qp::solve_native(&input, normal, cache.coarse, cache.inexact)
+            }
             Clarabel => {
                 clarabel_tries += 1;
                 qp::solve_clarabel(&input)
@@ -169,8 +211,12 @@ pub(super) fn run_attempts(
             break;
         }
     }
+    let best = best.expect("at least one attempt");
+    // Consecutive QPs of a form finding differ little: the form that answered goes first.
+    cache.native_fallback_first =
+        best.solver == Native && best.formulation != native && best.out.status.is_solved();
     Ok(Attempts {
-        best: best.expect("at least one attempt"),
+        best,
         models,
         kept_key,
     })

@@ -24,6 +24,8 @@ pub struct Prior<'a> {
 ///   symbolic factorisation), which depends on the mesh's connectivity and the settings but
 ///   not on the positions;
 /// - the last answer with its active bounds;
+/// - both of these also for the native fallback form (edge-based, where a reduced attempt
+///   failed; see `attempts::native_fallback`);
 /// - the reduced operator q = S y of the last plan, with the inputs it was built from (see
 ///   `PlanKey`).
 ///
@@ -32,6 +34,11 @@ pub struct Prior<'a> {
 #[derive(Default)]
 pub struct StressCache {
     pub(super) normal: ipm::PatternCache,
+    /// The same for the native fallback form (edge-based, after a failed reduced attempt).
+    pub(super) fallback: ipm::PatternCache,
+    /// The last step's answer came from the native fallback form: the next step tries it
+    /// first (`attempts::attempt_list`).
+    pub(super) native_fallback_first: bool,
     pub(super) reduced: Option<(PlanKey, AiryOperator)>,
     /// Solve native QPs to `ipm::Tolerances::for_form_finding` (coarse when large).
     pub(super) coarse: bool,
@@ -66,6 +73,7 @@ impl StressCache {
     /// set is wrong in hundreds of rows and the failed attempt costs several factorisations.
     pub fn far_from_balance(&mut self, far: bool) {
         self.normal.far_from_balance(far);
+        self.fallback.far_from_balance(far);
     }
 
     /// Loads (physical, per vertex) the next steps add to the true loads in the QP's target;

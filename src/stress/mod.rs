@@ -124,8 +124,11 @@ pub struct StressResult {
     /// previous step's active set alone (form finding reuses it between steps).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
-    /// every reduced attempt failed numerically, or when the native solver answered a mesh with
-    /// a vertex of more than 64 edges (same optimum; see `docs/method.md` §9).
+    /// every reduced attempt failed numerically, when the native solver answered a mesh with
+    /// a vertex of more than 64 edges, or when its reduced attempt failed and its edge-based
+    /// one answered (same optimum; see `docs/method.md` §9). The Airy values, hole jumps and
+    /// force diagram of a native edge-based answer to a reduced request are the reduced
+    /// operator's where that attempt built it (fitted to the forces).
     pub formulation: Formulation,
     /// The solver that produced the answer (clarabel after a fallback from the native one).
     pub solver: QpSolver,
@@ -217,7 +220,13 @@ pub fn analyse_cached(
         }
         None => y,
     };
-    let airy_op = map.airy();
+    let (airy_op, y) = match map.airy() {
+        None if solver == QpSolver::Native => match reduced_view(&mut models, &q_frame) {
+            Some((op, fitted)) => (Some(op), fitted),
+            None => (None, y),
+        },
+        op => (op, y),
+    };
 
     // Back to physical units.
     let force_densities: Vec<f64> = q_frame.iter().map(|q| q * unit).collect();
@@ -366,6 +375,30 @@ fn refit(map: &attempts::ForceMap, y: &[f64], q_old: &[f64], q_new: &[f64]) -> V
             Some(dy) => y.iter().zip(&dy).map(|(a, b)| a + b).collect(),
             None => y.to_vec(),
         },
+    }
+}
+
+/// The reduced view of a native answer of the edge-based form where the reduced attempt
+/// before it failed (`attempts::native_fallback`; the reduced model is then built): the
+/// reduced unknowns fitted by least squares to its force densities, so that its Airy values,
+/// hole jumps and force diagram are the reduced operator's, as a reduced answer's are. The
+/// fit is exact to rounding, because both forms have the same feasible force densities. The
+/// model is left in place when there is none to fit or the fit fails.
+fn reduced_view(
+    models: &mut [Option<attempts::ForceModel>; 2],
+    q_frame: &[f64],
+) -> Option<(airy::AiryOperator, Vec<f64>)> {
+    let (map, balance) = models[slot(Reduced)].take()?;
+    let attempts::ForceMap::Airy(op) = map else {
+        models[slot(Reduced)] = Some((map, balance));
+        return None;
+    };
+    match certify::least_squares(&op.s, q_frame) {
+        Some(y) => Some((op, y)),
+        None => {
+            models[slot(Reduced)] = Some((attempts::ForceMap::Airy(op), balance));
+            None
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 pub mod assess;
 mod models;
 #[allow(unused_imports)] // each test binary uses its own part
-pub use models::{central_vertex, find_models, models_dir, models_required, MODELS};
+pub use models::{central_vertex, find_models, models_dir, models_required, read_shared, MODELS};
 use voussoir::generate::{self, Domain};
 use voussoir::Mesh;
 
