@@ -10,7 +10,10 @@
 //! - from there, finds the optimum by an active-set method whose equality-constrained QPs are
 //!   solved exactly (`active`, `kkt`: augmented KKT system, refinement with compensated
 //!   residuals);
-//! - where that does not end at a verified optimum, solves the QP again with the native
+//! - where that does not end at a verified optimum, descends from the best answer so far by a
+//!   primal active-set method whose working sets' QPs are solved at their own conditioning
+//!   (`primal`, `augmented`: Björck's scaled augmented system, nothing regularised);
+//! - where that does not end at a verified optimum either, solves the QP again with the native
 //!   interior-point method to an absolute gap of `GAP_ABS`, and runs the active-set method
 //!   from its answer.
 //!
@@ -19,7 +22,9 @@
 //! definitions (no cancellation of ½ xᵀPx + cᵀx): the polish never makes an answer worse.
 
 mod active;
+mod augmented;
 mod kkt;
+mod primal;
 mod project;
 
 use super::qp::{self, QpInput};
@@ -131,8 +136,9 @@ fn interior_point(
 /// when it does not lower the objective with every bound and balance row kept.
 ///
 /// First the active-set polish from the answer at hand; if that does not end at a verified
-/// optimum, the native interior-point method in edge coordinates, and the active-set polish
-/// from its answer. The best of these by the objective recomputed from its definition is
+/// optimum, the primal descent from the best answer so far; if that does not either, the
+/// native interior-point method in edge coordinates, and the active-set polish from its
+/// answer. The best of these by the objective recomputed from its definition is
 /// taken if it keeps the balance rows as well as the answer at hand did.
 pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certified> {
     let (qp, tau_col) = edge_qp(inp);
@@ -140,14 +146,8 @@ pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certifi
     let x0 = unknowns(inp, &tau_col, n, q0, tau0);
     let balanced = project::balanced(&qp, &x0);
     let mut candidates = Vec::new();
-    let optimal = polish_from(&qp, balanced.as_deref().unwrap_or(&x0), &mut candidates);
+    let mut optimal = polish_from(&qp, balanced.as_deref().unwrap_or(&x0), &mut candidates);
     candidates.extend(balanced);
-    if !optimal {
-        if let Some(x) = interior_point(inp, n, &tau_col, &qp) {
-            polish_from(&qp, &x, &mut candidates);
-            candidates.push(x);
-        }
-    }
     let before = (
         active::objective(&qp, &x0),
         inf_norm(&project::imbalance(&qp, &x0)),
@@ -158,14 +158,34 @@ pub(super) fn certify(inp: &QpInput, q0: &[f64], tau0: &[f64]) -> Option<Certifi
             .fold(0.0, f64::max);
         inf_norm(&project::imbalance(&qp, x)) <= before.1.max(1e-12 * terms)
     };
-    let x = candidates
-        .into_iter()
-        .filter(|x| kept(x))
-        .map(|x| (active::objective(&qp, &x), x))
-        .filter(|(value, _)| *value < before.0)
-        .min_by(|a, b| a.0.total_cmp(&b.0))?
-        .1;
+    if !optimal {
+        // The primal active-set descent from the best answer so far that keeps the balance
+        // rows (or the answer at hand).
+        let start = lowest(&qp, candidates.iter().filter(|x| kept(x)).cloned());
+        if let Some(d) = primal::descend(&qp, start.as_ref().map_or(&x0, |s| &s.1)) {
+            optimal = d.optimal;
+            candidates.push(d.x);
+        }
+    }
+    if !optimal {
+        if let Some(x) = interior_point(inp, n, &tau_col, &qp) {
+            polish_from(&qp, &x, &mut candidates);
+            candidates.push(x);
+        }
+    }
+    let (value, x) = lowest(&qp, candidates.into_iter().filter(|x| kept(x)))?;
+    if value >= before.0 {
+        return None;
+    }
     Some(answer(inp, &tau_col, &x))
+}
+
+/// The candidate with the lowest finite objective, with its objective.
+fn lowest(qp: &EdgeQp, candidates: impl Iterator<Item = Vec<f64>>) -> Option<(f64, Vec<f64>)> {
+    candidates
+        .map(|x| (active::objective(qp, &x), x))
+        .filter(|(value, _)| value.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
 /// The active-set polish from `x`, with each regularisation of `kkt::DELTAS` in turn until
