@@ -9,12 +9,13 @@
 //!   [ D Mᵀ   0      D Eᵀ S] [ x̄ ] = [ 0   ]     r = b − M x = α u,  x = D x̄,  λ = −α S μ̄
 //!   [ 0      S E D  0     ] [ μ̄ ]   [ S f ]
 //!
-//! (D unit column scales, S unit row scales of E). Nothing is squared and nothing is
-//! regularised: the regulariser's rows enter as √w (the directions only it bends have
-//! singular values ~√w of M D, where a KKT system with the Hessian holds w), and the balance
-//! rows are kept exactly. With α the typical √w of the scaled columns the system's condition is
-//! about that of M D itself, so refinement against the exact system, every residual
-//! recomputed by compensated sums, converges to rounding.
+//! (D unit column scales, S unit row scales of E). The regulariser's rows, one entry each,
+//! are eliminated into a diagonal −w v² d² / α of the x block, of the size of α. Nothing is
+//! squared and nothing is regularised: the regulariser enters as √w, or as w/α (the
+//! directions only it bends have singular values ~√w of M D, where a KKT system with the
+//! Hessian holds w), and the balance rows are kept exactly. With α the typical √w of the
+//! scaled columns the system's condition is about that of M D itself, so refinement against
+//! the exact system, every residual recomputed by compensated sums, converges to rounding.
 
 use super::kkt::{dot2, transpose, EdgeQp, Side2};
 use super::Csr;
@@ -27,28 +28,39 @@ use faer::{Conj, MatMut};
 const REFINE: usize = 20;
 
 /// The least-squares rows of the QP, M = [A; √w B] and b = [t; √w s], with the transposes of
-/// M and E.
+/// M and E. Rows of B with a single entry (the regulariser's) are not rows of M: each adds
+/// w v² to the diagonal `h` of its column and w v s to `c` (their residual unknown eliminated,
+/// which leaves a diagonal of the size of α in the x block).
 pub(super) struct Rows {
     m: Csr,
     b: Vec<f64>,
     mt: Csr,
     et: Csr,
+    h: Vec<f64>,
+    c: Vec<f64>,
 }
 
 impl Rows {
     pub(super) fn new(qp: &EdgeQp) -> Rows {
         let mut m = Csr::new(qp.n());
         let mut b = qp.t.clone();
+        let (mut h, mut c) = (vec![0.0; qp.n()], vec![0.0; qp.n()]);
         for i in 0..qp.a.nrows() {
             m.push_row(qp.a.row(i).collect());
         }
         for i in 0..qp.b.nrows() {
+            let mut entries = qp.b.row(i);
+            if let (Some((k, v)), None) = (entries.next(), entries.next()) {
+                h[k] += qp.w[i] * v * v;
+                c[k] += qp.w[i] * v * qp.s[i];
+                continue;
+            }
             let root = qp.w[i].sqrt();
             m.push_row(qp.b.row(i).map(|(c, v)| (c, root * v)).collect());
             b.push(root * qp.s[i]);
         }
         let (mt, et) = (transpose(&m), transpose(&qp.eq));
-        Rows { m, b, mt, et }
+        Rows { m, b, mt, et, h, c }
     }
 }
 
@@ -91,7 +103,7 @@ impl Augmented {
         // Unit 2-norm of each free column of [M; S E], and the scaled regulariser's norm.
         let (mut d, mut reg) = (Vec::with_capacity(n_f), Vec::new());
         for &k in &free {
-            let mm: f64 = rows.mt.row(k).map(|(_, v)| v * v).sum();
+            let mm: f64 = rows.mt.row(k).map(|(_, v)| v * v).sum::<f64>() + rows.h[k];
             let ee: f64 = (rows.et.row(k))
                 .map(|(i, v)| (v * row_scale[i]).powi(2))
                 .sum();
@@ -103,7 +115,8 @@ impl Augmented {
             d.push(scale);
             let rr: f64 = (rows.mt.row(k).filter(|(i, _)| *i >= qp.a.nrows()))
                 .map(|(_, v)| v * v)
-                .sum();
+                .sum::<f64>()
+                + rows.h[k];
             if rr > 0.0 {
                 reg.push(rr.sqrt() * scale);
             }
@@ -122,6 +135,13 @@ impl Augmented {
             col_of[k] = j;
         }
         let mut triplets = Vec::new();
+        for (j, &k) in free.iter().enumerate() {
+            triplets.push(Triplet::new(
+                m_m + j,
+                m_m + j,
+                -rows.h[k] * d[j] * d[j] / alpha,
+            ));
+        }
         for i in 0..m_m {
             triplets.push(Triplet::new(i, i, alpha));
             for (c, v) in rows.m.row(i).filter(|(c, _)| is_free(*c)) {
@@ -199,17 +219,30 @@ impl Augmented {
         }
         let z = (0..qp.n())
             .map(|k| {
-                let (value, size) = self.gradient_terms(rows, k, &u, &mu);
+                let (value, size) = self.gradient_terms(rows, k, &x, &u, &mu);
                 [-self.alpha * value, self.alpha * size]
             })
             .collect();
         Some(Solution { x, z, error })
     }
 
-    /// (Mᵀ u + Eᵀ μ)_k by compensated sums, with the sum of its terms' sizes.
-    fn gradient_terms(&self, rows: &Rows, k: usize, u: &[f64], mu: &[f64]) -> (f64, f64) {
+    /// (Mᵀ u + Eᵀ μ − (h x − c) / α)_k by compensated sums, with the sum of its terms' sizes.
+    fn gradient_terms(
+        &self,
+        rows: &Rows,
+        k: usize,
+        x: &[f64],
+        u: &[f64],
+        mu: &[f64],
+    ) -> (f64, f64) {
+        let diagonal = [
+            (-rows.h[k] / self.alpha, x[k]),
+            (rows.c[k] / self.alpha, 1.0),
+        ];
         let terms = || {
-            (rows.mt.row(k).map(|(i, v)| (v, u[i]))).chain(rows.et.row(k).map(|(i, v)| (v, mu[i])))
+            (rows.mt.row(k).map(|(i, v)| (v, u[i])))
+                .chain(rows.et.row(k).map(|(i, v)| (v, mu[i])))
+                .chain(diagonal)
         };
         (dot2(terms()), terms().map(|(a, b)| (a * b).abs()).sum())
     }
@@ -237,7 +270,7 @@ impl Augmented {
             rhs.push(r);
         }
         for (j, &k) in self.free.iter().enumerate() {
-            let (g, s) = self.gradient_terms(rows, k, u, mu);
+            let (g, s) = self.gradient_terms(rows, k, x, u, mu);
             worst[1] = worst[1].max(g.abs());
             size[1] = size[1].max(s);
             rhs.push(-self.d[j] * g);
