@@ -26,6 +26,8 @@ use faer::{Conj, MatMut};
 
 /// Refinement steps at most; refinement stops earlier once the error no longer halves.
 const REFINE: usize = 20;
+/// Refinement steps at least (unless the error is already at rounding).
+const MIN_REFINE: usize = 3;
 
 /// The least-squares rows of the QP, M = [A; √w B] and b = [t; √w s], with the transposes of
 /// M and E. Rows of B with a single entry (the regulariser's) are not rows of M: each adds
@@ -197,14 +199,17 @@ impl Augmented {
             .collect();
         let mut mu = vec![0.0; m_e];
         let (mut best, mut error) = (f64::INFINITY, f64::INFINITY);
-        for _ in 0..REFINE {
+        for step in 0..REFINE {
             crate::interrupt::poll();
             let (rhs, e) = self.residual(qp, rows, &x, &u, &mu);
             error = e;
-            if !error.is_finite() || error >= 0.5 * best || error < 1e-16 {
+            // The error is relative to the terms, which fall by orders of magnitude in the
+            // first corrections where x0 is far from the optimum: it is judged from the third.
+            let stalled = step >= MIN_REFINE && error >= 0.5 * best;
+            if !error.is_finite() || stalled || error < 1e-16 {
                 break;
             }
-            best = error;
+            best = best.min(error);
             let z = self.solve(rhs);
             u.iter_mut().zip(&z).for_each(|(v, dz)| *v += dz);
             for (j, &k) in self.free.iter().enumerate() {

@@ -126,3 +126,53 @@ fn most_wrong(side: &[Side2], z: &[[f64; 2]]) -> Option<usize> {
         .filter(|&k| wrong(k) > DUAL_TOL * scale)
         .max_by(|&a, &b| wrong(a).total_cmp(&wrong(b)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stress::sparse::Csr;
+
+    /// ½ (x0 − x1 − 2)² + ½ w ‖x‖² subject to x0 + x1 + x2 = 3 and x ≥ `lo`, w = 1e-16: along
+    /// the line where the residual vanishes only the regulariser bends the objective.
+    fn line_qp(lo: f64) -> EdgeQp {
+        let mut a = Csr::new(3);
+        a.push_row(vec![(0, 1.0), (1, -1.0)]);
+        let mut b = Csr::new(3);
+        for k in 0..3 {
+            b.push_row(vec![(k, 1.0)]);
+        }
+        let mut eq = Csr::new(3);
+        eq.push_row(vec![(0, 1.0), (1, 1.0), (2, 1.0)]);
+        EdgeQp {
+            a,
+            t: vec![2.0],
+            b,
+            s: vec![0.0; 3],
+            w: vec![1e-16; 3],
+            eq,
+            f: vec![3.0],
+            lo: vec![lo; 3],
+            up: vec![f64::INFINITY; 3],
+        }
+    }
+
+    #[test]
+    fn reaches_the_optimum_the_regulariser_alone_settles() {
+        // On the line x = (2 + s, s, 1 − 2s) the regulariser's minimum is s = 0.
+        let d = descend(&line_qp(-10.0), &[1.0, 1.0, 1.0]).expect("descended");
+        assert!(d.optimal);
+        for (v, want) in d.x.iter().zip([2.0, 0.0, 1.0]) {
+            assert!((v - want).abs() < 1e-9, "{:?}", d.x);
+        }
+    }
+
+    #[test]
+    fn holds_the_bounds_that_settle_the_optimum() {
+        // With x ≥ 0.5 the residual cannot vanish: the optimum is (2, 0.5, 0.5).
+        let d = descend(&line_qp(0.5), &[1.0, 1.0, 1.0]).expect("descended");
+        assert!(d.optimal);
+        for (v, want) in d.x.iter().zip([2.0, 0.5, 0.5]) {
+            assert!((v - want).abs() < 1e-12, "{:?}", d.x);
+        }
+    }
+}
