@@ -281,10 +281,11 @@ fn fine_family() -> Vec<(u64, usize, bool)> {
         .collect()
 }
 
-/// The vaults of the fine family whose fresh analysis stops short of the QP's optimum
-/// (docs/solver.md, "Not every holed vault certifies yet"); ~30 s in a release build.
+/// The vaults of the fine family whose QP's optimum lies far along directions only the
+/// regulariser bends, settled by many bounds (docs/solver.md, "Holed vaults whose optimum
+/// the regulariser settles"): the active-set polish stops short there and the primal descent
+/// certifies them; ~40 s in a release build.
 #[test]
-#[ignore = "fails: the polish stops short (issue 46); cargo test --release -- --ignored"]
 fn form_found_anchored_vaults_that_stop_short_certify_afresh() {
     let cases = [(32, 4, true), (33, 8, true), (36, 1, true)];
     certify_all("reanalysis-short", &cases, 0.0015);
@@ -292,7 +293,7 @@ fn form_found_anchored_vaults_that_stop_short_certify_afresh() {
 
 /// The whole fine family; ~5 min in a release build.
 #[test]
-#[ignore = "fails on three anchored vaults (issue 46); cargo test --release -- --ignored"]
+#[ignore = "~5 min in a release build; cargo test --release -- --ignored"]
 fn form_found_fine_holed_family_certifies_that_it_stands_afresh() {
     let cases = fine_family();
     assert_eq!(cases.len(), 24);
