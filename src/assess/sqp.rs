@@ -4,9 +4,10 @@
 //! last accepted step) and a proximal weight ρ (Levenberg–Marquardt): a step is accepted
 //! only when φ falls by at least a tenth of what its model predicts, else once retried with
 //! a second-order correction (the constraints are bilinear, so their second-order term is
-//! known exactly) and then ρ grows; accepted steps update ρ by Nielsen's rule. ν grows while
-//! the linearised residuals cannot be met at its price and otherwise follows the step's
-//! multipliers (ten times the largest).
+//! known exactly) and then ρ grows; accepted steps update ρ by Nielsen's rule, and one that
+//! leaves the residuals above target is replaced by its corrected step where that is better.
+//! ν grows while the linearised residuals cannot be met at its price and otherwise follows
+//! the step's multipliers (ten times the largest).
 
 use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
@@ -243,7 +244,7 @@ impl<'m, 'a> Search<'m, 'a> {
         let joint_multiplier = step.joint_multiplier;
         let accepted = self
             .acceptable(phi, predicted, &trial)
-            .then_some(trial)
+            .then(|| self.corrected_if_better(layout, &step, trial.clone()))
             .or_else(|| {
                 let correction = bilinear_term(self.model, &step);
                 let input = self.input(Some(&correction));
@@ -286,6 +287,27 @@ impl<'m, 'a> Search<'m, 'a> {
                 Outcome::Continue
             }
             _ => Outcome::Continue,
+        }
+    }
+
+    /// An accepted `trial` that leaves the residuals above the target, or the step with its
+    /// second-order correction where that lowers φ further (so it passes the same test): the
+    /// bilinear term a step leaves in the residuals would otherwise hold each step short of
+    /// equilibrium (the Maratos effect of an exact penalty).
+    fn corrected_if_better(&self, layout: &Layout, step: &Step, trial: State) -> State {
+        if self.model.violation(&trial).0 <= self.feasible_below {
+            return trial;
+        }
+        let correction = bilinear_term(self.model, step);
+        let input = self.input(Some(&correction));
+        let Some(second) = solve_step(self.model, layout, &self.state, &input) else {
+            return trial;
+        };
+        let corrected = self.apply(&second);
+        if self.merit(&corrected) < self.merit(&trial) {
+            corrected
+        } else {
+            trial
         }
     }
 
