@@ -17,7 +17,7 @@
 //! scaled columns the system's condition is about that of M D itself, so refinement against
 //! the exact system, every residual recomputed by compensated sums, converges to rounding.
 
-use super::kkt::{dot2, transpose, EdgeQp, Side2};
+use super::kkt::{dot2, transpose, unit_row_scales, EdgeQp, Side2};
 use super::Csr;
 use faer::linalg::solvers::SolveCore;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -91,17 +91,7 @@ impl Augmented {
         let free: Vec<usize> = (0..qp.n()).filter(|&k| side[k] == Side2::Free).collect();
         let (n_f, m_m, m_e) = (free.len(), rows.m.nrows(), qp.eq.nrows());
         let is_free = |c: usize| side[c] == Side2::Free;
-        let row_scale: Vec<f64> = (0..m_e)
-            .map(|i| {
-                let m = (qp.eq.row(i).filter(|(c, _)| is_free(*c)))
-                    .fold(0.0f64, |m, (_, v)| m.max(v.abs()));
-                if m > 0.0 {
-                    1.0 / m
-                } else {
-                    1.0
-                }
-            })
-            .collect();
+        let row_scale = unit_row_scales(&qp.eq, is_free);
         // Unit 2-norm of each free column of [M; S E], and the scaled regulariser's norm.
         let (mut d, mut reg) = (Vec::with_capacity(n_f), Vec::new());
         for &k in &free {

@@ -59,6 +59,22 @@ pub(super) fn dot2(terms: impl Iterator<Item = (f64, f64)>) -> f64 {
 }
 
 /// The transpose of `m` (columns as rows).
+/// Per row of `m`: 1 over its largest |entry| in the columns `keep` takes (1 where none),
+/// which gives each row unit ∞-norm over those columns.
+pub(super) fn unit_row_scales(m: &Csr, keep: impl Fn(usize) -> bool) -> Vec<f64> {
+    (0..m.nrows())
+        .map(|i| {
+            let largest =
+                (m.row(i).filter(|(c, _)| keep(*c))).fold(0.0f64, |a, (_, v)| a.max(v.abs()));
+            if largest > 0.0 {
+                1.0 / largest
+            } else {
+                1.0
+            }
+        })
+        .collect()
+}
+
 pub(super) fn transpose(m: &Csr) -> Csr {
     let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m.ncols];
     for r in 0..m.nrows() {
@@ -239,17 +255,7 @@ impl System {
         }
         // Row scales of E (unit ∞-norm over the free unknowns), then column scales of x
         // (unit 2-norm of the column of [A; S E; √w B]).
-        let row_scale: Vec<f64> = (0..m_e)
-            .map(|i| {
-                let m = (qp.eq.row(i).filter(|(c, _)| col_of[*c] != usize::MAX))
-                    .fold(0.0f64, |m, (_, v)| m.max(v.abs()));
-                if m > 0.0 {
-                    1.0 / m
-                } else {
-                    1.0
-                }
-            })
-            .collect();
+        let row_scale = unit_row_scales(&qp.eq, |c| col_of[c] != usize::MAX);
         let mut norm2 = vec![0.0; n_f];
         let mut add = |m: &Csr, i: usize, s: f64| {
             for (c, v) in m.row(i) {
