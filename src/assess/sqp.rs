@@ -242,16 +242,11 @@ impl<'m, 'a> Search<'m, 'a> {
         let trial = self.apply(&step);
         let multipliers = step.multipliers.clone();
         let joint_multiplier = step.joint_multiplier;
-        let accepted = self
-            .acceptable(phi, predicted, &trial)
-            .then(|| self.corrected_if_better(layout, &step, trial.clone()))
-            .or_else(|| {
-                let correction = bilinear_term(self.model, &step);
-                let input = self.input(Some(&correction));
-                let second = solve_step(self.model, layout, &self.state, &input)?;
-                let trial = self.apply(&second);
-                self.acceptable(phi, predicted, &trial).then_some(trial)
-            });
+        let accepted = if self.acceptable(phi, predicted, &trial) {
+            Some(self.corrected_if_better(layout, &step, trial))
+        } else {
+            (self.corrected(layout, &step)).filter(|t| self.acceptable(phi, predicted, t))
+        };
         let Some(next) = accepted else {
             return self.reject();
         };
@@ -298,17 +293,19 @@ impl<'m, 'a> Search<'m, 'a> {
         if self.model.violation(&trial).0 <= self.feasible_below {
             return trial;
         }
+        match self.corrected(layout, step) {
+            Some(corrected) if self.merit(&corrected) < self.merit(&trial) => corrected,
+            _ => trial,
+        }
+    }
+
+    /// The state after `step` solved again with its second-order correction: the bilinear
+    /// term it leaves in the residuals moved to the right-hand side.
+    fn corrected(&self, layout: &Layout, step: &Step) -> Option<State> {
         let correction = bilinear_term(self.model, step);
         let input = self.input(Some(&correction));
-        let Some(second) = solve_step(self.model, layout, &self.state, &input) else {
-            return trial;
-        };
-        let corrected = self.apply(&second);
-        if self.merit(&corrected) < self.merit(&trial) {
-            corrected
-        } else {
-            trial
-        }
+        let second = solve_step(self.model, layout, &self.state, &input)?;
+        Some(self.apply(&second))
     }
 
     /// ν at ten times the largest multiplier where the step met its linearised residuals
