@@ -90,7 +90,7 @@ pub(super) fn transpose(m: &Csr) -> Csr {
 }
 
 /// Row-wise M x − rhs, each row by `dot2`.
-fn residual(m: &Csr, x: &[f64], rhs: &[f64]) -> Vec<f64> {
+pub(super) fn residual(m: &Csr, x: &[f64], rhs: &[f64]) -> Vec<f64> {
     (0..m.nrows())
         .map(|r| dot2(m.row(r).map(|(c, v)| (v, x[c])).chain([(rhs[r], -1.0)])))
         .collect()

@@ -245,9 +245,7 @@ fn answer(inp: &QpInput, tau_col: &[Option<usize>], x: &[f64]) -> Certified {
 
 /// max |A x − t|: ε∞ in frame units, by compensated sums.
 fn eps_inf(qp: &EdgeQp, x: &[f64]) -> f64 {
-    (0..qp.a.nrows())
-        .map(|i| kkt::dot2(qp.a.row(i).map(|(c, v)| (v, x[c])).chain([(qp.t[i], -1.0)])))
-        .fold(0.0, |m, r| m.max(r.abs()))
+    inf_norm(&kkt::residual(&qp.a, x, &qp.t))
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
