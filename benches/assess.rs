@@ -10,26 +10,26 @@
 //! Hemispheres: radius 1 on `generate::polar_disk` meshes, rim anchored, thickness 0.1 along
 //! the normal (docs/method.md §16.1), every analysis; t_min/R = s × 0.1. Shared models: each
 //! with a uniform normal thickness of 2 % of its plan diagonal, fit and least thickness.
-//! Heyman: the least thickness of a hemispherical dome and of a semicircular barrel (an arch
-//! strip with free sides) over the family of shells R ± t/2 read vertically
-//! (`min_thickness_of_family`), free supports on the classical springing joint (the plane
-//! z = 0, reach t/2: `Envelope::from_bounds`' defaults), against Heyman's t/R ≈ 0.042 and
-//! Milankovitch's 0.1075 (radial joints) and the continuum values of this convention
-//! (docs/benchmarks.md).
+//! Heyman: the least thickness of a hemispherical dome (on zipped rings and on a radial form
+//! diagram) and of a semicircular barrel (an arch strip with free sides) over the family of
+//! shells R ± t/2 read vertically (`min_thickness_of_family`), free supports on the classical
+//! springing joint (the plane z = 0, reach t/2: `Envelope::from_bounds`' defaults), against
+//! Heyman's t/R ≈ 0.042 and Milankovitch's 0.1075 (radial joints) and the continuum values of
+//! this convention (docs/benchmarks.md).
 //! Large: a hemispherical dome (4921 vertices) and a cross vault (5041) of radius 1 between
 //! the shells R ± t/2 read vertically (t = 0.1; the cross vault's as compas_tno's
 //! `apply_envelope`: the intersection of two semicircular barrels), classical springing
 //! joints, every analysis but max-load; each search is cancelled after `--budget` seconds
 //! of steps (default 600; the `fit` start of the other analyses is not cancelled).
-//! `--only TEXT` (with `--hemisphere`, `--models` or `--large`) keeps the rows whose
-//! "model analysis" contains TEXT.
+//! `--only TEXT` (with `--hemisphere`, `--models`, `--heyman` or `--large`) keeps the rows
+//! whose "model analysis" (with `--heyman`, "model") contains TEXT.
 
 #[path = "../tests/common/models.rs"]
 mod models;
 #[path = "../tests/common/assess.rs"]
 mod shells;
 
-use shells::{barrel, hemisphere_by_angle};
+use shells::{barrel, hemisphere_by_angle, hemisphere_meridians};
 
 use voussoir::{
     assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
@@ -144,6 +144,9 @@ fn shell_family(
 }
 
 fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classical: f64) {
+    if !name.contains(&only()) {
+        return;
+    }
     let problem = Problem::new(mesh.clone());
     let settings = AssessSettings::default();
     let family = |t: f64| shell_family(mesh, &radius, t);
@@ -168,10 +171,22 @@ fn heyman() {
     println!("|---|---|---|---|---|---|---|---|---|");
     let only_barrels = std::env::args().any(|a| a == "--barrels");
     for rings in [6, 10, 14].into_iter().filter(|_| !only_barrels) {
-        let name = format!("hemisphere {rings} rings");
+        let name = format!("hemisphere, zipped, {rings} rings");
         heyman_row(
             &name,
             &hemisphere_by_angle(rings),
+            |p| p[0].hypot(p[1]),
+            0.042,
+        );
+    }
+    for (rings, meridians) in [(6, 16), (10, 24), (14, 32)]
+        .into_iter()
+        .filter(|_| !only_barrels)
+    {
+        let name = format!("hemisphere, radial, {rings} rings x {meridians}");
+        heyman_row(
+            &name,
+            &hemisphere_meridians(rings, meridians),
             |p| p[0].hypot(p[1]),
             0.042,
         );

@@ -25,6 +25,38 @@ pub fn hemisphere_by_angle(rings: usize) -> Mesh {
     generate::lift(&p, &t, height, |_, outer| outer).unwrap()
 }
 
+/// A hemisphere of radius 1 on a radial form diagram (compas_tno's `create_circular_radial`,
+/// triangulated): `rings` rings equal in the meridian's angle, each with `meridians` vertices on
+/// the same meridians, a fan at the crown and every quad split by a diagonal whose direction
+/// alternates from meridian to meridian; rim anchored. Unlike [`hemisphere_by_angle`], its
+/// edges run along continuous meridians and hoops.
+pub fn hemisphere_meridians(rings: usize, meridians: usize) -> Mesh {
+    let mut points = vec![[0.0, 0.0]];
+    for k in 1..=rings {
+        let r = (0.5 * std::f64::consts::PI * k as f64 / rings as f64).sin();
+        for m in 0..meridians {
+            let a = 2.0 * std::f64::consts::PI * m as f64 / meridians as f64;
+            points.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    let id = |k: usize, m: usize| (1 + (k - 1) * meridians + m % meridians) as u32;
+    let mut faces: Vec<[u32; 3]> = (0..meridians)
+        .map(|m| [0, id(1, m), id(1, m + 1)])
+        .collect();
+    for k in 1..rings {
+        for m in 0..meridians {
+            let (a, b, c, d) = (id(k, m), id(k + 1, m), id(k + 1, m + 1), id(k, m + 1));
+            if m % 2 == 0 {
+                faces.extend([[a, b, c], [a, c, d]]);
+            } else {
+                faces.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    let height = |u: [f64; 2]| (1.0 - u[0] * u[0] - u[1] * u[1]).max(0.0).sqrt();
+    generate::lift(&points, &faces, height, |_, outer| outer).unwrap()
+}
+
 /// A semicircular barrel of radius 1 and depth 0.1 (an arch strip with free long sides),
 /// `nx` voussoirs equal in angle and `ny` rows, anchored at x = ±1.
 pub fn barrel(nx: usize, ny: usize) -> Mesh {
