@@ -3,6 +3,7 @@
 //!     cargo bench --bench formfind                  # known-answer cases and the shared models
 //!     cargo bench --bench formfind -- --known       # known-answer cases only
 //!     cargo bench --bench formfind -- --models      # shared models only
+//!     cargo bench --bench formfind -- --models cheese   # ... whose names contain "cheese"
 //!     cargo bench --bench formfind -- --seeds 5     # more seeds per known-answer case
 //!     cargo bench --bench formfind -- --large       # also the 97k-vertex dome
 //!     cargo bench --bench formfind -- --warm        # warm re-solves only
@@ -184,11 +185,14 @@ fn model_list(large: bool) -> Vec<(String, Problem)> {
     list
 }
 
-fn models(large: bool) {
+fn models(large: bool, only: Option<&str>) {
     println!("\nForm finding, default settings (distances over the plan diagonal; \"/ cold\": the form finding's time over one cold stress step of the input)\n");
     println!("| model | V | cold step s (QP its) | method | end | steps | QP its | from last answer | solvers | s | / cold | Hausdorff | L2 | RMS change | max change |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (name, problem) in model_list(large) {
+        if only.is_some_and(|o| !name.contains(o)) {
+            continue;
+        }
         let (cold, cold_its) = cold_step(&problem);
         for method in [FormMethod::Nearest, FormMethod::Paper] {
             let s = FormFindSettings::default().with_method(method);
@@ -295,11 +299,14 @@ fn main() {
         return;
     }
     let (only_known, only_models) = (has("--known"), has("--models"));
+    let only = (args.iter().position(|a| a == "--models"))
+        .and_then(|i| args.get(i + 1))
+        .filter(|a| !a.starts_with("--"));
     if !only_models {
         known(seeds, &[400, 1500]);
     }
     if !only_known {
-        models(has("--large"));
-        warm(has("--large"), None);
+        models(has("--large"), only.map(String::as_str));
+        warm(has("--large"), only.map(String::as_str));
     }
 }

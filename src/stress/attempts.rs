@@ -103,8 +103,9 @@ pub(super) fn slot(f: Formulation) -> usize {
     (f == EdgeBased) as usize
 }
 
-/// What the attempts of a stress step leave: the best answer, the force models built (index
-/// `slot`), and the key of the reduced operator taken from the cache, if one was.
+/// What the attempts of a stress step leave: the best answer (its iterations summed over every
+/// attempt), the force models built (index `slot`), and the key of the reduced operator taken
+/// from the cache, if one was.
 pub(super) struct Attempts {
     pub(super) best: Attempt,
     pub(super) models: [Option<ForceModel>; 2],
@@ -138,7 +139,8 @@ pub(super) fn run_attempts(
     let mut clarabel_tries = 0;
     // The key of a kept reduced operator, stored back with it after the step.
     let mut kept_key = None;
-    for &(solver, formulation, lift_forces, factor) in &attempts {
+    let mut iterations = 0;
+    for (k, &(solver, formulation, lift_forces, factor)) in attempts.iter().enumerate() {
         if models[slot(formulation)].is_none() {
             let kept = (cache.reduced.take())
                 .filter(|(key, _)| formulation == Reduced && key.fits(mesh, plan, settings.holes))
@@ -186,7 +188,9 @@ pub(super) fn run_attempts(
                 } else {
                     &mut cache.fallback
                 };
-                qp::solve_native(&input, normal, cache.coarse, cache.inexact)
+                // Another native attempt next has the same optimum: a stall hands over.
+                let stall_exit = attempts.get(k + 1).is_some_and(|a| a.0 == Native);
+                qp::solve_native(&input, normal, (cache.coarse, cache.inexact), stall_exit)
             }
             Clarabel => {
                 clarabel_tries += 1;
@@ -195,6 +199,7 @@ pub(super) fn run_attempts(
         };
         let status = out.status;
         let n_unknowns = out.y.len();
+        iterations += out.iterations;
         if best
             .as_ref()
             .is_none_or(|b| status.rank() < b.out.status.rank())
@@ -211,7 +216,8 @@ pub(super) fn run_attempts(
             break;
         }
     }
-    let best = best.expect("at least one attempt");
+    let mut best = best.expect("at least one attempt");
+    best.out.iterations = iterations;
     // Consecutive QPs of a form finding differ little: the form that answered goes first.
     cache.native_fallback_first =
         best.solver == Native && best.formulation != native && best.out.status.is_solved();

@@ -120,8 +120,9 @@ pub struct StressResult {
     pub objective: f64,
     /// The force diagram (reciprocal figure) of the forces.
     pub force_diagram: ForceDiagram,
-    /// Iterations of the QP solver; 0 when the native solver reached the optimum from the
-    /// previous step's active set alone (form finding reuses it between steps).
+    /// Iterations of the QP solvers, summed over the step's attempts (a native attempt that
+    /// failed and the one that answered); 0 when the native solver reached the optimum from
+    /// the previous step's active set alone (form finding reuses it between steps).
     pub iterations: u32,
     /// The formulation that produced the forces: the requested one, or the edge-based one when
     /// every reduced attempt failed numerically, when the native solver answered a mesh with

@@ -492,18 +492,24 @@ fn native_bound_rows(
 /// matrix lives in y space. `lift_forces` does not apply. `cache`: see `ipm::solve`;
 /// `coarse`: solve to `ipm::Tolerances::for_form_finding` (coarse beyond 20k unknowns);
 /// `inexact`: a relative gap to stop at where it is looser than the tolerances' (see
-/// `ipm::Tolerances::inexact`).
+/// `ipm::Tolerances::inexact`); `stall_exit`: a stall ends the iterations (another native
+/// attempt with the same optimum follows).
 pub fn solve_native(
     inp: &QpInput,
     cache: &mut ipm::PatternCache,
-    coarse: bool,
-    inexact: Option<f64>,
+    (coarse, inexact): (bool, Option<f64>),
+    stall_exit: bool,
 ) -> QpOutput {
     let n = inp.s.ncols + inp.tau_normal.iter().flatten().count();
     let tol = if coarse {
         ipm::Tolerances::for_form_finding(n)
     } else {
         ipm::Tolerances::for_size(n)
+    };
+    let tol = if stall_exit {
+        tol.with_stall_exit()
+    } else {
+        tol
     };
     let (tol, loosened) = match inexact {
         Some(gap) if gap > tol.gap_rel => (tol.inexact(gap), true),

@@ -133,6 +133,10 @@ pub struct Tolerances {
     pub max_iter: u32,
     /// Gondzio's centrality correctors per iteration, at most (see `CORRECTOR_STRETCH`).
     pub correctors: usize,
+    /// Whether a stall (`kkt::Progress`) ends the iterations: where the caller has a cheaper
+    /// way on than crawling to the budget (`for_size`, `with_stall_exit`). From a warm start
+    /// only beyond 20k unknowns (see `solve`).
+    pub stall_exits: bool,
 }
 
 impl Tolerances {
@@ -142,7 +146,8 @@ impl Tolerances {
     /// - The iteration budget is larger beyond 20k unknowns, where the fallback (clarabel)
     ///   costs thousands of native iterations (see `fallback_is_costly`).
     /// - Beyond 20k unknowns one centrality corrector per iteration instead of three, because
-    ///   each costs a solve with a large factor.
+    ///   each costs a solve with a large factor, and a stall ends the iterations (the caller
+    ///   keeps the answer at hand rather than call clarabel).
     pub fn for_size(n: usize) -> Tolerances {
         let base = Tolerances::default();
         let large = fallback_is_costly(n);
@@ -150,7 +155,17 @@ impl Tolerances {
             dual_feas: base.dual_feas * (n as f64 / 1e4).sqrt().max(1.0),
             max_iter: if large { 150 } else { 80 },
             correctors: if large { 1 } else { base.correctors },
+            stall_exits: large,
             ..base
+        }
+    }
+
+    /// These tolerances, with a stall ending the iterations: for an attempt that another
+    /// native attempt with the same optimum follows.
+    pub fn with_stall_exit(self) -> Tolerances {
+        Tolerances {
+            stall_exits: true,
+            ..self
         }
     }
 
@@ -207,6 +222,7 @@ impl Default for Tolerances {
             // cheaper than crawling on (see `for_size`).
             max_iter: 80,
             correctors: 3,
+            stall_exits: false,
         }
     }
 }
@@ -487,7 +503,13 @@ fn iterate(
     if let Some(w) = warm.filter(|w| !w.z.is_empty()) {
         let start = blend(qp, w, &cold);
         let budget = tol.max_iter.min(WARM_BUDGET);
-        let out = interior_point((qp, normal, cons), start, tol, budget, &mut space);
+        // The blend's first iterations may idle while it leaves the last active set: there a
+        // stall hands over to the cold start only where every stall is an exit anyway.
+        let warm_tol = Tolerances {
+            stall_exits: fallback_is_costly(n),
+            ..*tol
+        };
+        let out = interior_point((qp, normal, cons), start, &warm_tol, budget, &mut space);
         if out.status == IpmStatus::Solved {
             return out;
         }
@@ -535,14 +557,13 @@ fn interior_point(
     budget: u32,
     space: &mut FactorSpace,
 ) -> IpmOutput {
-    let n = qp.c.len();
     // The last iterate that met the relaxed tolerances, returned if the method stops early.
     let mut almost: Option<Vec<f64>> = None;
     let mut polishing = Polishing {
         below: f64::INFINITY,
         failed_guess: None,
     };
-    let (mut progress, stall_exits) = (Progress::new(), fallback_is_costly(n));
+    let mut progress = Progress::new();
     let mut iterations = budget;
     for iteration in 0..budget {
         crate::interrupt::poll();
@@ -563,7 +584,7 @@ fn interior_point(
                 z: it.z,
             };
         }
-        if progress.stalled(iteration, kkt.excess(tol)) && stall_exits {
+        if progress.stalled(iteration, kkt.excess(tol)) && tol.stall_exits {
             iterations = iteration;
             break;
         }
