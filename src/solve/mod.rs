@@ -214,9 +214,9 @@ pub struct FormFindResult {
     /// native method did not converge (see `QpSolver::Native`); also for a step whose answer
     /// gave way to the forces at hand (see `history`).
     pub solvers: Vec<QpSolver>,
-    /// The QP iterations of each stress step (interior-point iterations of the answering
-    /// solver; 0 where the native solver reached the optimum from the previous step's answer
-    /// alone), in the order of `solvers`.
+    /// The QP iterations of each stress step (interior-point iterations of every attempt of
+    /// the step, a failed one's included; 0 where the native solver reached the optimum from
+    /// the previous step's answer alone), in the order of `solvers`.
     pub qp_iterations: Vec<u32>,
     /// Distances to the input surface, normalised by the plan bounding-box diagonal: symmetric
     /// Hausdorff and area-weighted RMS point-to-surface distance, sampled at vertices.
