@@ -252,9 +252,14 @@ fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
+/// Refinement rounds at most of `least_squares`.
+const REFINE_ROUNDS: usize = 8;
+
 /// The least-squares solution Δy of S Δy = dq (normal equations, with the diagonal raised by
-/// 1e-12 of itself against a rank-deficient S), refined once against the residual recomputed
-/// from its definition; None if the factorisation fails.
+/// 1e-12 of itself against a rank-deficient S), refined against the residual recomputed from
+/// its definition while the normal residual Sᵀ(dq − S Δy) halves (`REFINE_ROUNDS` at most):
+/// the normal equations square S's condition, which plan slivers make large, and each round
+/// removes that factor's share of the error again; None if the factorisation fails.
 pub(super) fn least_squares(s: &Csr, dq: &[f64]) -> Option<Vec<f64>> {
     use faer::linalg::solvers::Solve;
     use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
@@ -281,14 +286,19 @@ pub(super) fn least_squares(s: &Csr, dq: &[f64]) -> Option<Vec<f64>> {
     let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets).ok()?;
     let symbolic = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).ok()?;
     let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).ok()?;
+    let st = kkt::transpose(s);
     let mut dy = vec![0.0; n];
-    for _ in 0..2 {
+    let mut last = f64::INFINITY;
+    for _ in 0..REFINE_ROUNDS {
         let sd = s.mul(&dy);
         let r: Vec<f64> = dq.iter().zip(&sd).map(|(a, b)| a - b).collect();
-        let mut rhs = Mat::from_fn(n, 1, |i, _| 0.0 * i as f64);
-        for (i, v) in kkt::transpose(s).mul(&r).into_iter().enumerate() {
-            rhs[(i, 0)] = v;
+        let normal = st.mul(&r);
+        let size = inf_norm(&normal);
+        if !(size < 0.5 * last) {
+            break;
         }
+        last = size;
+        let mut rhs = Mat::from_fn(n, 1, |i, _| normal[i]);
         llt.solve_in_place(rhs.as_mut());
         for (i, d) in dy.iter_mut().enumerate() {
             *d += rhs[(i, 0)];
