@@ -188,8 +188,11 @@ pub(super) fn run_attempts(
                 } else {
                     &mut cache.fallback
                 };
-                // Another native attempt next has the same optimum: a stall hands over.
-                let stall_exit = attempts.get(k + 1).is_some_and(|a| a.0 == Native);
+                // In form finding (whose loop judges each answer and takes another step) a
+                // stall hands over to the next native attempt, which has the same optimum. A
+                // fresh analysis crawls on: an answer near the tolerances is what its
+                // certificate polish needs, and the hard QPs it meets reach one only there.
+                let stall_exit = cache.coarse && attempts.get(k + 1).is_some_and(|a| a.0 == Native);
                 qp::solve_native(&input, normal, (cache.coarse, cache.inexact), stall_exit)
             }
             Clarabel => {
