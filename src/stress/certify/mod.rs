@@ -294,7 +294,7 @@ pub(super) fn least_squares(s: &Csr, dq: &[f64]) -> Option<Vec<f64>> {
         let r: Vec<f64> = dq.iter().zip(&sd).map(|(a, b)| a - b).collect();
         let normal = st.mul(&r);
         let size = inf_norm(&normal);
-        if !(size < 0.5 * last) {
+        if size.is_nan() || size >= 0.5 * last {
             break;
         }
         last = size;
