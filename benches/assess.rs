@@ -7,8 +7,9 @@
 //!     cargo bench --bench assess -- --heyman --barrels   # its barrels only
 //!     cargo bench --bench assess -- --large [--budget S] [--only TEXT]   # ~5k vertices
 //!
-//! Hemispheres: radius 1 on `generate::polar_disk` meshes, rim anchored, thickness 0.1 along
-//! the normal (docs/method.md §16.1), every analysis; t_min/R = s × 0.1. Shared models: each
+//! Hemispheres: radius 1 on `generate::polar_disk` meshes and on radial form diagrams
+//! ("radial"), rim anchored, thickness 0.1 along the normal (docs/method.md §16.1), every
+//! analysis; t_min/R = s × 0.1. Shared models: each
 //! with a uniform normal thickness of 2 % of its plan diagonal, fit and least thickness.
 //! Heyman: the least thickness of a hemispherical dome (on zipped rings and on a radial form
 //! diagram) and of a semicircular barrel (an arch strip with free sides) over the family of
@@ -90,6 +91,18 @@ fn hemispheres() {
             Objective::MaxThrust,
         ] {
             row(&format!("hemisphere {rings} rings"), &mesh, 0.1, objective);
+        }
+    }
+    for (rings, meridians) in [(6, 16), (10, 24), (14, 32)] {
+        let mesh = hemisphere_meridians(rings, meridians);
+        for objective in [
+            Objective::Fit,
+            Objective::MinThickness,
+            Objective::MinThrust,
+            Objective::MaxThrust,
+        ] {
+            let name = format!("radial hemisphere {rings} x {meridians}");
+            row(&name, &mesh, 0.1, objective);
         }
     }
 }
