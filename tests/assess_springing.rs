@@ -7,7 +7,8 @@ mod common;
 
 use common::assess::{barrel, hemisphere_by_angle, hemisphere_meridians, reactions, shell};
 use voussoir::{
-    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error, Mesh, Problem,
+    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error,
+    FamilyThickness, Mesh, Problem,
 };
 
 /// How far beyond its reach (σ b) each support's reaction line meets the springing plane
@@ -37,6 +38,20 @@ fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, toleran
     common::assess::check_certificate(mesh, envelope, r, tolerance);
 }
 
+/// The least thickness over Heyman's shells of a hemisphere `mesh` (`min_thickness_of_family`
+/// from t = 0.1, scale tolerance 1e-3), converged and certified with its joints; with the
+/// envelope at that thickness.
+fn least_heyman_shell(mesh: &Mesh) -> (FamilyThickness, Envelope) {
+    let problem = Problem::new(mesh.clone());
+    let envelope_at = |t: f64| shell(mesh, |p| p[0].hypot(p[1]), t);
+    let settings = AssessSettings::default();
+    let family = min_thickness_of_family(&problem, envelope_at, 0.1, 1e-3, &settings).unwrap();
+    assert!(family.converged, "{} rounds", family.rounds);
+    let envelope = envelope_at(family.thickness).unwrap();
+    check_certificate(mesh, &envelope, &family.result, 1e-6);
+    (family, envelope)
+}
+
 /// Heyman's hemispherical dome over the shells 1 ± t/2 read vertically, springing plane
 /// z = 0 and reach t/2 (the defaults of `from_bounds`): on a 4-ring mesh the least
 /// thickness is within 10 % of 0.059, what the 6- and 10-ring meshes of these zipped rings give
@@ -47,25 +62,21 @@ fn check_certificate(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, toleran
 #[test]
 fn heyman_dome_meets_the_classical_joint() {
     let mesh = hemisphere_by_angle(4);
-    let problem = Problem::new(mesh.clone());
-    let envelope_at = |t: f64| shell(&mesh, |p| p[0].hypot(p[1]), t);
-    let settings = AssessSettings::default();
-    let family = min_thickness_of_family(&problem, envelope_at, 0.1, 1e-3, &settings).unwrap();
+    let (family, envelope) = least_heyman_shell(&mesh);
     let t = family.thickness;
-    assert!(family.converged, "{} rounds", family.rounds);
-    let envelope = envelope_at(t).unwrap();
     for a in (0..mesh.positions().len()).filter(|&v| mesh.anchored()[v]) {
         assert_eq!(envelope.springing[a], 0.0);
         assert!((envelope.reach[a] - 0.5 * t).abs() <= 1e-12);
     }
-    check_certificate(&mesh, &envelope, &family.result, 1e-6);
     assert!((t - 0.059).abs() <= 0.1 * 0.059, "t_min {t}");
     let n = mesh.positions().len();
     let vertical = |t: f64| {
-        let e = envelope_at(t)?;
+        let e = shell(&mesh, |p| p[0].hypot(p[1]), t)?;
         let springing = e.springing.clone();
         e.with_springing(springing, vec![f64::INFINITY; n])
     };
+    let problem = Problem::new(mesh.clone());
+    let settings = AssessSettings::default();
     let old = min_thickness_of_family(&problem, vertical, 0.1, 1e-3, &settings).unwrap();
     assert!(old.result.joints.is_empty());
     assert!(
@@ -82,14 +93,8 @@ fn heyman_dome_meets_the_classical_joint() {
 /// about 30 % above it. Heyman's 0.042 is for his own convention (docs/benchmarks.md).
 #[test]
 fn heyman_dome_on_meridians_meets_the_continuum() {
-    let mesh = hemisphere_meridians(6, 16);
-    let problem = Problem::new(mesh.clone());
-    let envelope_at = |t: f64| shell(&mesh, |p| p[0].hypot(p[1]), t);
-    let settings = AssessSettings::default();
-    let family = min_thickness_of_family(&problem, envelope_at, 0.1, 1e-3, &settings).unwrap();
+    let (family, _) = least_heyman_shell(&hemisphere_meridians(6, 16));
     let t = family.thickness;
-    assert!(family.converged, "{} rounds", family.rounds);
-    check_certificate(&mesh, &envelope_at(t).unwrap(), &family.result, 1e-6);
     assert!((t / 0.0449 - 1.0).abs() <= 0.05, "t_min {t}");
 }
 
