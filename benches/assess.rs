@@ -30,7 +30,7 @@ mod models;
 #[path = "../tests/common/assess.rs"]
 mod shells;
 
-use shells::{barrel, hemisphere_by_angle, hemisphere_meridians};
+use shells::{barrel, hemisphere_by_angle, hemisphere_meridians, shell};
 
 use voussoir::{
     assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
@@ -82,27 +82,20 @@ fn header(what: &str) {
 
 fn hemispheres() {
     header("Hemisphere R = 1, t = 0.1 (normal thickness, tangent-plane vertical reading)");
-    for rings in [6, 10, 14, 20] {
-        let mesh = hemisphere(rings);
+    let zipped =
+        [6, 10, 14, 20].map(|rings| (format!("hemisphere {rings} rings"), hemisphere(rings)));
+    let radial = [(6, 16), (10, 24), (14, 32)].map(|(rings, meridians)| {
+        let name = format!("radial hemisphere {rings} x {meridians}");
+        (name, hemisphere_meridians(rings, meridians))
+    });
+    for (name, mesh) in zipped.iter().chain(&radial) {
         for objective in [
             Objective::Fit,
             Objective::MinThickness,
             Objective::MinThrust,
             Objective::MaxThrust,
         ] {
-            row(&format!("hemisphere {rings} rings"), &mesh, 0.1, objective);
-        }
-    }
-    for (rings, meridians) in [(6, 16), (10, 24), (14, 32)] {
-        let mesh = hemisphere_meridians(rings, meridians);
-        for objective in [
-            Objective::Fit,
-            Objective::MinThickness,
-            Objective::MinThrust,
-            Objective::MaxThrust,
-        ] {
-            let name = format!("radial hemisphere {rings} x {meridians}");
-            row(&name, &mesh, 0.1, objective);
+            row(name, mesh, 0.1, objective);
         }
     }
 }
@@ -136,33 +129,13 @@ fn models() {
     }
 }
 
-/// The shell between radii R ± t/2 (R = 1) read on the vertical at plan radius r; below the
-/// intrados' footprint the springing plane z = 0 bounds it.
-fn shell_bounds(r: f64, t: f64) -> (f64, f64) {
-    let at = |radius: f64| (radius * radius - r * r).max(0.0).sqrt();
-    (at(1.0 - 0.5 * t), at(1.0 + 0.5 * t))
-}
-
-fn shell_family(
-    mesh: &Mesh,
-    radius: impl Fn([f64; 3]) -> f64,
-    t: f64,
-) -> voussoir::Result<Envelope> {
-    let (lower, upper) = mesh
-        .positions()
-        .iter()
-        .map(|&p| shell_bounds(radius(p), t))
-        .unzip();
-    Envelope::from_bounds(mesh, lower, upper, &Thickness::Uniform(t))
-}
-
 fn heyman_row(name: &str, mesh: &Mesh, radius: impl Fn([f64; 3]) -> f64, classical: f64) {
     if !name.contains(&only()) {
         return;
     }
     let problem = Problem::new(mesh.clone());
     let settings = AssessSettings::default();
-    let family = |t: f64| shell_family(mesh, &radius, t);
+    let family = |t: f64| shell(mesh, &radius, t);
     match min_thickness_of_family(&problem, family, 0.1, 1e-3, &settings) {
         Ok(f) => println!(
             "| {name} | {} | {:.4} | {classical} | {:+.1}% | {} | {} | {:.1e} | {:.1} |",
@@ -279,10 +252,10 @@ fn large() {
     println!("| model | V | analysis | end | certified | steps | t_min / R | thrust / weight | eps_inf | s |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
     let dome = hemisphere_by_angle(40);
-    let dome_envelope = shell_family(&dome, |p| p[0].hypot(p[1]), 0.1).unwrap();
+    let dome_envelope = shell(&dome, |p| p[0].hypot(p[1]), 0.1).unwrap();
     let vault = cross_vault(70);
     let groin = |p: [f64; 3]| p[0].abs().min(p[1].abs());
-    let vault_envelope = shell_family(&vault, groin, 0.1).unwrap();
+    let vault_envelope = shell(&vault, groin, 0.1).unwrap();
     for (name, mesh, envelope) in [
         ("dome", &dome, &dome_envelope),
         ("cross vault", &vault, &vault_envelope),

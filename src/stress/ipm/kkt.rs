@@ -117,7 +117,7 @@ pub(super) const STALL_WINDOW: u32 = 10;
 /// iterations. A stall is an exit where `Tolerances::stall_exits` says so: beyond 20k unknowns
 /// (`fallback_is_costly`: the caller then keeps the answer at hand), because there iterations
 /// whose directions have gone inexact can crawl to the iteration limit without improving the
-/// answer, and where another native attempt with the same optimum follows.
+/// answer, and in form finding where another native attempt with the same optimum follows.
 pub(super) struct Progress {
     pub(super) reference: [f64; 2],
     pub(super) since: u32,
