@@ -18,6 +18,7 @@ faces fan-triangulated, its supports anchored, the supports' heights free within
 
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -179,7 +180,8 @@ def run_case(case):
            f"compare.worker({json.dumps(json.dumps(case))}, {str(out)!r})"
     subprocess.run([str(PY), "-c", code], check=True)
     tno = json.loads(out.read_text())
-    problem = WORK / "problem.json"
+    slug = re.sub(r"[^a-z0-9]+", "-", f"{case['name']} {case['analysis']}".lower()).strip("-")
+    problem = WORK / f"problem-{slug}.json"
     problem.write_text(json.dumps(tno["voussoir"]))
     start, before = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
     ours = json.loads(subprocess.run([str(EXE), str(problem)], check=True,
