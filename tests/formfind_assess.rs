@@ -318,9 +318,30 @@ fn the_envelope_of_a_thickness_is_read_along_the_normals_and_loads_its_weight() 
     assert!((total - 2.5 * 0.08 * area).abs() < 1e-12 * total, "{total}");
 }
 
+/// The dome is self-supporting as it stands (its stress alone balances it), so its least
+/// thickness is 0: no safety factor, a null in the report.
+#[test]
+fn a_self_supporting_middle_surface_needs_no_thickness() {
+    let dir = with_dome("assess-min-thickness-zero");
+    let args = ["--assess", "min-thickness", "--thickness", "0.1"];
+    let (code, err) = run_dome(&dir, &args);
+    assert_eq!(code, 0, "{err}");
+    let r = read_json(&dir.path("r.json"));
+    check_certificate(&dir.path("t.obj"), &r);
+    let a = &r["assessment"];
+    assert_eq!(a["thickness_scale"].as_f64(), Some(0.0));
+    assert_eq!(a["thickness_min"].as_f64(), Some(0.0));
+    assert!(a["safety_factor"].is_null(), "{}", a["safety_factor"]);
+}
+
+/// The dome with its crown lowered by 0.03: no longer balanced as it stands, so it needs
+/// some of its thickness.
 #[test]
 fn min_thickness_scales_the_bounds_and_reports_the_safety_factor() {
-    let dir = with_dome("assess-min-thickness");
+    let dir = Scratch::new("assess-min-thickness");
+    let mut d = dome();
+    d.positions[2] -= 0.03;
+    fs::write(dir.path("dome.obj"), obj_text(&d.positions, &d.triangles)).unwrap();
     let args = ["--assess", "min-thickness", "--thickness", "0.1"];
     let (code, err) = run_dome(&dir, &args);
     assert_eq!(code, 0, "{err}");

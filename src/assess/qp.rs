@@ -306,7 +306,7 @@ fn lagrangian_hessian(
     Hessian { blocks }
 }
 
-/// ½ dᵀ P d + cᵀ d: the proximal term ρ (Σ dz² + Σ l² dq² + dt²), the objective's model and
+/// ½ dᵀ P d + cᵀ d: the proximal term ρ max(ν, 1) (Σ dz² + Σ l² dq² + dt²), the objective's model and
 /// the penalty ν Σ (e⁺ + e⁻).
 fn objective(
     model: &Model,
@@ -316,7 +316,10 @@ fn objective(
 ) -> (Triplets, Vec<f64>) {
     let mut p = Triplets::default();
     let mut c = vec![0.0; layout.n];
-    let (rho, rho_z) = (input.rho, input.rho_z);
+    // ρ weighs the proximal term in the QP's units (see `solve_step`), so that a change of
+    // ν does not change how far the next step may go.
+    let unit = input.nu.max(1.0);
+    let (rho, rho_z) = (input.rho * unit, input.rho_z * unit);
     for (e, col) in layout.q_col.iter().enumerate() {
         if let Some(col) = col {
             let l = model.stress.plan.length[e];

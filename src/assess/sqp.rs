@@ -389,9 +389,12 @@ impl<'m, 'a> Search<'m, 'a> {
     fn apply(&self, step: &Step) -> State {
         let model = self.model;
         let s = &self.state;
-        let y = (s.y.iter().zip(&step.dy)).map(|(a, b)| a + b).collect();
-        let q = (s.q.iter().zip(&step.dq).zip(&model.stress.bounds))
-            .map(|((q, dq), b)| b.map_or(0.0, |(lo, hi)| (q + dq).clamp(lo, hi)))
+        let y: Vec<f64> = (s.y.iter().zip(&step.dy)).map(|(a, b)| a + b).collect();
+        // q = S y exactly (the QP meets it to its tolerance): the reduced coordinates' exact
+        // horizontal balance must not drift with the QPs' residuals.
+        let sy = model.stress.s().mul(&y);
+        let q = (sy.iter().zip(&model.stress.bounds))
+            .map(|(q, b)| b.map_or(0.0, |(lo, hi)| q.clamp(lo, hi)))
             .collect();
         let t = match model.objective {
             Objective::MinThickness => (s.t + step.dt).max(0.0),
