@@ -582,7 +582,6 @@ fn fit_ends_nearer_the_middle_than_the_least_thrust() {
     };
     let least_thrust = solve(Objective::MinThrust, 200);
     let fit = solve(Objective::Fit, 60);
-    eprintln!("fit {fit:.4e} least thrust {least_thrust:.4e}");
     assert!(
         fit < least_thrust,
         "fit {fit:.4e}, least thrust {least_thrust:.4e}"

@@ -58,8 +58,12 @@ fn formfind_in(dir: &Scratch, args: &[&str]) -> (i32, String) {
 
 /// A scratch folder with the dome as `dome.obj`.
 fn with_dome(name: &str) -> Scratch {
+    with_mesh(name, &dome())
+}
+
+/// A scratch directory holding `d` as dome.obj.
+fn with_mesh(name: &str, d: &Dome) -> Scratch {
     let dir = Scratch::new(name);
-    let d = dome();
     fs::write(dir.path("dome.obj"), obj_text(&d.positions, &d.triangles)).unwrap();
     dir
 }
@@ -318,16 +322,22 @@ fn the_envelope_of_a_thickness_is_read_along_the_normals_and_loads_its_weight() 
     assert!((total - 2.5 * 0.08 * area).abs() < 1e-12 * total, "{total}");
 }
 
+/// `--assess min-thickness --thickness 0.1` on `dir`'s dome.obj: exit 0, the report with its
+/// surface checked from the outputs.
+fn least_thickness_report(dir: &Scratch) -> Value {
+    let args = ["--assess", "min-thickness", "--thickness", "0.1"];
+    let (code, err) = run_dome(dir, &args);
+    assert_eq!(code, 0, "{err}");
+    let r = read_json(&dir.path("r.json"));
+    check_certificate(&dir.path("t.obj"), &r);
+    r
+}
+
 /// The dome is self-supporting as it stands (its stress alone balances it), so its least
 /// thickness is 0: no safety factor, a null in the report.
 #[test]
 fn a_self_supporting_middle_surface_needs_no_thickness() {
-    let dir = with_dome("assess-min-thickness-zero");
-    let args = ["--assess", "min-thickness", "--thickness", "0.1"];
-    let (code, err) = run_dome(&dir, &args);
-    assert_eq!(code, 0, "{err}");
-    let r = read_json(&dir.path("r.json"));
-    check_certificate(&dir.path("t.obj"), &r);
+    let r = least_thickness_report(&with_dome("assess-min-thickness-zero"));
     let a = &r["assessment"];
     assert_eq!(a["thickness_scale"].as_f64(), Some(0.0));
     assert_eq!(a["thickness_min"].as_f64(), Some(0.0));
@@ -338,15 +348,9 @@ fn a_self_supporting_middle_surface_needs_no_thickness() {
 /// some of its thickness.
 #[test]
 fn min_thickness_scales_the_bounds_and_reports_the_safety_factor() {
-    let dir = Scratch::new("assess-min-thickness");
     let mut d = dome();
     d.positions[2] -= 0.03;
-    fs::write(dir.path("dome.obj"), obj_text(&d.positions, &d.triangles)).unwrap();
-    let args = ["--assess", "min-thickness", "--thickness", "0.1"];
-    let (code, err) = run_dome(&dir, &args);
-    assert_eq!(code, 0, "{err}");
-    let r = read_json(&dir.path("r.json"));
-    check_certificate(&dir.path("t.obj"), &r);
+    let r = least_thickness_report(&with_mesh("assess-min-thickness", &d));
     let a = &r["assessment"];
     let s = a["thickness_scale"].as_f64().unwrap();
     assert!(s > 0.0 && s < 1.0, "scale {s}");

@@ -155,7 +155,10 @@ pub(super) fn solve_step(
     state: &State,
     input: &StepInput,
 ) -> Option<Step> {
-    let (mut p, c) = objective(model, layout, state, input);
+    // The QP in units of ν: the slacks cost 1, so that its tolerances do not depend on
+    // how dear the penalty has become (the step and the multipliers are the same).
+    let unit = input.nu.max(1.0);
+    let (mut p, c) = objective(model, layout, state, input, unit);
     let hessian = input
         .multipliers
         .map(|mu| lagrangian_hessian(model, layout, state, mu, input.direction));
@@ -182,9 +185,6 @@ pub(super) fn solve_step(
     joint_cones(model, layout, state, &mut rows);
     rows.n_soc = (rows.next() - rows.n_zero - rows.n_nonneg) / 3;
     let first_residual_row = layout.q_col.iter().flatten().count();
-    // The QP in units of ν: the slacks cost 1, so that its tolerances do not depend on
-    // how dear the penalty has become (the step and the multipliers are the same).
-    let unit = input.nu.max(1.0);
     p.v.iter_mut().for_each(|v| *v /= unit);
     let c: Vec<f64> = c.iter().map(|v| v / unit).collect();
     let (x, z) = run_clarabel(layout.n, p, &c, rows)?;
@@ -306,19 +306,18 @@ fn lagrangian_hessian(
     Hessian { blocks }
 }
 
-/// ½ dᵀ P d + cᵀ d: the proximal term ρ max(ν, 1) (Σ dz² + Σ l² dq² + dt²), the objective's model and
-/// the penalty ν Σ (e⁺ + e⁻).
+/// ½ dᵀ P d + cᵀ d: the proximal term ρ·unit (Σ dz² + Σ l² dq² + dt²), the objective's
+/// model and the penalty ν Σ (e⁺ + e⁻). `unit` is the QP's (see `solve_step`): ρ weighs
+/// the proximal term in it, so that a change of ν does not change how far a step may go.
 fn objective(
     model: &Model,
     layout: &Layout,
     state: &State,
     input: &StepInput,
+    unit: f64,
 ) -> (Triplets, Vec<f64>) {
     let mut p = Triplets::default();
     let mut c = vec![0.0; layout.n];
-    // ρ weighs the proximal term in the QP's units (see `solve_step`), so that a change of
-    // ν does not change how far the next step may go.
-    let unit = input.nu.max(1.0);
     let (rho, rho_z) = (input.rho * unit, input.rho_z * unit);
     for (e, col) in layout.q_col.iter().enumerate() {
         if let Some(col) = col {
