@@ -372,7 +372,7 @@ fn refit(map: &attempts::ForceMap, y: &[f64], q_old: &[f64], q_new: &[f64]) -> V
             }
             y
         }
-        attempts::ForceMap::Airy(op) => match certify::least_squares_fit(&op.s, &dq) {
+        attempts::ForceMap::Airy(op) => match certify::least_squares_fit(&op.s, &dq, q_new) {
             Some(dy) => y.iter().zip(&dy).map(|(a, b)| a + b).collect(),
             None => y.to_vec(),
         },
@@ -394,7 +394,7 @@ fn reduced_view(
         models[slot(Reduced)] = Some((map, balance));
         return None;
     };
-    match certify::least_squares_fit(&op.s, q_frame) {
+    match certify::least_squares_fit(&op.s, q_frame, q_frame) {
         Some(y) => Some((op, y)),
         None => {
             models[slot(Reduced)] = Some((attempts::ForceMap::Airy(op), balance));

@@ -255,22 +255,23 @@ fn inf_norm(v: &[f64]) -> f64 {
 /// Refinement rounds at most of `least_squares`.
 const REFINE_ROUNDS: usize = 8;
 
-/// A fit whose largest residual |S Δy − dq| is within this fraction of dq's largest entry
-/// is exact to the rounding of S's sums (see `least_squares`).
+/// A fit whose largest residual |S Δy − dq| is within this fraction of the largest force
+/// density it serves is exact to the rounding of those forces (see `least_squares_fit`).
 const FIT_ROUNDING: f64 = 1e-12;
 
 /// [`least_squares`], refined against the exact residuals in Björck's augmented form
 /// (`augmented`, nothing squared) where the normal equations leave the fit further from dq
-/// than rounding; of the two, the one with the smaller largest residual.
-pub(super) fn least_squares_fit(s: &Csr, dq: &[f64]) -> Option<Vec<f64>> {
+/// than the rounding of `forces`, the force densities the fit serves (dq may be a small change
+/// of them); of the two, the one with the smaller largest residual.
+pub(super) fn least_squares_fit(s: &Csr, dq: &[f64], forces: &[f64]) -> Option<Vec<f64>> {
     let y = least_squares(s, dq)?;
-    let size = inf_norm(dq);
+    let scale = inf_norm(forces);
     let misfit = |y: &[f64]| {
         let sy = s.mul(y);
         inf_norm(&sy.iter().zip(dq).map(|(a, b)| a - b).collect::<Vec<f64>>())
     };
     let before = misfit(&y);
-    if before <= FIT_ROUNDING * size {
+    if before <= FIT_ROUNDING * scale {
         return Some(y);
     }
     let n = s.ncols;
@@ -372,11 +373,11 @@ mod tests {
     }
 
     #[test]
-    fn an_ill_conditioned_fit_reproduces_its_target_to_rounding() {
+    fn an_ill_conditioned_fit_beats_the_normal_equations() {
         let s = ill_conditioned();
         let truth = [1.0, -1.0, 0.5, 1.0, 1.0];
         let q = s.mul(&truth);
-        let y = least_squares_fit(&s, &q).expect("fit");
+        let y = least_squares_fit(&s, &q, &q).expect("fit");
         let misfit: Vec<f64> = s.mul(&y).iter().zip(&q).map(|(a, b)| a - b).collect();
         let relative = inf_norm(&misfit) / inf_norm(&q);
         assert!(relative < 1e-9, "misfit {relative:.2e} of the target");
