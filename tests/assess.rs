@@ -567,23 +567,29 @@ fn distance_from_middle(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) -> f
 /// surface of another analysis inside the same envelope, which `fit` could have returned.
 /// On this radial hemisphere a proximal weight that kept the scale of the infeasible phase's
 /// dear penalty halts the search near its start, ten times farther than the least-thrust
-/// surface.
+/// surface; and with the QP's second-order correction alone the search creeps by a fraction
+/// of a percent per step and is still moving at its 200 steps (method.md §16.3).
 #[test]
-fn fit_ends_nearer_the_middle_than_the_least_thrust() {
+fn fit_converges_nearer_the_middle_than_the_least_thrust() {
     let mesh = common::assess::hemisphere_meridians(10, 24);
     let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1)).unwrap();
-    let solve = |objective: Objective, steps: usize| {
-        let settings = (AssessSettings::default())
-            .with_objective(objective)
-            .with_max_iterations(steps);
+    let solve = |objective: Objective| {
+        let settings = AssessSettings::default().with_objective(objective);
         let r = run(mesh.clone(), &envelope, settings);
         check_certificate(&mesh, &envelope, &r, 1e-6);
-        distance_from_middle(&mesh, &envelope, &r)
+        (distance_from_middle(&mesh, &envelope, &r), r)
     };
-    let least_thrust = solve(Objective::MinThrust, 200);
-    let fit = solve(Objective::Fit, 60);
+    let (least_thrust, _) = solve(Objective::MinThrust);
+    let (fit, r) = solve(Objective::Fit);
     assert!(
         fit < least_thrust,
         "fit {fit:.4e}, least thrust {least_thrust:.4e}"
     );
+    assert_eq!(
+        r.termination,
+        Termination::Converged,
+        "{} steps",
+        r.iterations
+    );
+    assert!(r.iterations < 100, "{} steps", r.iterations);
 }

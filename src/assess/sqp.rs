@@ -13,6 +13,7 @@ use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
 use super::{AssessSettings, Objective};
 use crate::error::Result;
+use crate::shape::ShapeStep;
 use crate::solve::{Progress, Termination};
 use std::time::Instant;
 
@@ -53,6 +54,11 @@ pub(super) fn solve(
     let start = Instant::now();
     let layout = Layout::new(model);
     let mut search = Search::new(model, settings);
+    // The other analyses' start (`fit` until certified) keeps the QP's correction: its
+    // answer is their starting point, not the nearest surface.
+    if model.objective == Objective::Fit && until == Until::Optimal {
+        search.heights = ShapeStep::new(&model.problem.mesh).ok();
+    }
     match from {
         Some(state) => search.restart_from(state),
         None => search.start_with_stress(&layout),
@@ -139,6 +145,9 @@ struct Search<'m, 'a> {
     mu: Option<Vec<f64>>,
     /// The last accepted step's dq and dz.
     direction: Option<(Vec<f64>, Vec<f64>)>,
+    /// The height solve of `fit`'s projected correction (none for the other analyses and
+    /// their start, or where its analysis failed).
+    heights: Option<ShapeStep>,
 }
 
 impl<'m, 'a> Search<'m, 'a> {
@@ -172,6 +181,7 @@ impl<'m, 'a> Search<'m, 'a> {
             polishing: false,
             mu: None,
             direction: None,
+            heights: None,
         }
     }
 
@@ -245,7 +255,9 @@ impl<'m, 'a> Search<'m, 'a> {
         let accepted = if self.acceptable(phi, predicted, &trial) {
             Some(self.corrected_if_better(layout, &step, trial))
         } else {
-            (self.corrected(layout, &step)).filter(|t| self.acceptable(phi, predicted, t))
+            self.corrected(layout, &step, &trial, |t| {
+                self.acceptable(phi, predicted, t)
+            })
         };
         let Some(next) = accepted else {
             return self.reject();
@@ -293,19 +305,58 @@ impl<'m, 'a> Search<'m, 'a> {
         if self.model.violation(&trial).0 <= self.feasible_below {
             return trial;
         }
-        match self.corrected(layout, step) {
-            Some(corrected) if self.merit(&corrected) < self.merit(&trial) => corrected,
-            _ => trial,
-        }
+        let phi = self.merit(&trial);
+        (self.corrected(layout, step, &trial, |c| self.merit(c) < phi)).unwrap_or(trial)
     }
 
-    /// The state after `step` solved again with its second-order correction: the bilinear
-    /// term it leaves in the residuals moved to the right-hand side.
-    fn corrected(&self, layout: &Layout, step: &Step) -> Option<State> {
+    /// The step's second-order correction, where `better` takes it: for `fit`, first the
+    /// trial's heights projected onto equilibrium with its forces (one height solve: the
+    /// least change in the fit's own measure), else the step solved again with the bilinear
+    /// term it leaves in the residuals on the right-hand side (one QP).
+    fn corrected(
+        &self,
+        layout: &Layout,
+        step: &Step,
+        trial: &State,
+        better: impl Fn(&State) -> bool,
+    ) -> Option<State> {
+        if let Some(projected) = self.projected(trial).filter(&better) {
+            return Some(projected);
+        }
         let correction = bilinear_term(self.model, step);
         let input = self.input(Some(&correction));
         let second = solve_step(self.model, layout, &self.state, &input)?;
-        Some(self.apply(&second))
+        Some(self.apply(&second)).filter(better)
+    }
+
+    /// `trial` with the heights of its non-anchored vertices moved the least (area-weighted)
+    /// to balance its forces, then brought back within the envelope: Fletcher's second-order
+    /// correction as a projection onto the residuals' zero set along the heights. None where
+    /// the height solve fails.
+    fn projected(&self, trial: &State) -> Option<State> {
+        let (model, heights) = (self.model, self.heights.as_ref()?);
+        let rows = heights.vertices();
+        let loads: Vec<f64> = (0..trial.z.len()).map(|v| model.load(trial, v)).collect();
+        let area: Vec<f64> = rows.iter().map(|&v| model.area[v as usize]).collect();
+        // A pull far below K's own scale: a projection where K is regular, and where a
+        // vertex has lost all stress its height stays.
+        let scale = (rows.iter())
+            .map(|&v| {
+                let sum: f64 = (model.incident[v as usize].iter())
+                    .map(|&e| trial.q[e as usize].abs())
+                    .sum();
+                sum * sum
+            })
+            .sum::<f64>()
+            / rows.len().max(1) as f64;
+        let mean_area = area.iter().sum::<f64>() / rows.len().max(1) as f64;
+        let rho = 1e-10 * scale / mean_area.max(f64::MIN_POSITIVE);
+        let z =
+            (heights.nearest(&trial.q, &loads, &trial.z, &trial.z, rho, &area, None, None)).ok()?;
+        Some(State {
+            z: self.within(z, trial.t),
+            ..trial.clone()
+        })
     }
 
     /// ν at ten times the largest multiplier where the step met its linearised residuals
@@ -400,29 +451,36 @@ impl<'m, 'a> Search<'m, 'a> {
             Objective::MinThickness => (s.t + step.dt).max(0.0),
             _ => s.t + step.dt,
         };
-        // Within the envelope at the new scale (the QP meets it to its tolerance).
+        let z = (s.z.iter().zip(&step.dz)).map(|(z, dz)| z + dz).collect();
+        // Within the envelope (the QP meets it to its tolerance).
+        State {
+            y,
+            q,
+            z: self.within(z, t),
+            t,
+        }
+    }
+
+    /// Heights `z` brought within the envelope at the scale of the scalar `t`, and on or
+    /// above the springing planes.
+    fn within(&self, mut z: Vec<f64>, t: f64) -> Vec<f64> {
+        let model = self.model;
         let scale = model.scale(&State {
             t,
             ..State::default()
         });
-        let mut z: Vec<f64> = (0..s.z.len())
-            .map(|v| {
-                let z = s.z[v] + step.dz[v];
-                if model.variable[v] {
-                    let (m, h) = (model.middle[v], scale * model.half[v]);
-                    z.clamp(m - h, m + h)
-                } else {
-                    z
-                }
-            })
-            .collect();
-        // On or above the springing plane (the QP meets it to its tolerance).
+        for (v, z) in z.iter_mut().enumerate() {
+            if model.variable[v] {
+                let (m, h) = (model.middle[v], scale * model.half[v]);
+                *z = z.clamp(m - h, m + h);
+            }
+        }
         for joint in &model.joints {
             let a = joint.support as usize;
             let m = model.middle[a];
             z[a] = z[a].max(m - scale * (m - joint.springing));
         }
-        State { y, q, z, t }
+        z
     }
 
     fn record(&mut self) {
