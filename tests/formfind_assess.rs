@@ -368,6 +368,34 @@ fn min_thickness_scales_the_bounds_and_reports_the_safety_factor() {
     }
 }
 
+/// A vault thinner than its least thickness: the least-thickness search scales the envelope
+/// up and certifies a surface there, but the vault as given is not shown safe, so the CLI
+/// exits 3 and says how much thicker it must be. The least thickness does not depend on the
+/// given one (the loads scale with it, which scales the stress, not the surface).
+#[test]
+fn a_least_thickness_above_the_given_one_exits_3() {
+    let mut d = dome();
+    d.positions[2] -= 0.03;
+    let dir = with_mesh("assess-min-thickness-thin", &d);
+    let t_min = least_thickness_report(&dir)["assessment"]["thickness_min"]
+        .as_f64()
+        .unwrap();
+    let thin = format!("{}", t_min / 3.0);
+    let (code, err) = run_dome(&dir, &["--assess", "min-thickness", "--thickness", &thin]);
+    assert_eq!(code, 3, "{err}");
+    assert!(
+        err.contains("safety factor") && err.contains("< 1"),
+        "{err}"
+    );
+    let r = read_json(&dir.path("r.json"));
+    check_certificate(&dir.path("t.obj"), &r);
+    let a = &r["assessment"];
+    assert_eq!(a["feasible"], true);
+    let s = a["thickness_scale"].as_f64().unwrap();
+    assert!((s - 3.0).abs() < 0.03, "scale {s}");
+    assert!(a["safety_factor"].as_f64().unwrap() < 1.0, "{a}");
+}
+
 /// Free supports from a thickness stand on or above their springing plane, the middle
 /// surface's height (docs/method.md §16.1): the greatest thrust raises them, as far as the
 /// joint lets the thrust reach the plane.

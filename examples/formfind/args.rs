@@ -161,7 +161,8 @@ Solver:
 
 Exit status: 0 converged (or --stress-only solved; with --assess: a certified thrust
 surface found and the analysis converged), 3 finished without converging or (--assess) with
-no thrust surface inside the envelope (outputs written, the report says why), 2 bad input,
+no thrust surface inside the envelope, or a least thickness above the given one (outputs
+written, the report says why), 2 bad input,
 options or output paths (nothing written), 1 other failure (nothing written).
 ",
         methods = names(FormMethod::ALL, " | "),

@@ -63,10 +63,17 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
     );
     crate::print_written(&paths, &pictures, &hint);
     let r = &a.result;
-    if r.feasible && r.termination == Termination::Converged {
+    let thicker = r.objective == Objective::MinThickness && r.thickness_scale > 1.0;
+    if r.feasible && r.termination == Termination::Converged && !thicker {
         return Ok(ExitCode::SUCCESS);
     }
-    let why = if r.feasible {
+    let why = if r.feasible && thicker {
+        format!(
+            "the least thickness found is {:.4} times the given one (safety factor {:.4} < 1): \
+             no thrust surface was found inside the vault as given",
+            r.thickness_scale, r.safety_factor
+        )
+    } else if r.feasible {
         format!(
             "{}: the thrust surface written is certified, its {} not proven optimal",
             ending(&r.termination),
@@ -111,8 +118,13 @@ fn summary(a: &run::Assessed) {
     );
     let (excess, vertex) = r.worst_bound;
     if r.feasible {
+        let scaled = if r.thickness_scale == 1.0 {
+            String::new()
+        } else {
+            format!(" at {:.6} times the thickness", r.thickness_scale)
+        };
         say!(
-            "a thrust surface fits: ε∞ = {:.2e}, q ≥ 0, every height within its bounds",
+            "a thrust surface fits{scaled}: ε∞ = {:.2e}, q ≥ 0, every height within its bounds",
             r.eps_inf
         );
     } else {
