@@ -156,7 +156,12 @@ fn bad_input_gets_one_line_and_no_output() {
     rejects(
         &[("sq.obj", SQUARE), ("s.json", "{\"anchored\": [0, 99]}")],
         &["sq.obj", "--supports", "s.json"],
-        "anchored vertex 99",
+        "--supports s.json: anchored vertex 99: out of range (MESH's vertex ids are 0 to 4",
+    );
+    rejects(
+        &[("sq.obj", SQUARE), ("s.json", "[3, 1, 3]")],
+        &["sq.obj", "--supports", "s.json"],
+        "--supports s.json: anchored vertex 3: listed twice",
     );
     rejects(
         &[("sq.obj", SQUARE), ("s.json", "{\"anchored\": [0, -1]}")],

@@ -106,6 +106,9 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
             name: "weld tolerance",
             reason,
         }) => return Err(format!("--weld: {reason} (or --no-weld)")),
+        Err(e @ voussoir::Error::InvalidAnchor { .. }) => {
+            return Err(anchor_error(&e, mesh_path, &options.supports))
+        }
         other => other.map_err(|e| e.to_string())?,
     };
     let name = mesh_path
@@ -117,6 +120,16 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
         faces: model.problem.mesh.input_faces(),
         read: model,
     })
+}
+
+/// An anchored id out of range or repeated, with the supports' source and MESH's id range
+/// (its own vertices, before welding).
+fn anchor_error(e: &voussoir::Error, mesh_path: &Path, supports: &io::Supports) -> String {
+    let range = io::read_mesh(mesh_path).map_or(String::new(), |(positions, _)| {
+        let last = positions.len().saturating_sub(1);
+        format!(" (MESH's vertex ids are 0 to {last}, before welding)")
+    });
+    format!("--supports {supports}: {e}{range}")
 }
 
 /// Whether `e` says the plan (the projection along z) is not a valid one.
