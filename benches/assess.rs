@@ -30,7 +30,7 @@ mod models;
 #[path = "../tests/common/assess.rs"]
 mod shells;
 
-use shells::{barrel, hemisphere_by_angle, hemisphere_meridians, shell};
+use shells::{barrel, distance_from_middle, hemisphere_by_angle, hemisphere_meridians, shell};
 
 use voussoir::{
     assess, generate, min_thickness_of_family, AssessSettings, Envelope, Mesh, Objective, Problem,
@@ -69,26 +69,10 @@ fn row(name: &str, mesh: &Mesh, thickness: f64, objective: Objective) {
         r.iterations,
         r.thickness_scale * thickness,
         r.thrust_horizontal / total,
-        distance(mesh, &envelope.middle, &r.positions),
+        distance_from_middle(mesh, &envelope.middle, &r.positions),
         r.eps_inf,
         r.seconds
     );
-}
-
-/// The plan-area-weighted RMS of the thrust surface's height above the middle surface: the
-/// root of `fit`'s objective (a third of each face's plan area to each corner).
-fn distance(mesh: &Mesh, middle: &[f64], positions: &[[f64; 3]]) -> f64 {
-    let (mut sum, mut area) = (0.0, 0.0);
-    for f in mesh.faces() {
-        let [a, b, c] = f.map(|v| positions[v as usize]);
-        let share =
-            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs() / 3.0;
-        for &v in f {
-            sum += share * (positions[v as usize][2] - middle[v as usize]).powi(2);
-            area += share;
-        }
-    }
-    (sum / area).sqrt()
 }
 
 fn header(what: &str) {

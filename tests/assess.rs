@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::assess::{check_certificate, shell};
+use common::assess::{check_certificate, distance_from_middle, shell};
 
 use voussoir::generate::{self, KnownPlan};
 use voussoir::{
@@ -546,23 +546,6 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
     assert!(most.load_factor > 31.58, "λ = {}", most.load_factor);
 }
 
-/// Σ a_v (z_v − m_v)² with a_v a third of the plan area of each face at v: what `fit`
-/// minimises, up to its normalisation.
-fn distance_from_middle(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) -> f64 {
-    let p = mesh.positions();
-    let mut share = vec![0.0; p.len()];
-    for f in mesh.faces() {
-        let [a, b, c] = f.map(|v| p[v as usize]);
-        let area = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs();
-        for &v in f {
-            share[v as usize] += area / 3.0;
-        }
-    }
-    (0..p.len())
-        .map(|v| share[v] * (r.positions[v][2] - envelope.middle[v]).powi(2))
-        .sum()
-}
-
 /// `fit` looks for the surface nearest the middle surface, so it ends nearer it than the
 /// surface of another analysis inside the same envelope, which `fit` could have returned.
 /// On this radial hemisphere a proximal weight that kept the scale of the infeasible phase's
@@ -577,7 +560,10 @@ fn fit_converges_nearer_the_middle_than_the_least_thrust() {
         let settings = AssessSettings::default().with_objective(objective);
         let r = run(mesh.clone(), &envelope, settings);
         check_certificate(&mesh, &envelope, &r, 1e-6);
-        (distance_from_middle(&mesh, &envelope, &r), r)
+        (
+            distance_from_middle(&mesh, &envelope.middle, &r.positions),
+            r,
+        )
     };
     let (least_thrust, _) = solve(Objective::MinThrust);
     let (fit, r) = solve(Objective::Fit);

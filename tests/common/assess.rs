@@ -205,3 +205,21 @@ fn check_joints(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, tolerance: f
         assert!(joint.offset <= s * b * (1.0 + 1e-3));
     }
 }
+
+/// The plan-area-weighted RMS height of `positions` above the middle surface `middle` (a
+/// third of each face's plan area to each corner): the root of what `fit` minimises, up to
+/// its normalisation.
+pub fn distance_from_middle(mesh: &Mesh, middle: &[f64], positions: &[[f64; 3]]) -> f64 {
+    let p = mesh.positions();
+    let (mut sum, mut area) = (0.0, 0.0);
+    for f in mesh.faces() {
+        let [a, b, c] = f.map(|v| p[v as usize]);
+        let share =
+            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).abs() / 3.0;
+        for &v in f {
+            sum += share * (positions[v as usize][2] - middle[v as usize]).powi(2);
+            area += share;
+        }
+    }
+    (sum / area).sqrt()
+}
