@@ -544,6 +544,28 @@ fn compas_tno_cross_vault_fits_and_carries_its_largest_load() {
     let most = assess(&problem, &envelope, &settings, None).unwrap();
     check_certificate(&mesh, &envelope, &most, 1e-6);
     assert!(most.load_factor > 31.58, "λ = {}", most.load_factor);
+    assert_eq!(most.termination, Termination::Converged);
+}
+
+/// A search ends where its undamped step predicts no fall of the merit beyond the QPs'
+/// noise (method.md §16.3). On this radial hemisphere in its shell R ± t/2, without
+/// springing joints, `fit` and `min-thrust` take 17 and 16 steps that way; rejecting such
+/// steps until the proximal weight reached its limit took 34 and 32.
+#[test]
+fn searches_end_at_a_stationary_point() {
+    let mesh = common::assess::hemisphere_meridians(6, 16);
+    let shell = shell(&mesh, |p| p[0].hypot(p[1]), 0.1).unwrap();
+    let reach = vec![f64::INFINITY; mesh.positions().len()];
+    let envelope = (shell.clone()).with_springing(shell.lower, reach).unwrap();
+    let mut steps = 0;
+    for objective in [Objective::Fit, Objective::MinThrust] {
+        let settings = AssessSettings::default().with_objective(objective);
+        let result = run(mesh.clone(), &envelope, settings);
+        check_certificate(&mesh, &envelope, &result, 1e-6);
+        assert_eq!(result.termination, Termination::Converged, "{objective}");
+        steps += result.iterations;
+    }
+    assert!(steps <= 50, "{steps} steps");
 }
 
 /// `fit` looks for the surface nearest the middle surface, so it ends nearer it than the

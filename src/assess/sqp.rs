@@ -23,6 +23,8 @@ const RHO_START: f64 = 1e-2;
 const RHO_MIN: f64 = 1e-8;
 /// Only steps at most this damped say the objective has settled.
 const RHO_SETTLED: f64 = 1e-3;
+/// A predicted fall of φ below this fraction of the objective is the QPs' noise.
+const STATIONARY: f64 = 1e-7;
 /// Beyond this ρ no step of the model lowers φ: the search is stationary.
 const RHO_MAX: f64 = 1e8;
 /// ν at most this factor above its start.
@@ -249,6 +251,9 @@ impl<'m, 'a> Search<'m, 'a> {
         };
         let phi = self.merit(&self.state);
         let predicted = phi - (step.model_objective + self.nu * step.slack + step.curvature);
+        if self.stationary(predicted) {
+            return Outcome::Converged;
+        }
         let trial = self.apply(&step);
         let multipliers = step.multipliers.clone();
         let joint_multiplier = step.joint_multiplier;
@@ -260,6 +265,13 @@ impl<'m, 'a> Search<'m, 'a> {
             })
         };
         let Some(next) = accepted else {
+            if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
+                let actual = phi - self.merit(&self.apply(&step));
+                eprintln!(
+                    "reject pred {predicted:.2e} actual {actual:.2e} rho {:.1e}",
+                    self.rho
+                );
+            }
             return self.reject();
         };
         let before = self.model.objective_value(&self.state);
@@ -286,7 +298,11 @@ impl<'m, 'a> Search<'m, 'a> {
         }
         self.history.push(after);
         let settled = self.rho <= RHO_SETTLED && self.settled();
-        match (settled, self.residual <= self.feasible_below) {
+        // Polishing starts once the objective has settled: equilibrium ends it.
+        match (
+            settled || self.polishing,
+            self.residual <= self.feasible_below,
+        ) {
             (true, true) => Outcome::Converged,
             // The objective has settled short of equilibrium: polish with a dear penalty.
             (true, false) => {
@@ -368,6 +384,16 @@ impl<'m, 'a> Search<'m, 'a> {
             let largest = max_abs(multipliers).max(joint);
             self.nu = (factor * largest).clamp(self.nu_max / NU_RANGE, self.nu_max);
         }
+    }
+
+    /// A feasible state where a step barely damped predicts no fall of φ above a relative
+    /// `STATIONARY` of the objective: a first-order stationary point of the merit to the
+    /// QPs' accuracy (the predicted fall of an ℓ1 model is zero exactly at a KKT point).
+    fn stationary(&self, predicted: f64) -> bool {
+        let f = self.model.objective_value(&self.state);
+        self.rho <= RHO_SETTLED
+            && self.residual <= self.feasible_below
+            && predicted <= STATIONARY * (f.abs() + self.objective_floor())
     }
 
     /// The objective moved by less than a relative 1e-5 over the last five accepted steps
