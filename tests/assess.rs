@@ -8,8 +8,8 @@ use common::assess::{check_certificate, distance_from_middle, shell};
 
 use voussoir::generate::{self, KnownPlan};
 use voussoir::{
-    assess, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error, Mesh,
-    Objective, Problem, Termination, Thickness,
+    assess, form_find, min_thickness_of_family, AssessResult, AssessSettings, Envelope, Error,
+    FormFindSettings, Mesh, Objective, Problem, Termination, Thickness,
 };
 
 /// A fan: a free centre at height `rise` over n rim supports on the circle of radius `r`.
@@ -600,4 +600,32 @@ fn fit_converges_nearer_the_middle_than_the_least_thrust() {
         r.iterations
     );
     assert!(r.iterations < 100, "{} steps", r.iterations);
+}
+
+/// free_vault form-found with form finding's default τ leans on pushes at its free edges
+/// (method.md §6), which an assessment's free edges (τ = 0) do not give: no search finds a
+/// thrust surface inside 3 % of its plan diagonal. Each search ends once its infeasibility
+/// settles at the largest penalty (method.md §16.3): 81 steps for the start, the floored
+/// retry and the least thickness together, where creeping to each iteration limit and a
+/// polish took about 700.
+#[test]
+fn free_vault_without_its_edge_pushes_stalls_at_once() {
+    let Some(dir) = common::models_dir() else {
+        return;
+    };
+    let problem = common::read_shared(&dir, "free_vault").unwrap();
+    let found = form_find(&problem, &FormFindSettings::default(), None).unwrap();
+    assert_eq!(found.termination, Termination::Converged);
+    let heights: Vec<f64> = found.positions.iter().map(|p| p[2]).collect();
+    let mesh = problem.mesh.clone().with_heights(&heights).unwrap();
+    let t = 0.03 * common::assess::plan_diagonal(&mesh);
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(t)).unwrap();
+    let result = run(mesh, &envelope, AssessSettings::default());
+    assert!(!result.feasible);
+    assert!(
+        matches!(result.termination, Termination::Stalled { .. }),
+        "{:?}",
+        result.termination
+    );
+    assert!(result.iterations <= 200, "{} steps", result.iterations);
 }

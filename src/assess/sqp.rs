@@ -67,6 +67,7 @@ pub(super) fn solve(
     }
     let mut termination = Termination::MaxIterations;
     let mut iterations = 0;
+    let mut stalled = false;
     while iterations < settings.max_iterations {
         if until == Until::Certified && search.best_feasible.is_some() {
             termination = Termination::Converged;
@@ -77,6 +78,11 @@ pub(super) fn solve(
             Outcome::Continue => {}
             Outcome::Stationary => {
                 termination = search.stationary_termination();
+                break;
+            }
+            Outcome::Infeasible => {
+                termination = search.stationary_termination();
+                stalled = true;
                 break;
             }
             Outcome::Converged => {
@@ -92,7 +98,7 @@ pub(super) fn solve(
         }
     }
     let found = until == Until::Certified && search.best_feasible.is_some();
-    if termination != Termination::Cancelled && !found {
+    if termination != Termination::Cancelled && !found && !stalled {
         iterations += search.polish(&layout);
     }
     let state = search.answer();
@@ -120,6 +126,9 @@ enum Outcome {
     Continue,
     Stationary,
     Converged,
+    /// The infeasibility has settled at the largest penalty: a stationary point of it,
+    /// which a polish at that penalty would not leave either.
+    Infeasible,
 }
 
 struct Search<'m, 'a> {
@@ -140,6 +149,8 @@ struct Search<'m, 'a> {
     least_infeasible: (f64, State),
     /// Objective values after the accepted steps.
     history: Vec<f64>,
+    /// ‖c‖₁ plus the joints' excess after the accepted steps.
+    violations: Vec<f64>,
     /// Once the objective has settled: ν stays high until the residuals meet the target.
     polishing: bool,
     /// The multipliers of the last accepted step's residual rows: the Hessian of the
@@ -180,6 +191,7 @@ impl<'m, 'a> Search<'m, 'a> {
             certified_below: 0.5 * settings.tolerance,
             best_feasible: None,
             history: Vec::new(),
+            violations: Vec::new(),
             polishing: false,
             mu: None,
             direction: None,
@@ -227,7 +239,7 @@ impl<'m, 'a> Search<'m, 'a> {
         while self.residual > self.feasible_below && steps < POLISH_STEPS {
             steps += 1;
             self.nu = (self.nu * 1e3).min(self.nu_max);
-            if let Outcome::Stationary = self.iterate(layout) {
+            if let Outcome::Stationary | Outcome::Infeasible = self.iterate(layout) {
                 break;
             }
         }
@@ -297,6 +309,10 @@ impl<'m, 'a> Search<'m, 'a> {
             );
         }
         self.history.push(after);
+        self.violations.push(self.model.violation(&self.state).1);
+        if self.infeasibility_settled() {
+            return Outcome::Infeasible;
+        }
         let settled = self.rho <= RHO_SETTLED && self.settled();
         // Polishing starts once the objective has settled: equilibrium ends it.
         match (
@@ -394,6 +410,18 @@ impl<'m, 'a> Search<'m, 'a> {
         self.rho <= RHO_SETTLED
             && self.residual <= self.feasible_below
             && predicted <= STATIONARY * (f.abs() + self.objective_floor())
+    }
+
+    /// At the largest penalty with the residuals above target, the violation moved by less
+    /// than a relative 1e-5 over the last five accepted steps: the search creeps along a
+    /// stationary point of the infeasibility (a plan whose free edges no compression-only
+    /// stress balances ends there), which the iteration limit would not see it leave.
+    fn infeasibility_settled(&self) -> bool {
+        let v = &self.violations;
+        self.nu >= self.nu_max * (1.0 - 1e-9)
+            && self.residual > self.feasible_below
+            && v.len() >= 6
+            && (v[v.len() - 6] - v[v.len() - 1]).abs() <= 1e-5 * v[v.len() - 1]
     }
 
     /// The objective moved by less than a relative 1e-5 over the last five accepted steps
