@@ -293,7 +293,9 @@ impl<'m, 'a> Search<'m, 'a> {
             self.update_penalty(&multipliers, joint_multiplier, step.slack);
             self.mu = Some(multipliers);
         }
-        self.residual = self.model.violation(&self.state).0;
+        let (largest, l1) = self.model.violation(&self.state);
+        self.residual = largest;
+        self.violations.push(l1);
         self.record();
         let ratio = (phi - self.merit(&self.state)) / predicted;
         // Nielsen's update: ρ follows how well the model predicted, without the swing
@@ -309,7 +311,6 @@ impl<'m, 'a> Search<'m, 'a> {
             );
         }
         self.history.push(after);
-        self.violations.push(self.model.violation(&self.state).1);
         if self.infeasibility_settled() {
             return Outcome::Infeasible;
         }
