@@ -862,6 +862,20 @@ TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
     }
 }
 
+// The pyramid 0.3 high in a slab 0.8 thick holds the plane through its supports: ever
+// flatter surfaces carry its weight, and the greatest thrust has no bound; 0.1 thick it has.
+TEST(CppApi, AnUnboundedGreatestThrustSaysSo) {
+    const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
+    voussoir::AssessSettings settings;
+    settings.objective(VSR_OBJECTIVE_MAX_THRUST);
+    for (double t : {0.8, 0.1}) {
+        const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, t);
+        const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
+        EXPECT_TRUE(a.outcome().converged()) << t;
+        EXPECT_EQ(a.thrust_unbounded(), t > 0.5) << t;
+    }
+}
+
 TEST(CppApi, SpringingJointsReachTheCSetter) {
     const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
     voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);

@@ -2028,6 +2028,18 @@ VsrStatus vsr_assessment_joints(const struct VsrAssessment *assessment, double *
 VsrStatus vsr_assessment_worst_joint(const struct VsrAssessment *assessment, double *excess, uint32_t *vertex);
 
 /**
+ * `unbounded` 1 when the analysis is max-thrust and the greatest thrust has no bound: the
+ * returned surface is certified, and its force densities scaled by every s from some
+ * s₀ ≥ 1 on, with heights approaching its unloaded surface over the same supports, give
+ * certified surfaces too (docs/method.md §16.4), so `thrust_horizontal` is a thrust
+ * reached, not the greatest; else 0. The pointer required; written only on success.
+ *
+ * # Safety
+ * `assessment`: a valid handle; the out-pointer writable.
+ */
+VsrStatus vsr_assessment_thrust_unbounded(const struct VsrAssessment *assessment, uint32_t *unbounded);
+
+/**
  * The least thickness t of a family of envelopes whose bounds are functions of t (Heyman's
  * dome between the spheres R ± t/2 read vertically, compas_tno's `zlb`/`zub`): `envelope_at`
  * gives the bounds at t; the self-weight is the middle surface's area × t × the settings'

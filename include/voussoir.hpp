@@ -804,6 +804,12 @@ class Assessment {
                                          &c.worst_residual_vertex));
         return c;
     }
+    /// max-thrust: the greatest thrust has no bound (vsr_assessment_thrust_unbounded).
+    bool thrust_unbounded() const {
+        std::uint32_t unbounded = 0;
+        check(vsr_assessment_thrust_unbounded(get(), &unbounded));
+        return unbounded != 0;
+    }
     WorstJoint worst_joint() const {
         WorstJoint w;
         check(vsr_assessment_worst_joint(get(), &w.excess, &w.vertex));

@@ -78,6 +78,7 @@ fn fan_thrusts_are_the_closed_forms() {
                 "{objective:?} fixed={fixed}: thrust {got} expected {expected}"
             );
             assert_eq!(result.termination, Termination::Converged);
+            assert!(!result.thrust_unbounded);
         }
     }
 }
@@ -143,6 +144,7 @@ fn hemisphere_analyses_are_certified_and_ordered() {
         } else {
             assert_eq!(result.thickness_scale, 1.0);
         }
+        assert!(!result.thrust_unbounded, "{objective:?}");
         thrust.push(result.thrust_horizontal);
     }
     assert!(thrust[2] < thrust[0] && thrust[0] < thrust[3], "{thrust:?}");
@@ -628,4 +630,141 @@ fn free_vault_without_its_edge_pushes_stalls_at_once() {
         result.termination
     );
     assert!(result.iterations <= 200, "{} steps", result.iterations);
+}
+
+/// A shallow cap inside a slab thick enough to hold a plane through its supports: flatter
+/// and flatter surfaces carry the weight with ever more thrust, so the greatest thrust has
+/// no bound, with free or fixed supports. The ray is checked from the outputs alone: the
+/// returned force densities scaled by s, with heights z̄ + w / s (K z̄ = 0 over the returned
+/// support heights, K w = p), stay certified for s up to 10⁶ while the thrust grows as s.
+#[test]
+fn a_thick_shallow_cap_has_no_greatest_thrust() {
+    let n = 8;
+    let points: Vec<[f64; 2]> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
+        .collect();
+    let pi = std::f64::consts::PI;
+    let height = |u: [f64; 2]| 0.05 * (pi * u[0]).sin() * (pi * u[1]).sin();
+    let edge = |u: [f64; 2], _| u.iter().any(|&x| !(1e-9..=1.0 - 1e-9).contains(&x));
+    let mesh = generate::lift(&points, &grid_faces(n, n), height, edge).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.3)).unwrap();
+    for fixed in [false, true] {
+        let settings = AssessSettings::default()
+            .with_objective(Objective::MaxThrust)
+            .with_fixed_supports(fixed);
+        let result = run(mesh.clone(), &envelope, settings);
+        check_certificate(&mesh, &envelope, &result, 1e-6);
+        assert!(result.thrust_unbounded, "fixed={fixed}");
+        assert_eq!(result.termination, Termination::Converged);
+        check_ray(&mesh, &envelope, &result);
+    }
+}
+
+/// Along the ray of `r`'s force densities: equilibrium (ε∞ < 1e-9), the heights within the
+/// envelope, every joint met, and the thrust s times the first.
+fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) {
+    let n = mesh.positions().len();
+    let held: Vec<f64> = (0..n)
+        .map(|v| {
+            if mesh.anchored()[v] {
+                r.positions[v][2]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let unloaded = dense_heights(mesh, &r.force_densities, &held, &vec![0.0; n]);
+    let loaded = dense_heights(mesh, &r.force_densities, &vec![0.0; n], &r.loads);
+    let diag = common::assess::plan_diagonal(mesh);
+    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored()[v]).collect();
+    let mean = free.iter().map(|&v| r.loads[v]).sum::<f64>() / free.len() as f64;
+    let mut thrust_at_one = None;
+    for s in [1.0, 2.0, 10.0, 1e3, 1e6] {
+        let mut ray = r.clone();
+        ray.force_densities = r.force_densities.iter().map(|q| s * q).collect();
+        for v in 0..n {
+            ray.positions[v][2] = unloaded[v] + loaded[v] / s;
+            let z = ray.positions[v][2];
+            let slack = 1e-9 * diag;
+            assert!(
+                z >= envelope.lower[v] - slack && z <= envelope.upper[v] + slack,
+                "s {s} v {v}"
+            );
+        }
+        let reactions = common::assess::reactions(mesh, &ray);
+        let thrust: f64 = (reactions.iter().flatten())
+            .map(|(h, _)| h[0].hypot(h[1]))
+            .sum();
+        let first = *thrust_at_one.get_or_insert(thrust);
+        assert!((thrust - s * first).abs() <= 1e-9 * thrust, "s {s}");
+        for joint in &r.joints {
+            let a = joint.vertex as usize;
+            let (h, v) = reactions[a].unwrap();
+            let w = ray.positions[a][2] - envelope.springing[a];
+            let excess = w * h[0].hypot(h[1]) - envelope.reach[a] * v;
+            let allowed = 1e-6 * envelope.reach[a] * mean;
+            assert!(excess <= allowed, "s {s} support {a}: {excess:e}");
+        }
+        let mut residual = ray.loads.iter().map(|p| -p).collect::<Vec<f64>>();
+        for (e, edge) in mesh.edges().iter().enumerate() {
+            let [i, j] = edge.v.map(|v| v as usize);
+            let f = ray.force_densities[e] * (ray.positions[i][2] - ray.positions[j][2]);
+            residual[i] += f;
+            residual[j] -= f;
+        }
+        let eps = (free.iter())
+            .map(|&v| residual[v].abs() / mean)
+            .fold(0.0, f64::max);
+        assert!(eps < 1e-9, "s {s}: eps {eps:e}");
+    }
+}
+
+/// Heights with Σ_j q_ij (z_i − z_j) = p_i at the free vertices and `held` at the anchored
+/// ones, by dense Gaussian elimination (independent of the library's sparse solves).
+fn dense_heights(mesh: &Mesh, q: &[f64], held: &[f64], p: &[f64]) -> Vec<f64> {
+    let n = mesh.positions().len();
+    let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored()[v]).collect();
+    let mut row = vec![usize::MAX; n];
+    for (k, &v) in free.iter().enumerate() {
+        row[v] = k;
+    }
+    let m = free.len();
+    let mut a = vec![vec![0.0; m + 1]; m];
+    for (k, &v) in free.iter().enumerate() {
+        a[k][m] = p[v];
+    }
+    for (e, edge) in mesh.edges().iter().enumerate() {
+        let [i, j] = edge.v.map(|v| v as usize);
+        for (x, y) in [(i, j), (j, i)] {
+            if row[x] == usize::MAX {
+                continue;
+            }
+            a[row[x]][row[x]] += q[e];
+            if row[y] == usize::MAX {
+                a[row[x]][m] += q[e] * held[y];
+            } else {
+                a[row[x]][row[y]] -= q[e];
+            }
+        }
+    }
+    for c in 0..m {
+        let pivot = (c..m)
+            .max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))
+            .unwrap();
+        a.swap(c, pivot);
+        let (top, rest) = a.split_at_mut(c + 1);
+        let pivot_row = &top[c];
+        for row in rest {
+            let f = row[c] / pivot_row[c];
+            for (x, p) in row[c..].iter_mut().zip(&pivot_row[c..]) {
+                *x -= f * p;
+            }
+        }
+    }
+    let mut z = held.to_vec();
+    for c in (0..m).rev() {
+        let tail: f64 = (c + 1..m).map(|k| a[c][k] * z[free[k]]).sum();
+        z[free[c]] = (a[c][m] - tail) / a[c][c];
+    }
+    z
 }

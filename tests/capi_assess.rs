@@ -116,6 +116,9 @@ fn assert_same(a: *const VsrAssessment, r: &AssessResult) {
         r.load_factor,
     ];
     assert_eq!(bits(&f), bits(&want));
+    let mut unbounded = 7;
+    assert_ok(unsafe { vsr_assessment_thrust_unbounded(a, &mut unbounded) });
+    assert_eq!(unbounded, u32::from(r.thrust_unbounded));
     let (mut eps, mut h, mut w, mut wb, mut wr) = (f64::NAN, f64::NAN, f64::NAN, 7, 7);
     assert_ok(unsafe { vsr_assessment_certificate(a, &mut eps, &mut h, &mut w, &mut wb, &mut wr) });
     assert_eq!(
@@ -736,6 +739,11 @@ fn assessment_getters_check_pointers_and_buffers() {
             vsr_assessment_worst_joint(a, x0, null_mut()),
             S::NullPointer,
             "vertex",
+        );
+        assert_failed(
+            vsr_assessment_thrust_unbounded(a, null_mut()),
+            S::NullPointer,
+            "unbounded",
         );
     }
     assert_eq!(

@@ -147,7 +147,7 @@ def test_assess_equals_the_rust_api(objective, extra, files, formfind):
     assert np.array_equal(r.upper, np.array(a["bounds"]["upper"]))
     assert np.array_equal(r.envelope_lower, np.array(a["envelope"]["lower"]))
     for key in ("feasible", "termination", "iterations", "thickness_scale", "safety_factor",
-                "thrust_horizontal", "load_factor", "eps_inf", "thickness_min"):
+                "thrust_horizontal", "load_factor", "thrust_unbounded", "eps_inf", "thickness_min"):
         assert getattr(r, key) == a[key], key
     check_certificate(r, mesh.anchored)
     assert len(r.joint_vertices) == len(mesh.anchored) > 0
@@ -157,6 +157,38 @@ def test_assess_equals_the_rust_api(objective, extra, files, formfind):
         assert 0 < r.thickness_scale < 1 and r.thickness_min == r.thickness_scale * 0.1
     if objective == "max-load":
         assert r.load_factor > 0
+
+
+def test_a_thick_shallow_cap_has_no_greatest_thrust():
+    """A cap 0.09 high in a shell 0.4 thick holds ever flatter surfaces: its greatest thrust
+    is unbounded, and the returned force densities scaled by 10 and 1000 (heights from the
+    same supports, recomputed here) still fit; a steeper, thinner dome's thrust is bounded."""
+    v, f, rim = dome(angle=math.radians(10))
+    mesh = voussoir.Mesh(v, f, rim)
+    r = voussoir.assess(mesh, 0.4, objective="max-thrust")
+    assert r.feasible and r.converged and r.thrust_unbounded
+    check_certificate(r, mesh.anchored)
+    n = len(v)
+    free = [i for i in range(n) if i not in set(rim)]
+    row = {vtx: k for k, vtx in enumerate(free)}
+    laplacian = np.zeros((len(free), len(free)))
+    held = np.zeros(len(free))
+    for (i, j), q in zip(r.edges.tolist(), r.force_densities):
+        for a, b in ((i, j), (j, i)):
+            if a in row:
+                laplacian[row[a], row[a]] += q
+                if b in row:
+                    laplacian[row[a], row[b]] -= q
+                else:
+                    held[row[a]] += q * r.positions[b, 2]
+    unloaded = np.linalg.solve(laplacian, held)
+    loaded = np.linalg.solve(laplacian, r.loads[free])
+    for s in (10.0, 1000.0):
+        z = unloaded + loaded / s
+        slack = 1e-9 * 2.0
+        assert np.all(z >= r.lower[free] - slack) and np.all(z <= r.upper[free] + slack), s
+    bounded = voussoir.assess(mesh, 0.02, objective="max-thrust")
+    assert not bounded.thrust_unbounded
 
 
 def test_surfaces_and_per_face_thickness():

@@ -175,6 +175,11 @@ class AssessmentResult:
     """Sum over the supports of |reaction| (force)."""
     load_factor: float
     """The factor lambda on the load pattern ("max-load"; else 0)."""
+    thrust_unbounded: bool
+    """"max-thrust" only: the greatest thrust has no bound. The surface is certified, and its
+    force densities scaled by any s from some s0 >= 1 on (the heights approaching its unloaded
+    surface) give certified surfaces too, so thrust_horizontal is a thrust reached, not the
+    greatest (docs/method.md section 16.4). False otherwise."""
     worst_bound: float
     """The largest excess of a height over its bounds (0 when all are inside)."""
     worst_bound_vertex: Optional[int]

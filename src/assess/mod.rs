@@ -15,6 +15,7 @@ mod envelope;
 mod family;
 mod model;
 mod qp;
+mod ray;
 mod sqp;
 
 pub use envelope::Envelope;
@@ -219,6 +220,12 @@ pub struct AssessResult {
     pub thrust_horizontal: f64,
     /// λ of [`Objective::MaxLoad`] (0 otherwise).
     pub load_factor: f64,
+    /// [`Objective::MaxThrust`] only: the greatest thrust has no bound. The returned surface
+    /// is certified, and its force densities scaled by every s from some s₀ ≥ 1 on, with
+    /// heights approaching its unloaded surface over the same supports, give certified
+    /// surfaces too (docs/method.md §16.4), so `thrust_horizontal` is a thrust reached, not
+    /// the greatest. False otherwise.
+    pub thrust_unbounded: bool,
     /// The largest excess of a height over its bound (0 when inside) and its vertex.
     pub worst_bound: (f64, Option<u32>),
     /// The springing joint of every free support with a finite reach (none with fixed

@@ -382,14 +382,16 @@ impl<'a> Model<'a> {
             .map(|&a| reactions[a as usize][0].hypot(reactions[a as usize][1]))
             .sum();
         let (joints, worst_joint) = self.joints_of(&positions, &force_densities, &loads, s, mean);
+        let feasible = eps_inf < settings.tolerance
+            && q_ok
+            && worst_bound.0 <= 1e-9 * diag
+            && worst_joint.0 < settings.tolerance
+            && (joints.iter())
+                .all(|j| positions[j.vertex as usize][2] >= j.springing - 1e-9 * diag);
         AssessResult {
             objective: self.objective,
-            feasible: eps_inf < settings.tolerance
-                && q_ok
-                && worst_bound.0 <= 1e-9 * diag
-                && worst_joint.0 < settings.tolerance
-                && (joints.iter())
-                    .all(|j| positions[j.vertex as usize][2] >= j.springing - 1e-9 * diag),
+            feasible,
+            thrust_unbounded: feasible && super::ray::ray_start(self, state).is_some(),
             termination: run.termination,
             iterations: run.iterations,
             positions,

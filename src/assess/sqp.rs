@@ -11,6 +11,7 @@
 
 use super::model::{other_end, Model, Run, State};
 use super::qp::{solve_step, Layout, Step, StepInput};
+use super::ray;
 use super::{AssessSettings, Objective};
 use crate::error::Result;
 use crate::shape::ShapeStep;
@@ -69,7 +70,7 @@ pub(super) fn solve(
     let mut iterations = 0;
     let mut stalled = false;
     while iterations < settings.max_iterations {
-        if until == Until::Certified && search.best_feasible.is_some() {
+        if search.unbounded || (until == Until::Certified && search.best_feasible.is_some()) {
             termination = Termination::Converged;
             break;
         }
@@ -97,7 +98,7 @@ pub(super) fn solve(
             }
         }
     }
-    let found = until == Until::Certified && search.best_feasible.is_some();
+    let found = search.unbounded || (until == Until::Certified && search.best_feasible.is_some());
     if termination != Termination::Cancelled && !found && !stalled {
         iterations += search.polish(&layout);
     }
@@ -158,6 +159,9 @@ struct Search<'m, 'a> {
     mu: Option<Vec<f64>>,
     /// The last accepted step's dq and dz.
     direction: Option<(Vec<f64>, Vec<f64>)>,
+    /// The best certified state starts a ray of certified surfaces whose thrust grows
+    /// without bound (the greatest thrust only).
+    unbounded: bool,
     /// The height solve of `fit`'s projected correction (none for the other analyses and
     /// their start, or where its analysis failed).
     heights: Option<ShapeStep>,
@@ -195,6 +199,7 @@ impl<'m, 'a> Search<'m, 'a> {
             polishing: false,
             mu: None,
             direction: None,
+            unbounded: false,
             heights: None,
         }
     }
@@ -545,8 +550,22 @@ impl<'m, 'a> Search<'m, 'a> {
         {
             self.best_feasible = Some((f, self.state.clone()));
         }
+        self.find_ray();
         if self.residual < self.least_infeasible.0 {
             self.least_infeasible = (self.residual, self.state.clone());
+        }
+    }
+
+    /// For the greatest thrust: where the current force densities start a ray of certified
+    /// surfaces (the thrust has no bound), its first state becomes the answer.
+    fn find_ray(&mut self) {
+        let Some(start) = ray::ray_start(self.model, &self.state) else {
+            return;
+        };
+        if self.model.violation(&start).0 <= self.certified_below {
+            let f = self.model.objective_value(&start);
+            self.best_feasible = Some((f, start));
+            self.unbounded = true;
         }
     }
 

@@ -1,0 +1,201 @@
+//! The certificate that the greatest thrust has no bound (docs/method.md §16.4): force
+//! densities q ≥ 0 that, scaled by every s ≥ s₀, carry the loads inside the envelope.
+//! Scaling q by s moves the surface towards the unloaded surface z̄ of q over the same
+//! supports: z(s) = z̄ + w / s, with K z̄ = 0 and K w = p (K = L_q on the non-anchored
+//! vertices, the supports held), exactly in equilibrium for every s, while the thrust s T
+//! grows without bound; every constraint is affine in 1/s, so it holds on the whole ray
+//! once it holds at both ends.
+
+use super::model::{other_end, Model, State};
+use super::Objective;
+use faer::linalg::solvers::SolveCore;
+use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Conj, MatMut, Side};
+
+/// A height may pass its bound by this much (frame units: 1e-9 of the plan diagonal, the
+/// certificate's own allowance).
+const BOUND_SLACK: f64 = 2e-9;
+/// The limit's joint inequality holds to rounding: this fraction of b Σ q_e times the
+/// envelope's height scale.
+const ROUNDING: f64 = 1e-12;
+
+/// The first state of a ray of certified surfaces along `state`'s force densities, where one
+/// starts: q scaled by s₀ with heights z̄ + w / s₀, the supports at `state`'s heights or, for
+/// those with a springing joint, on their springing planes. None where the analysis is not
+/// the greatest thrust or no such ray starts.
+pub(super) fn ray_start(model: &Model, state: &State) -> Option<State> {
+    if model.objective != Objective::MaxThrust || !scalable(model, &state.q) {
+        return None;
+    }
+    let solver = Laplacian::new(model, &state.q)?;
+    let w = solver.solve(model, &state.q, &vec![0.0; state.z.len()], |v| {
+        model.dead[v]
+    })?;
+    let mut supports = state.z.clone();
+    for joint in &model.joints {
+        supports[joint.support as usize] = joint.springing;
+    }
+    let start = [state.z.as_slice(), &supports]
+        .into_iter()
+        .find_map(|held| {
+            let unloaded = solver.solve(model, &state.q, held, |_| 0.0)?;
+            let s0 = envelope_start(model, &unloaded, &w)?
+                .max(joints_start(model, &state.q, &unloaded, &w)?)
+                .max(1.0);
+            Some(State {
+                y: state.y.iter().map(|y| s0 * y).collect(),
+                q: state.q.iter().map(|q| s0 * q).collect(),
+                z: (unloaded.iter().zip(&w)).map(|(z, w)| z + w / s0).collect(),
+                t: state.t,
+            })
+        });
+    start
+}
+
+/// Scaling q keeps it within its bounds and horizontal balance without external forces
+/// (a homogeneous system), and raises the thrust.
+fn scalable(model: &Model, q: &[f64]) -> bool {
+    let no_external = (model.stress.external.iter()).all(|f| f[0] == 0.0 && f[1] == 0.0);
+    let bounds_ok = (model.stress.bounds.iter().zip(q)).all(|(b, &q)| match b {
+        None => true,
+        Some((lo, hi)) => q >= 0.0 && q >= *lo && (q == 0.0 || hi.is_infinite()),
+    });
+    no_external && bounds_ok && model.thrust(q) > 0.0
+}
+
+/// K = L_q on the non-anchored vertices, factorised.
+struct Laplacian {
+    /// Row of each vertex (None at supports and unreferenced vertices).
+    row: Vec<Option<usize>>,
+    llt: Llt<usize, f64>,
+}
+
+impl Laplacian {
+    /// None where K is singular (a vertex the stress does not tie to a support).
+    fn new(model: &Model, q: &[f64]) -> Option<Laplacian> {
+        let mut row = vec![None; model.middle.len()];
+        for (k, &v) in model.residual.iter().enumerate() {
+            row[v as usize] = Some(k);
+        }
+        let edges = &model.problem.mesh.edges;
+        let mut triplets = Vec::new();
+        for (k, &i) in model.residual.iter().enumerate() {
+            let i = i as usize;
+            let mut diagonal = 0.0;
+            for &e in &model.incident[i] {
+                diagonal += q[e as usize];
+                if let Some(c) = row[other_end(edges[e as usize].v, i)].filter(|&c| c < k) {
+                    triplets.push(Triplet::new(k, c, -q[e as usize]));
+                }
+            }
+            triplets.push(Triplet::new(k, k, diagonal));
+        }
+        let m = model.residual.len();
+        let matrix = SparseColMat::<usize, f64>::try_new_from_triplets(m, m, &triplets).ok()?;
+        let symbolic = SymbolicLlt::try_new(matrix.symbolic(), Side::Lower).ok()?;
+        let llt = Llt::try_new_with_symbolic(symbolic, matrix.as_ref(), Side::Lower).ok()?;
+        Some(Laplacian { row, llt })
+    }
+
+    /// Heights per vertex with K z = `load` at the non-anchored vertices, the supports at
+    /// `supports`' heights.
+    fn solve(
+        &self,
+        model: &Model,
+        q: &[f64],
+        supports: &[f64],
+        load: impl Fn(usize) -> f64,
+    ) -> Option<Vec<f64>> {
+        let edges = &model.problem.mesh.edges;
+        let mut rhs: Vec<f64> = (model.residual.iter())
+            .map(|&i| {
+                let i = i as usize;
+                let held: f64 = (model.incident[i].iter())
+                    .filter_map(|&e| {
+                        let j = other_end(edges[e as usize].v, i);
+                        self.row[j].is_none().then(|| q[e as usize] * supports[j])
+                    })
+                    .sum();
+                load(i) + held
+            })
+            .collect();
+        let m = rhs.len();
+        let view = MatMut::from_column_major_slice_mut(&mut rhs, m, 1);
+        self.llt.solve_in_place_with_conj(Conj::No, view);
+        let mut z = supports.to_vec();
+        for (k, &v) in model.residual.iter().enumerate() {
+            z[v as usize] = rhs[k];
+        }
+        z.iter().all(|x| x.is_finite()).then_some(z)
+    }
+}
+
+/// The least s from which z̄ + w / s lies within the envelope at every non-anchored vertex
+/// (the supports keep their heights); None where z̄ itself (s → ∞) lies outside.
+fn envelope_start(model: &Model, unloaded: &[f64], w: &[f64]) -> Option<f64> {
+    let outside = |v: usize| {
+        let (m, h) = (model.middle[v], model.half[v]);
+        (unloaded[v] - m).abs() > h + BOUND_SLACK
+    };
+    let referenced = model.supports.iter().chain(&model.residual);
+    if referenced.map(|&v| v as usize).any(outside) {
+        return None;
+    }
+    let mut start: f64 = 0.0;
+    for &v in &model.residual {
+        let v = v as usize;
+        let (m, h) = (model.middle[v], model.half[v]);
+        let room = if w[v] > 0.0 {
+            m + h + BOUND_SLACK - unloaded[v]
+        } else {
+            unloaded[v] - (m - h - BOUND_SLACK)
+        };
+        if room <= 0.0 {
+            return None;
+        }
+        start = start.max(w[v].abs() / room);
+    }
+    Some(start)
+}
+
+/// The least s from which every joint holds: with the support's height fixed, w_a = z_a − s_a,
+/// H(s) = s H̄ and V(s) = s V̄ + W, the joint w_a |H̄| − b V̄ ≤ b W / s; None where its limit
+/// (s → ∞) fails or a support lies below its springing plane.
+fn joints_start(model: &Model, q: &[f64], unloaded: &[f64], w: &[f64]) -> Option<f64> {
+    let u = &model.stress.plan.u;
+    let heights = (model.middle.iter().zip(&model.half))
+        .map(|(m, h)| m.abs() + h)
+        .filter(|x| x.is_finite())
+        .fold(0.0, f64::max);
+    let mut start: f64 = 0.0;
+    for joint in &model.joints {
+        let a = joint.support as usize;
+        let lift = unloaded[a] - joint.springing;
+        if lift < -BOUND_SLACK {
+            return None;
+        }
+        let (mut h, mut v_bar, mut q_sum, mut v_rest) = ([0.0; 2], 0.0, 0.0, model.dead[a]);
+        for &(e, j) in &joint.edges {
+            let j = j as usize;
+            for d in 0..2 {
+                h[d] += q[e] * (u[a][d] - u[j][d]);
+            }
+            v_bar += q[e] * (unloaded[j] - unloaded[a]);
+            q_sum += q[e];
+            v_rest += q[e] * w[j];
+        }
+        let moment = lift.max(0.0) * h[0].hypot(h[1]);
+        let limit = moment - joint.reach * v_bar;
+        let rest = joint.reach * v_rest;
+        if limit > ROUNDING * (moment + joint.reach * q_sum * heights) {
+            return None;
+        }
+        if limit < 0.0 && rest < 0.0 {
+            start = start.max(rest / limit);
+        } else if limit >= 0.0 && rest < 0.0 {
+            return None;
+        }
+    }
+    Some(start)
+}
