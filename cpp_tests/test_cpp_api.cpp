@@ -864,7 +864,8 @@ TEST(CppApi, AssessmentEqualsTheCApiBitForBit) {
 
 // The pyramid 0.3 high in a slab 0.8 thick holds the plane through its supports: ever
 // flatter surfaces carry its weight, and the greatest thrust has no bound; 0.1 thick it has.
-TEST(CppApi, AnUnboundedGreatestThrustSaysSo) {
+// The factor on a load at its apex has none.
+TEST(CppApi, AnUnboundedObjectiveSaysSo) {
     const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
     voussoir::AssessSettings settings;
     settings.objective(VSR_OBJECTIVE_MAX_THRUST);
@@ -872,8 +873,15 @@ TEST(CppApi, AnUnboundedGreatestThrustSaysSo) {
         const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, t);
         const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
         EXPECT_TRUE(a.outcome().converged()) << t;
-        EXPECT_EQ(a.thrust_unbounded(), t > 0.5) << t;
+        EXPECT_EQ(a.unbounded(), t > 0.5) << t;
     }
+    // A load on the apex alone is carried by the pyramid itself, at any factor.
+    settings.objective(VSR_OBJECTIVE_MAX_LOAD).load_pattern({0, 0, 0, 0, 1});
+    const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);
+    const voussoir::Assessment a = voussoir::assess(mesh, envelope, settings);
+    EXPECT_TRUE(a.outcome().converged());
+    EXPECT_TRUE(a.unbounded());
+    EXPECT_GT(a.figures().load_factor, 0.0);
 }
 
 TEST(CppApi, SpringingJointsReachTheCSetter) {

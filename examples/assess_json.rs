@@ -108,7 +108,7 @@ fn run(doc: &Value) -> Result<Value, String> {
         "seconds": r.seconds,
         "thrust_horizontal": r.thrust_horizontal,
         "load_factor": r.load_factor,
-        "thrust_unbounded": r.thrust_unbounded,
+        "unbounded": r.unbounded,
         "thickness_scale": r.thickness_scale,
         "eps_inf": r.eps_inf,
         "worst_bound": r.worst_bound.0,

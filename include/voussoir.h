@@ -2028,16 +2028,16 @@ VsrStatus vsr_assessment_joints(const struct VsrAssessment *assessment, double *
 VsrStatus vsr_assessment_worst_joint(const struct VsrAssessment *assessment, double *excess, uint32_t *vertex);
 
 /**
- * `unbounded` 1 when the analysis is max-thrust and the greatest thrust has no bound: the
- * returned surface is certified, and its force densities scaled by every s from some
- * s₀ ≥ 1 on, with heights approaching its unloaded surface over the same supports, give
- * certified surfaces too (docs/method.md §16.4), so `thrust_horizontal` is a thrust
- * reached, not the greatest; else 0. The pointer required; written only on success.
+ * `unbounded` 1 when the analysis is max-thrust or max-load and its objective has no
+ * bound: the returned surface is certified, and its force densities (and load factor)
+ * scaled by every s from some s₀ ≥ 1 on, with heights approaching a limit surface over the
+ * same supports, give certified surfaces too (docs/method.md §16.4), so
+ * `thrust_horizontal` or `load_factor` is a value reached, not the greatest; else 0. The pointer required; written only on success.
  *
  * # Safety
  * `assessment`: a valid handle; the out-pointer writable.
  */
-VsrStatus vsr_assessment_thrust_unbounded(const struct VsrAssessment *assessment, uint32_t *unbounded);
+VsrStatus vsr_assessment_unbounded(const struct VsrAssessment *assessment, uint32_t *unbounded);
 
 /**
  * The least thickness t of a family of envelopes whose bounds are functions of t (Heyman's

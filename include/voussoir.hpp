@@ -804,10 +804,10 @@ class Assessment {
                                          &c.worst_residual_vertex));
         return c;
     }
-    /// max-thrust: the greatest thrust has no bound (vsr_assessment_thrust_unbounded).
-    bool thrust_unbounded() const {
+    /// max-thrust, max-load: the objective has no bound (vsr_assessment_unbounded).
+    bool unbounded() const {
         std::uint32_t unbounded = 0;
-        check(vsr_assessment_thrust_unbounded(get(), &unbounded));
+        check(vsr_assessment_unbounded(get(), &unbounded));
         return unbounded != 0;
     }
     WorstJoint worst_joint() const {

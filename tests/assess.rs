@@ -78,7 +78,7 @@ fn fan_thrusts_are_the_closed_forms() {
                 "{objective:?} fixed={fixed}: thrust {got} expected {expected}"
             );
             assert_eq!(result.termination, Termination::Converged);
-            assert!(!result.thrust_unbounded);
+            assert!(!result.unbounded);
         }
     }
 }
@@ -144,7 +144,7 @@ fn hemisphere_analyses_are_certified_and_ordered() {
         } else {
             assert_eq!(result.thickness_scale, 1.0);
         }
-        assert!(!result.thrust_unbounded, "{objective:?}");
+        assert!(!result.unbounded, "{objective:?}");
         thrust.push(result.thrust_horizontal);
     }
     assert!(thrust[2] < thrust[0] && thrust[0] < thrust[3], "{thrust:?}");
@@ -193,6 +193,7 @@ fn max_load_is_certified_with_its_factor() {
     let result = run(mesh.clone(), &envelope, settings);
     check_certificate(&mesh, &envelope, &result, 1e-6);
     assert!(result.load_factor > 0.0, "λ = {}", result.load_factor);
+    assert!(!result.unbounded);
     let dead = run(mesh.clone(), &envelope, AssessSettings::default()).loads;
     for v in 0..n {
         let expected = dead[v] + result.load_factor * pattern[v];
@@ -634,11 +635,12 @@ fn free_vault_without_its_edge_pushes_stalls_at_once() {
 
 /// A shallow cap inside a slab thick enough to hold a plane through its supports: flatter
 /// and flatter surfaces carry the weight with ever more thrust, so the greatest thrust has
-/// no bound, with free or fixed supports. The ray is checked from the outputs alone: the
-/// returned force densities scaled by s, with heights z̄ + w / s (K z̄ = 0 over the returned
-/// support heights, K w = p), stay certified for s up to 10⁶ while the thrust grows as s.
+/// no bound, with free or fixed supports, and so has the factor on a point load. The ray is
+/// checked from the outputs alone: the returned force densities (and λ) scaled by s, with
+/// heights z∞ + w / s (K z∞ = λ p_live over the returned support heights, K w = p_dead),
+/// stay certified for s up to 10⁶ while the thrust grows as s.
 #[test]
-fn a_thick_shallow_cap_has_no_greatest_thrust() {
+fn a_thick_shallow_cap_has_no_greatest_thrust_or_load() {
     let n = 8;
     let points: Vec<[f64; 2]> = (0..=n)
         .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
@@ -654,15 +656,32 @@ fn a_thick_shallow_cap_has_no_greatest_thrust() {
             .with_fixed_supports(fixed);
         let result = run(mesh.clone(), &envelope, settings);
         check_certificate(&mesh, &envelope, &result, 1e-6);
-        assert!(result.thrust_unbounded, "fixed={fixed}");
+        assert!(result.unbounded, "fixed={fixed}");
         assert_eq!(result.termination, Termination::Converged);
-        check_ray(&mesh, &envelope, &result);
+        check_ray(
+            &mesh,
+            &envelope,
+            &result,
+            &vec![0.0; mesh.positions().len()],
+        );
     }
+    // A point load on the crown: the tent it hangs from fits too, so λ has no bound.
+    let mut pattern = vec![0.0; mesh.positions().len()];
+    pattern[n / 2 * (n + 1) + n / 2] = 1.0;
+    let settings = AssessSettings::default()
+        .with_objective(Objective::MaxLoad)
+        .with_load_pattern(pattern.clone());
+    let result = run(mesh.clone(), &envelope, settings);
+    check_certificate(&mesh, &envelope, &result, 1e-6);
+    assert!(result.unbounded && result.load_factor > 0.0);
+    assert_eq!(result.termination, Termination::Converged);
+    check_ray(&mesh, &envelope, &result, &pattern);
 }
 
-/// Along the ray of `r`'s force densities: equilibrium (ε∞ < 1e-9), the heights within the
-/// envelope, every joint met, and the thrust s times the first.
-fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) {
+/// Along the ray of `r`'s force densities and load factor on `live`: equilibrium
+/// (ε∞ < 1e-9), the heights within the envelope, every joint met, and the thrust s times
+/// the first.
+fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult, live: &[f64]) {
     let n = mesh.positions().len();
     let held: Vec<f64> = (0..n)
         .map(|v| {
@@ -673,8 +692,11 @@ fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) {
             }
         })
         .collect();
-    let unloaded = dense_heights(mesh, &r.force_densities, &held, &vec![0.0; n]);
-    let loaded = dense_heights(mesh, &r.force_densities, &vec![0.0; n], &r.loads);
+    let lambda = r.load_factor;
+    let carried: Vec<f64> = live.iter().map(|p| lambda * p).collect();
+    let dead: Vec<f64> = (r.loads.iter().zip(&carried)).map(|(p, c)| p - c).collect();
+    let limit = dense_heights(mesh, &r.force_densities, &held, &carried);
+    let loaded = dense_heights(mesh, &r.force_densities, &vec![0.0; n], &dead);
     let diag = common::assess::plan_diagonal(mesh);
     let free: Vec<usize> = (0..n).filter(|&v| !mesh.anchored()[v]).collect();
     let mean = free.iter().map(|&v| r.loads[v]).sum::<f64>() / free.len() as f64;
@@ -682,8 +704,11 @@ fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) {
     for s in [1.0, 2.0, 10.0, 1e3, 1e6] {
         let mut ray = r.clone();
         ray.force_densities = r.force_densities.iter().map(|q| s * q).collect();
+        ray.loads = (dead.iter().zip(&carried))
+            .map(|(d, c)| d + s * c)
+            .collect();
         for v in 0..n {
-            ray.positions[v][2] = unloaded[v] + loaded[v] / s;
+            ray.positions[v][2] = limit[v] + loaded[v] / s;
             let z = ray.positions[v][2];
             let slack = 1e-9 * diag;
             assert!(
@@ -712,8 +737,10 @@ fn check_ray(mesh: &Mesh, envelope: &Envelope, r: &AssessResult) {
             residual[i] += f;
             residual[j] -= f;
         }
+        // Relative to the ray's own mean load, as the certificate measures.
+        let mean_s = free.iter().map(|&v| ray.loads[v]).sum::<f64>() / free.len() as f64;
         let eps = (free.iter())
-            .map(|&v| residual[v].abs() / mean)
+            .map(|&v| residual[v].abs() / mean_s)
             .fold(0.0, f64::max);
         assert!(eps < 1e-9, "s {s}: eps {eps:e}");
     }

@@ -117,8 +117,8 @@ fn assert_same(a: *const VsrAssessment, r: &AssessResult) {
     ];
     assert_eq!(bits(&f), bits(&want));
     let mut unbounded = 7;
-    assert_ok(unsafe { vsr_assessment_thrust_unbounded(a, &mut unbounded) });
-    assert_eq!(unbounded, u32::from(r.thrust_unbounded));
+    assert_ok(unsafe { vsr_assessment_unbounded(a, &mut unbounded) });
+    assert_eq!(unbounded, u32::from(r.unbounded));
     let (mut eps, mut h, mut w, mut wb, mut wr) = (f64::NAN, f64::NAN, f64::NAN, 7, 7);
     assert_ok(unsafe { vsr_assessment_certificate(a, &mut eps, &mut h, &mut w, &mut wb, &mut wr) });
     assert_eq!(
@@ -741,7 +741,7 @@ fn assessment_getters_check_pointers_and_buffers() {
             "vertex",
         );
         assert_failed(
-            vsr_assessment_thrust_unbounded(a, null_mut()),
+            vsr_assessment_unbounded(a, null_mut()),
             S::NullPointer,
             "unbounded",
         );

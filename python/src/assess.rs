@@ -301,7 +301,7 @@ fn fields<'py>(
     d.set_item("reactions", matrix(py, &r.reactions))?;
     d.set_item("thrust_horizontal", r.thrust_horizontal)?;
     d.set_item("load_factor", r.load_factor)?;
-    d.set_item("thrust_unbounded", r.thrust_unbounded)?;
+    d.set_item("unbounded", r.unbounded)?;
     d.set_item("worst_bound", r.worst_bound.0)?;
     d.set_item("worst_bound_vertex", r.worst_bound.1)?;
     d.set_item("worst_residual_vertex", r.worst_residual_vertex)?;

@@ -387,9 +387,10 @@ def run_assess(a: argparse.Namespace) -> int:
     safety = f"safety factor {r.safety_factor:.4g}, " if r.feasible else ""
     print(f"assessment {r.objective}: {verdict} ({r.termination.replace('_', ' ')} after "
           f"{r.iterations} steps); {safety}thrust {r.thrust_horizontal:.6g}")
-    if r.thrust_unbounded:
-        print("the greatest thrust has no bound: this surface's force densities scaled up by any "
-              "factor from some s0 on still fit")
+    if r.unbounded:
+        what = "the load factor" if r.objective == "max-load" else "the greatest thrust"
+        print(f"{what} has no bound: this surface's force densities scaled up by any factor "
+              "from some s0 on still fit")
     print(f"wrote: {out} (thrust surface), {report_path} (report)")
     if not r.converged:
         print("voussoir: no certified optimum: the outputs hold the best state reached", file=sys.stderr)

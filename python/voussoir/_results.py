@@ -175,11 +175,12 @@ class AssessmentResult:
     """Sum over the supports of |reaction| (force)."""
     load_factor: float
     """The factor lambda on the load pattern ("max-load"; else 0)."""
-    thrust_unbounded: bool
-    """"max-thrust" only: the greatest thrust has no bound. The surface is certified, and its
-    force densities scaled by any s from some s0 >= 1 on (the heights approaching its unloaded
-    surface) give certified surfaces too, so thrust_horizontal is a thrust reached, not the
-    greatest (docs/method.md section 16.4). False otherwise."""
+    unbounded: bool
+    """"max-thrust" and "max-load": the objective has no bound. The surface is certified, and
+    its force densities (and load factor) scaled by any s from some s0 >= 1 on (the heights
+    approaching a limit surface) give certified surfaces too, so thrust_horizontal or
+    load_factor is a value reached, not the greatest (docs/method.md section 16.4). False
+    otherwise."""
     worst_bound: float
     """The largest excess of a height over its bounds (0 when all are inside)."""
     worst_bound_vertex: Optional[int]

@@ -220,12 +220,12 @@ pub struct AssessResult {
     pub thrust_horizontal: f64,
     /// λ of [`Objective::MaxLoad`] (0 otherwise).
     pub load_factor: f64,
-    /// [`Objective::MaxThrust`] only: the greatest thrust has no bound. The returned surface
-    /// is certified, and its force densities scaled by every s from some s₀ ≥ 1 on, with
-    /// heights approaching its unloaded surface over the same supports, give certified
-    /// surfaces too (docs/method.md §16.4), so `thrust_horizontal` is a thrust reached, not
-    /// the greatest. False otherwise.
-    pub thrust_unbounded: bool,
+    /// [`Objective::MaxThrust`] and [`Objective::MaxLoad`]: the objective has no bound. The
+    /// returned surface is certified, and its force densities (and λ) scaled by every s from
+    /// some s₀ ≥ 1 on, with heights approaching a limit surface over the same supports, give
+    /// certified surfaces too (docs/method.md §16.4), so `thrust_horizontal` or
+    /// `load_factor` is a value reached, not the greatest. False otherwise.
+    pub unbounded: bool,
     /// The largest excess of a height over its bound (0 when inside) and its vertex.
     pub worst_bound: (f64, Option<u32>),
     /// The springing joint of every free support with a finite reach (none with fixed

@@ -391,7 +391,7 @@ impl<'a> Model<'a> {
         AssessResult {
             objective: self.objective,
             feasible,
-            thrust_unbounded: feasible && super::ray::ray_start(self, state).is_some(),
+            unbounded: feasible && super::ray::ray_start(self, state).is_some(),
             termination: run.termination,
             iterations: run.iterations,
             positions,

@@ -1,10 +1,10 @@
-//! The certificate that the greatest thrust has no bound (docs/method.md §16.4): force
-//! densities q ≥ 0 that, scaled by every s ≥ s₀, carry the loads inside the envelope.
-//! Scaling q by s moves the surface towards the unloaded surface z̄ of q over the same
-//! supports: z(s) = z̄ + w / s, with K z̄ = 0 and K w = p (K = L_q on the non-anchored
-//! vertices, the supports held), exactly in equilibrium for every s, while the thrust s T
-//! grows without bound; every constraint is affine in 1/s, so it holds on the whole ray
-//! once it holds at both ends.
+//! The certificate that the greatest thrust or the largest load factor has no bound
+//! (docs/method.md §16.4): force densities q ≥ 0 that, scaled by every s ≥ s₀, carry the
+//! loads inside the envelope. With q scaled by s (and, for the load factor, λ = s λ₀) the
+//! surface is z(s) = z∞ + w / s, with K z∞ = λ₀ p_live (0 for the thrust) over the held
+//! supports and K w = p_dead (K = L_q on the non-anchored vertices): exactly in equilibrium
+//! for every s while the thrust s T, or λ, grows without bound; every constraint is affine
+//! in 1/s, so it holds on the whole ray once it holds at both ends.
 
 use super::model::{other_end, Model, State};
 use super::Objective;
@@ -20,18 +20,25 @@ const BOUND_SLACK: f64 = 2e-9;
 /// envelope's height scale.
 const ROUNDING: f64 = 1e-12;
 
-/// The first state of a ray of certified surfaces along `state`'s force densities, where one
-/// starts: q scaled by s₀ with heights z̄ + w / s₀, the supports at `state`'s heights or, for
-/// those with a springing joint, on their springing planes. None where the analysis is not
-/// the greatest thrust or no such ray starts.
+/// The first state of a ray of certified surfaces along `state`'s force densities (and load
+/// factor), where one starts: q (and λ) scaled by s₀ with heights z∞ + w / s₀, the supports
+/// at `state`'s heights or, for those with a springing joint, on their springing planes.
+/// None where the analysis is neither the greatest thrust nor the largest load, or no such
+/// ray starts.
 pub(super) fn ray_start(model: &Model, state: &State) -> Option<State> {
-    if model.objective != Objective::MaxThrust || !scalable(model, &state.q) {
+    let live = match model.objective {
+        Objective::MaxThrust => 0.0,
+        Objective::MaxLoad if state.t > 0.0 => state.t,
+        _ => return None,
+    };
+    let grows = live > 0.0 || model.thrust(&state.q) > 0.0;
+    if !grows || !scalable(model, &state.q) {
         return None;
     }
+    let limit_load = |v: usize| live * model.live[v];
     let solver = Laplacian::new(model, &state.q)?;
-    let w = solver.solve(model, &state.q, &vec![0.0; state.z.len()], |v| {
-        model.dead[v]
-    })?;
+    let zero = vec![0.0; state.z.len()];
+    let w = solver.solve(model, &state.q, &zero, |v| model.dead[v])?;
     let mut supports = state.z.clone();
     for joint in &model.joints {
         supports[joint.support as usize] = joint.springing;
@@ -39,29 +46,29 @@ pub(super) fn ray_start(model: &Model, state: &State) -> Option<State> {
     let start = [state.z.as_slice(), &supports]
         .into_iter()
         .find_map(|held| {
-            let unloaded = solver.solve(model, &state.q, held, |_| 0.0)?;
-            let s0 = envelope_start(model, &unloaded, &w)?
-                .max(joints_start(model, &state.q, &unloaded, &w)?)
+            let limit = solver.solve(model, &state.q, held, limit_load)?;
+            let s0 = envelope_start(model, &limit, &w)?
+                .max(joints_start(model, &state.q, &limit, &w, limit_load)?)
                 .max(1.0);
             Some(State {
                 y: state.y.iter().map(|y| s0 * y).collect(),
                 q: state.q.iter().map(|q| s0 * q).collect(),
-                z: (unloaded.iter().zip(&w)).map(|(z, w)| z + w / s0).collect(),
-                t: state.t,
+                z: (limit.iter().zip(&w)).map(|(z, w)| z + w / s0).collect(),
+                t: if live > 0.0 { s0 * live } else { state.t },
             })
         });
     start
 }
 
 /// Scaling q keeps it within its bounds and horizontal balance without external forces
-/// (a homogeneous system), and raises the thrust.
+/// (a homogeneous system).
 fn scalable(model: &Model, q: &[f64]) -> bool {
     let no_external = (model.stress.external.iter()).all(|f| f[0] == 0.0 && f[1] == 0.0);
     let bounds_ok = (model.stress.bounds.iter().zip(q)).all(|(b, &q)| match b {
         None => true,
         Some((lo, hi)) => q >= 0.0 && q >= *lo && (q == 0.0 || hi.is_infinite()),
     });
-    no_external && bounds_ok && model.thrust(q) > 0.0
+    no_external && bounds_ok && q.iter().any(|&q| q > 0.0)
 }
 
 /// K = L_q on the non-anchored vertices, factorised.
@@ -131,12 +138,12 @@ impl Laplacian {
     }
 }
 
-/// The least s from which z̄ + w / s lies within the envelope at every non-anchored vertex
-/// (the supports keep their heights); None where z̄ itself (s → ∞) lies outside.
-fn envelope_start(model: &Model, unloaded: &[f64], w: &[f64]) -> Option<f64> {
+/// The least s from which z∞ + w / s lies within the envelope at every non-anchored vertex
+/// (the supports keep their heights); None where z∞ itself (s → ∞) lies outside.
+fn envelope_start(model: &Model, limit: &[f64], w: &[f64]) -> Option<f64> {
     let outside = |v: usize| {
         let (m, h) = (model.middle[v], model.half[v]);
-        (unloaded[v] - m).abs() > h + BOUND_SLACK
+        (limit[v] - m).abs() > h + BOUND_SLACK
     };
     let referenced = model.supports.iter().chain(&model.residual);
     if referenced.map(|&v| v as usize).any(outside) {
@@ -147,9 +154,9 @@ fn envelope_start(model: &Model, unloaded: &[f64], w: &[f64]) -> Option<f64> {
         let v = v as usize;
         let (m, h) = (model.middle[v], model.half[v]);
         let room = if w[v] > 0.0 {
-            m + h + BOUND_SLACK - unloaded[v]
+            m + h + BOUND_SLACK - limit[v]
         } else {
-            unloaded[v] - (m - h - BOUND_SLACK)
+            limit[v] - (m - h - BOUND_SLACK)
         };
         if room <= 0.0 {
             return None;
@@ -160,9 +167,16 @@ fn envelope_start(model: &Model, unloaded: &[f64], w: &[f64]) -> Option<f64> {
 }
 
 /// The least s from which every joint holds: with the support's height fixed, w_a = z_a − s_a,
-/// H(s) = s H̄ and V(s) = s V̄ + W, the joint w_a |H̄| − b V̄ ≤ b W / s; None where its limit
-/// (s → ∞) fails or a support lies below its springing plane.
-fn joints_start(model: &Model, q: &[f64], unloaded: &[f64], w: &[f64]) -> Option<f64> {
+/// H(s) = s H̄ and V(s) = s V̄ + W (V̄ with the limit's load at the support, W with the dead
+/// one), the joint w_a |H̄| − b V̄ ≤ b W / s; None where its limit (s → ∞) fails or a support
+/// lies below its springing plane.
+fn joints_start(
+    model: &Model,
+    q: &[f64],
+    limit: &[f64],
+    w: &[f64],
+    limit_load: impl Fn(usize) -> f64,
+) -> Option<f64> {
     let u = &model.stress.plan.u;
     let heights = (model.middle.iter().zip(&model.half))
         .map(|(m, h)| m.abs() + h)
@@ -171,17 +185,18 @@ fn joints_start(model: &Model, q: &[f64], unloaded: &[f64], w: &[f64]) -> Option
     let mut start: f64 = 0.0;
     for joint in &model.joints {
         let a = joint.support as usize;
-        let lift = unloaded[a] - joint.springing;
+        let lift = limit[a] - joint.springing;
         if lift < -BOUND_SLACK {
             return None;
         }
-        let (mut h, mut v_bar, mut q_sum, mut v_rest) = ([0.0; 2], 0.0, 0.0, model.dead[a]);
+        let (mut h, mut v_bar, mut q_sum, mut v_rest) =
+            ([0.0; 2], limit_load(a), 0.0, model.dead[a]);
         for &(e, j) in &joint.edges {
             let j = j as usize;
             for d in 0..2 {
                 h[d] += q[e] * (u[a][d] - u[j][d]);
             }
-            v_bar += q[e] * (unloaded[j] - unloaded[a]);
+            v_bar += q[e] * (limit[j] - limit[a]);
             q_sum += q[e];
             v_rest += q[e] * w[j];
         }

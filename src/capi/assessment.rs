@@ -458,16 +458,16 @@ pub unsafe extern "C" fn vsr_assessment_worst_joint(
     })
 }
 
-/// `unbounded` 1 when the analysis is max-thrust and the greatest thrust has no bound: the
-/// returned surface is certified, and its force densities scaled by every s from some
-/// s₀ ≥ 1 on, with heights approaching its unloaded surface over the same supports, give
-/// certified surfaces too (docs/method.md §16.4), so `thrust_horizontal` is a thrust
-/// reached, not the greatest; else 0. The pointer required; written only on success.
+/// `unbounded` 1 when the analysis is max-thrust or max-load and its objective has no
+/// bound: the returned surface is certified, and its force densities (and load factor)
+/// scaled by every s from some s₀ ≥ 1 on, with heights approaching a limit surface over the
+/// same supports, give certified surfaces too (docs/method.md §16.4), so
+/// `thrust_horizontal` or `load_factor` is a value reached, not the greatest; else 0. The pointer required; written only on success.
 ///
 /// # Safety
 /// `assessment`: a valid handle; the out-pointer writable.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn vsr_assessment_thrust_unbounded(
+pub unsafe extern "C" fn vsr_assessment_unbounded(
     assessment: *const VsrAssessment,
     unbounded: *mut u32,
 ) -> VsrStatus {
@@ -476,7 +476,7 @@ pub unsafe extern "C" fn vsr_assessment_thrust_unbounded(
         let a = unsafe { handle("assessment", assessment)? };
         let out = out_ptr("unbounded", unbounded)?;
         // SAFETY: non-NULL and writable (caller's contract).
-        unsafe { out.write(u32::from(a.result.thrust_unbounded)) };
+        unsafe { out.write(u32::from(a.result.unbounded)) };
         Ok(())
     })
 }

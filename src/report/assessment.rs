@@ -100,9 +100,9 @@ pub struct AssessmentFigures {
     pub thrust_horizontal: f64,
     /// λ of `max-load` (0 otherwise).
     pub load_factor: f64,
-    /// `max-thrust` only: the greatest thrust has no bound (`thrust_horizontal` is a thrust
-    /// reached); false otherwise.
-    pub thrust_unbounded: bool,
+    /// `max-thrust`, `max-load`: the objective has no bound (`thrust_horizontal` or
+    /// `load_factor` is a value reached); false otherwise.
+    pub unbounded: bool,
     /// max |r| / mean load over the non-anchored vertices.
     pub eps_inf: f64,
     /// Largest horizontal imbalance at a non-anchored vertex over the mean load.
@@ -266,7 +266,7 @@ fn figures(
         safety_factor: r.safety_factor,
         thrust_horizontal: r.thrust_horizontal,
         load_factor: r.load_factor,
-        thrust_unbounded: r.thrust_unbounded,
+        unbounded: r.unbounded,
         eps_inf: r.eps_inf,
         horizontal_imbalance: r.horizontal_imbalance,
         worst_bound: excess(r.worst_bound),

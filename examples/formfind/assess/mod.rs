@@ -150,12 +150,18 @@ fn summary(a: &run::Assessed) {
             );
         }
         Objective::MaxLoad => say!("load factor λ = {:.6e}", r.load_factor),
-        Objective::MaxThrust if r.thrust_unbounded => say!(
-            "the greatest thrust has no bound: this surface's force densities scaled up by \
-             any factor from some s0 on still fit (the surfaces flatten towards its unloaded \
-             surface)"
-        ),
         _ => {}
+    }
+    if r.unbounded {
+        let what = if r.objective == Objective::MaxLoad {
+            "the load factor"
+        } else {
+            "the greatest thrust"
+        };
+        say!(
+            "{what} has no bound: this surface's force densities scaled up by any factor \
+             from some s0 on still fit"
+        );
     }
     say!(
         "horizontal thrust (Σ |H| over the supports): {:.6e}",
