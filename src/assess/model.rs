@@ -391,7 +391,7 @@ impl<'a> Model<'a> {
         AssessResult {
             objective: self.objective,
             feasible,
-            unbounded: feasible && super::ray::ray_start(self, state).is_some(),
+            unbounded: feasible && run.unbounded,
             termination: run.termination,
             iterations: run.iterations,
             positions,
@@ -636,4 +636,6 @@ pub(super) struct Run {
     pub termination: Termination,
     pub iterations: usize,
     pub seconds: f64,
+    /// The state starts a certified ray along which the objective has no bound (ray.rs).
+    pub unbounded: bool,
 }

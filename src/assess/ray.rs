@@ -20,12 +20,13 @@ const BOUND_SLACK: f64 = 2e-9;
 /// envelope's height scale.
 const ROUNDING: f64 = 1e-12;
 
-/// The first state of a ray of certified surfaces along `state`'s force densities (and load
-/// factor), where one starts: q (and λ) scaled by s₀ with heights z∞ + w / s₀, the supports
+/// A state of a ray of certified surfaces along `state`'s force densities (and load factor),
+/// at s = max(s₀, `at_least`), s₀ ≥ 1 where the ray starts: q (and λ) scaled by s with
+/// heights z∞ + w / s, the supports
 /// at `state`'s heights or, for those with a springing joint, on their springing planes.
 /// None where the analysis is neither the greatest thrust nor the largest load, or no such
 /// ray starts.
-pub(super) fn ray_start(model: &Model, state: &State) -> Option<State> {
+pub(super) fn ray_start(model: &Model, state: &State, at_least: f64) -> Option<State> {
     let live = match model.objective {
         Objective::MaxThrust => 0.0,
         Objective::MaxLoad if state.t > 0.0 => state.t,
@@ -49,7 +50,8 @@ pub(super) fn ray_start(model: &Model, state: &State) -> Option<State> {
             let limit = solver.solve(model, &state.q, held, limit_load)?;
             let s0 = envelope_start(model, &limit, &w)?
                 .max(joints_start(model, &state.q, &limit, &w, limit_load)?)
-                .max(1.0);
+                .max(1.0)
+                .max(at_least);
             Some(State {
                 y: state.y.iter().map(|y| s0 * y).collect(),
                 q: state.q.iter().map(|q| s0 * q).collect(),
@@ -134,8 +136,26 @@ impl Laplacian {
         for (k, &v) in model.residual.iter().enumerate() {
             z[v as usize] = rhs[k];
         }
-        z.iter().all(|x| x.is_finite()).then_some(z)
+        let solved = z.iter().all(|x| x.is_finite()) && balanced(model, q, &z, load);
+        solved.then_some(z)
     }
+}
+
+/// K z = load at every non-anchored vertex to 1e-10 of the terms' size: a K near singular
+/// (a region the stress barely ties to a support) yields no certificate.
+fn balanced(model: &Model, q: &[f64], z: &[f64], load: impl Fn(usize) -> f64) -> bool {
+    let edges = &model.problem.mesh.edges;
+    model.residual.iter().all(|&i| {
+        let i = i as usize;
+        let (mut sum, mut size) = (-load(i), load(i).abs());
+        for &e in &model.incident[i] {
+            let j = other_end(edges[e as usize].v, i);
+            let q = q[e as usize];
+            sum += q * (z[i] - z[j]);
+            size += q * (z[i].abs() + z[j].abs());
+        }
+        sum.abs() <= 1e-10 * size
+    })
 }
 
 /// The least s from which z∞ + w / s lies within the envelope at every non-anchored vertex
@@ -152,11 +172,15 @@ fn envelope_start(model: &Model, limit: &[f64], w: &[f64]) -> Option<f64> {
     let mut start: f64 = 0.0;
     for &v in &model.residual {
         let v = v as usize;
-        let (m, h) = (model.middle[v], model.half[v]);
+        if w[v] == 0.0 {
+            continue;
+        }
+        // Half the allowance: the start keeps the other half against rounding.
+        let (m, h, slack) = (model.middle[v], model.half[v], 0.5 * BOUND_SLACK);
         let room = if w[v] > 0.0 {
-            m + h + BOUND_SLACK - limit[v]
+            m + h + slack - limit[v]
         } else {
-            limit[v] - (m - h - BOUND_SLACK)
+            limit[v] - (m - h - slack)
         };
         if room <= 0.0 {
             return None;
@@ -213,4 +237,73 @@ fn joints_start(
         }
     }
     Some(start)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assess::{AssessSettings, Envelope};
+    use crate::{Mesh, Problem, Thickness};
+
+    /// A free centre over six supports on the unit circle, all at height 0, the centre
+    /// between `centre_lower` and 0.5, the supports between −0.1 and 0.1.
+    fn fan_problem(centre_lower: f64) -> (Problem, Envelope) {
+        let mut positions = vec![[0.0, 0.0, 0.2]];
+        for k in 0..6 {
+            let a = std::f64::consts::PI * k as f64 / 3.0;
+            positions.push([a.cos(), a.sin(), 0.0]);
+        }
+        let faces: Vec<[u32; 3]> = (0..6u32).map(|k| [0, k + 1, (k + 1) % 6 + 1]).collect();
+        let mesh = Mesh::new(positions, faces, &[1, 2, 3, 4, 5, 6]).unwrap();
+        let mut lower = vec![-0.1; 7];
+        let mut upper = vec![0.1; 7];
+        (lower[0], upper[0]) = (centre_lower, 0.5);
+        let envelope = Envelope::from_bounds(&mesh, lower, upper, &Thickness::Uniform(0.1));
+        (Problem::new(mesh), envelope.unwrap())
+    }
+
+    /// The spokes' force density `q` (frame units), the rim's 0, the supports at 0.
+    fn spokes(model: &Model, q: f64) -> State {
+        let edges = &model.problem.mesh.edges;
+        State {
+            y: Vec::new(),
+            q: (edges.iter())
+                .map(|e| if e.v.contains(&0) { q } else { 0.0 })
+                .collect(),
+            z: vec![0.0; 7],
+            t: 0.0,
+        }
+    }
+
+    /// The centre hangs w = p / Σq above the supports' plane and rises to it as 1/s: the ray
+    /// starts where it meets the centre's upper bound, or further where asked.
+    #[test]
+    fn the_ray_starts_where_its_binding_bound_allows() {
+        let (problem, envelope) = fan_problem(-0.1);
+        let settings = AssessSettings::default()
+            .with_objective(Objective::MaxThrust)
+            .with_fixed_supports(true);
+        let model = Model::new(&problem, &envelope, &settings).unwrap();
+        let top = model.middle[0] + model.half[0];
+        // w = 2 × top: the ray starts at s₀ = 2 (to the half slack).
+        let q = model.dead[0] / (6.0 * 2.0 * top);
+        let state = spokes(&model, q);
+        let scale = |s: &State| s.q.iter().fold(0.0f64, |a, &x| a.max(x)) / q;
+        let start = ray_start(&model, &state, 1.0).unwrap();
+        assert!((scale(&start) - 2.0).abs() < 1e-6, "{}", scale(&start));
+        assert!(start.z[0] <= top + BOUND_SLACK && start.z[0] > top - 1e-6);
+        let later = ray_start(&model, &state, 5.0).unwrap();
+        assert!((scale(&later) - 5.0).abs() < 1e-12);
+        // A centre whose lower bound lies above the supports: flat surfaces leave the
+        // envelope, so no ray.
+        let (problem, envelope) = fan_problem(0.05);
+        let model = Model::new(&problem, &envelope, &settings).unwrap();
+        assert!(ray_start(&model, &spokes(&model, q), 1.0).is_none());
+        // Fit and the least thrust look for no ray.
+        for objective in [Objective::Fit, Objective::MinThrust] {
+            let settings = settings.clone().with_objective(objective);
+            let model = Model::new(&problem, &envelope, &settings).unwrap();
+            assert!(ray_start(&model, &spokes(&model, q), 1.0).is_none());
+        }
+    }
 }

@@ -102,12 +102,14 @@ pub(super) fn solve(
     if termination != Termination::Cancelled && !found && !stalled {
         iterations += search.polish(&layout);
     }
+    let unbounded = search.unbounded;
     let state = search.answer();
     Ok(Run {
         state,
         termination,
         iterations,
         seconds: start.elapsed().as_secs_f64(),
+        unbounded,
     })
 }
 
@@ -117,6 +119,7 @@ pub(super) fn stopped(model: &Model, settings: &AssessSettings, run: Run) -> Run
     let mut search = Search::new(model, settings);
     search.restart_from(run.state);
     Run {
+        unbounded: search.unbounded,
         state: search.answer(),
         termination: Termination::Cancelled,
         ..run
@@ -159,6 +162,8 @@ struct Search<'m, 'a> {
     mu: Option<Vec<f64>>,
     /// The last accepted step's dq and dz.
     direction: Option<(Vec<f64>, Vec<f64>)>,
+    /// The analysis' settings, for the certificate of a ray's start.
+    settings: AssessSettings,
     /// The best certified state starts a ray of certified surfaces whose thrust grows
     /// without bound (the greatest thrust only).
     unbounded: bool,
@@ -200,6 +205,7 @@ impl<'m, 'a> Search<'m, 'a> {
             mu: None,
             direction: None,
             unbounded: false,
+            settings: settings.clone(),
             heights: None,
         }
     }
@@ -558,11 +564,25 @@ impl<'m, 'a> Search<'m, 'a> {
 
     /// For the greatest thrust: where the current force densities start a ray of certified
     /// surfaces (the thrust has no bound), its first state becomes the answer.
+    /// Far enough along the ray to pass the best state found; taken only where the result's
+    /// own certificate accepts it.
     fn find_ray(&mut self) {
-        let Some(start) = ray::ray_start(self.model, &self.state) else {
+        let f = self.model.objective_value(&self.state);
+        let at_least = match &self.best_feasible {
+            Some((best, _)) if f < 0.0 && *best < 0.0 => best / f,
+            _ => 1.0,
+        };
+        let Some(start) = ray::ray_start(self.model, &self.state, at_least) else {
             return;
         };
-        if self.model.violation(&start).0 <= self.certified_below {
+        let run = Run {
+            state: start.clone(),
+            termination: Termination::Converged,
+            iterations: 0,
+            seconds: 0.0,
+            unbounded: true,
+        };
+        if self.model.certify(run, &self.settings).feasible {
             let f = self.model.objective_value(&start);
             self.best_feasible = Some((f, start));
             self.unbounded = true;
