@@ -344,12 +344,16 @@ impl<'m, 'a> Search<'m, 'a> {
     /// An accepted `trial` that leaves the residuals above the target, or the step with its
     /// second-order correction where that lowers φ further (so it passes the same test): the
     /// bilinear term a step leaves in the residuals would otherwise hold each step short of
-    /// equilibrium (the Maratos effect of an exact penalty).
+    /// equilibrium (the Maratos effect of an exact penalty). A trial that meets the target
+    /// is projected (`fit`) where that lowers φ.
     fn corrected_if_better(&self, layout: &Layout, step: &Step, trial: State) -> State {
-        if self.model.violation(&trial).0 <= self.feasible_below {
-            return trial;
-        }
         let phi = self.merit(&trial);
+        if self.model.violation(&trial).0 <= self.feasible_below {
+            // The residuals a feasible step leaves still cost ν each: projected away (one
+            // height solve), they no longer hold the next steps' model ratio down.
+            let projected = self.projected(&trial).filter(|c| self.merit(c) < phi);
+            return projected.unwrap_or(trial);
+        }
         (self.corrected(layout, step, &trial, |c| self.merit(c) < phi)).unwrap_or(trial)
     }
 
