@@ -164,8 +164,8 @@ struct Search<'m, 'a> {
     direction: Option<(Vec<f64>, Vec<f64>)>,
     /// The analysis' settings, for the certificate of a ray's start.
     settings: AssessSettings,
-    /// The best certified state starts a ray of certified surfaces whose thrust grows
-    /// without bound (the greatest thrust only).
+    /// The best certified state lies on a ray of certified surfaces along which the
+    /// objective has no bound (the greatest thrust and the largest load only; ray.rs).
     unbounded: bool,
     /// The height solve of `fit`'s projected correction (none for the other analyses and
     /// their start, or where its analysis failed).
@@ -350,7 +350,8 @@ impl<'m, 'a> Search<'m, 'a> {
         let phi = self.merit(&trial);
         if self.model.violation(&trial).0 <= self.feasible_below {
             // The residuals a feasible step leaves still cost ν each: projected away (one
-            // height solve), they no longer hold the next steps' model ratio down.
+            // height solve, `fit` only), they no longer hold the next steps' model ratio
+            // down.
             let projected = self.projected(&trial).filter(|c| self.merit(c) < phi);
             return projected.unwrap_or(trial);
         }
@@ -566,10 +567,10 @@ impl<'m, 'a> Search<'m, 'a> {
         }
     }
 
-    /// For the greatest thrust: where the current force densities start a ray of certified
-    /// surfaces (the thrust has no bound), its first state becomes the answer.
-    /// Far enough along the ray to pass the best state found; taken only where the result's
-    /// own certificate accepts it.
+    /// For the greatest thrust and the largest load: where the current force densities start
+    /// a ray of certified surfaces (the objective has no bound), its state far enough along
+    /// to pass the best state found becomes the answer, where the result's own certificate
+    /// accepts it.
     fn find_ray(&mut self) {
         let f = self.model.objective_value(&self.state);
         let at_least = match &self.best_feasible {
