@@ -347,8 +347,10 @@ impl<'m, 'a> Search<'m, 'a> {
     /// equilibrium (the Maratos effect of an exact penalty). A trial that meets the target
     /// is projected (`fit`) where that lowers φ.
     fn corrected_if_better(&self, layout: &Layout, step: &Step, trial: State) -> State {
-        let phi = self.merit(&trial);
-        if self.model.violation(&trial).0 <= self.feasible_below {
+        // One pass over the residuals gives both the target test and φ.
+        let (largest, l1) = self.model.violation(&trial);
+        let phi = self.model.objective_value(&trial) + self.nu * l1;
+        if largest <= self.feasible_below {
             // The residuals a feasible step leaves still cost ν each: projected away (one
             // height solve, `fit` only), they no longer hold the next steps' model ratio
             // down.
@@ -572,6 +574,12 @@ impl<'m, 'a> Search<'m, 'a> {
     /// to pass the best state found becomes the answer, where the result's own certificate
     /// accepts it.
     fn find_ray(&mut self) {
+        if !matches!(
+            self.model.objective,
+            Objective::MaxThrust | Objective::MaxLoad
+        ) {
+            return;
+        }
         let f = self.model.objective_value(&self.state);
         let at_least = match &self.best_feasible {
             Some((best, _)) if f < 0.0 && *best < 0.0 => best / f,
