@@ -611,3 +611,22 @@ def test_a_family_may_give_its_springing_joints():
         voussoir.min_thickness_of_family(mesh, lambda t: (*bounds(t), None, -1.0), 0.1)
     with pytest.raises(voussoir.VoussoirError, match="pair"):
         voussoir.min_thickness_of_family(mesh, lambda t: (*bounds(t), None), 0.1)
+
+
+def test_a_free_corner_is_refused_at_once():
+    """A vault over a square anchored along two sides has a free corner between its free
+    sides: every edge leaves it on one side, so compression cannot hold it in any envelope.
+    The answer comes without a search and names the corner; anchored all round, it fits."""
+    n = 4
+    v = np.array([(i / n, j / n, 0.1 + 0.1 * (i / n) * (1 - i / n) + 0.1 * (j / n) * (1 - j / n))
+                  for j in range(n + 1) for i in range(n + 1)])
+    vid = lambda i, j: j * (n + 1) + i  # noqa: E731
+    f = np.array([t for j in range(n) for i in range(n)
+                  for t in ((vid(i, j), vid(i + 1, j), vid(i + 1, j + 1)),
+                            (vid(i, j), vid(i + 1, j + 1), vid(i, j + 1)))], dtype=np.int64)
+    two_sides = [k for k, p in enumerate(v) if p[0] == 0 or p[1] == 0]
+    r = voussoir.assess(voussoir.Mesh(v, f, two_sides), 1.0, objective="min-thickness")
+    assert not r.feasible and r.termination == "infeasible" and r.iterations == 0
+    assert f"vertex {vid(n, n)} is a free corner" in r.termination_message
+    all_round = [k for k, p in enumerate(v) if p[0] in (0, 1) or p[1] in (0, 1)]
+    assert voussoir.assess(voussoir.Mesh(v, f, all_round), 1.0).feasible

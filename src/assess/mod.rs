@@ -11,6 +11,7 @@
 //! only steps that lower its merit function. Every returned figure is recomputed from the
 //! returned heights and forces.
 
+mod corners;
 mod envelope;
 mod family;
 mod model;
@@ -255,7 +256,10 @@ pub struct AssessResult {
 ///
 /// A search that ends without a certified surface proves nothing: the analysis then runs
 /// again from surfaces of a stricter problem and of the least thickness (docs/method.md
-/// §16.3) before it answers `feasible == false`.
+/// §16.3) before it answers `feasible == false`. A free corner (a free boundary vertex whose
+/// edges all leave it on one side in plan) does prove it: no compression-only surface in any
+/// envelope balances its load, and the answer, without a search, is `feasible == false` with
+/// [`Termination::Infeasible`] naming the corners.
 ///
 /// `progress` sees every step of every search (the start's `fit` search, the retries and the
 /// search for [`AssessResult::needed_scale`]), numbered as one sequence; returning false
@@ -274,6 +278,11 @@ pub fn assess(
         cancelled: false,
     };
     let model = model::Model::new(problem, envelope, settings)?;
+    let corners = corners::free_corners(&model);
+    if !corners.is_empty() {
+        let run = corners::unbalanced(&model, &corners);
+        return Ok(finish(&model, run, settings, &steps, start));
+    }
     let run = analyse(&model, problem, envelope, settings, &mut steps)?;
     let mut result = finish(&model, run, settings, &steps, start);
     if result.feasible || result.termination == Termination::Cancelled {

@@ -63,8 +63,9 @@ pub unsafe extern "C" fn vsr_assessment_objective(
 /// every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
 /// least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
 /// when the objective's optimum was reached (else why the search stopped: max iterations,
-/// stalled, cancelled, ...); the steps taken; the wall-clock seconds. Every pointer
-/// required; written only on success.
+/// stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where free
+/// corners hold no thrust surface in any envelope: the termination message names them); the
+/// steps taken; the wall-clock seconds. Every pointer required; written only on success.
 ///
 /// # Safety
 /// `assessment`: a valid handle; the out-pointers writable.

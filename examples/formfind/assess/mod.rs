@@ -79,6 +79,11 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
             ending(&r.termination),
             r.objective.as_str()
         )
+    } else if let Termination::Infeasible { constraint } = &r.termination {
+        format!(
+            "no thrust surface exists in any envelope: relax {constraint}; the outputs hold \
+             the middle surface without force"
+        )
     } else {
         format!(
             "no thrust surface found inside the envelope ({}): the outputs hold the least \
