@@ -884,6 +884,20 @@ TEST(CppApi, AnUnboundedObjectiveSaysSo) {
     EXPECT_GT(a.figures().load_factor, 0.0);
 }
 
+TEST(CppApi, AFreeCornerHoldsNoThrustSurface) {
+    // Anchored at three corners, the fourth (vertex 3) is free with every edge leaving it on
+    // one side in plan: compression cannot balance it, so no envelope holds a surface.
+    const voussoir::Mesh mesh(kPositions, kTriangles, {0, 1, 2});
+    const voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 1.0);
+    const voussoir::Assessment a = voussoir::assess(mesh, envelope, voussoir::AssessSettings());
+    const voussoir::AssessmentOutcome outcome = a.outcome();
+    EXPECT_FALSE(outcome.feasible);
+    EXPECT_EQ(outcome.termination, VSR_TERMINATION_INFEASIBLE);
+    EXPECT_EQ(outcome.iterations, 0u);
+    const std::string message = a.termination_message();
+    EXPECT_NE(message.find("vertex 3 is a free corner"), std::string::npos) << message;
+}
+
 TEST(CppApi, SpringingJointsReachTheCSetter) {
     const voussoir::Mesh mesh(kPositions, kTriangles, kAnchored);
     voussoir::Envelope envelope = voussoir::Envelope::from_thickness(mesh, 0.1);

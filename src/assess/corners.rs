@@ -13,22 +13,27 @@ use crate::solve::Termination;
 /// up to rounding, can carry its load as an arch along the edge.
 const MARGIN: f64 = 1e-9;
 
-/// The non-anchored vertices with a load and no prescribed horizontal force whose edges
-/// with force all leave them into one open half-plane (only free boundary vertices can), in
-/// increasing order.
-pub(super) fn free_corners(model: &Model) -> Vec<u32> {
+/// The non-anchored vertices whose edges with force all leave them into one open half-plane
+/// (only free boundary vertices can), in increasing order, where that proves the analysis
+/// infeasible: the vertex's load exceeds what the certificate forgives (`tolerance` times
+/// the mean load), no prescribed horizontal force acts there, and no live load of
+/// `max-load`, whose factor may take either sign, could cancel its dead load.
+pub(super) fn free_corners(model: &Model, tolerance: f64) -> Vec<u32> {
     let mut corners: Vec<u32> = (model.residual.iter().copied())
-        .filter(|&v| is_corner(model, v))
+        .filter(|&v| unbalanced_load(model, v, tolerance) && is_corner(model, v))
         .collect();
     corners.sort_unstable();
     corners
 }
 
+fn unbalanced_load(model: &Model, v: u32, tolerance: f64) -> bool {
+    let v = v as usize;
+    let live = model.objective == Objective::MaxLoad && model.live[v] != 0.0;
+    model.dead[v].abs() >= tolerance && !live && model.stress.external[v] == [0.0, 0.0]
+}
+
 fn is_corner(model: &Model, v: u32) -> bool {
     let vi = v as usize;
-    if model.dead_physical[vi] == 0.0 || model.stress.external[vi] != [0.0, 0.0] {
-        return false;
-    }
     let mesh = &model.problem.mesh;
     let u = &model.stress.plan.u;
     let mut angles: Vec<f64> = (model.incident[vi].iter())

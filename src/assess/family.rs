@@ -68,7 +68,7 @@ pub fn min_thickness_of_family(
         rounds += 1;
         let result = assess(problem, &envelope_at(t)?, &settings, None)?;
         if !result.feasible {
-            let end = format!("{:?}", result.termination);
+            let end = result.termination.to_string();
             if best.is_none() {
                 return Err(no_surface(t, &end));
             }

@@ -278,7 +278,7 @@ pub fn assess(
         cancelled: false,
     };
     let model = model::Model::new(problem, envelope, settings)?;
-    let corners = corners::free_corners(&model);
+    let corners = corners::free_corners(&model, settings.tolerance);
     if !corners.is_empty() {
         let run = corners::unbalanced(&model, &corners);
         return Ok(finish(&model, run, settings, &steps, start));

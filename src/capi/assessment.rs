@@ -180,7 +180,8 @@ pub unsafe extern "C" fn vsr_assessment_certificate(
 
 /// A one-line description of the termination, as a NUL-terminated UTF-8 string copied into
 /// `out` (`len` bytes; `needed` counts the terminating NUL); for `VSR_TERMINATION_STALLED` it
-/// lists the vertices with the largest residuals.
+/// lists the vertices with the largest residuals, for `VSR_TERMINATION_INFEASIBLE` the free
+/// corners.
 ///
 /// # Safety
 /// `assessment`: a valid handle; `out`: NULL or `len` writable bytes; `needed`: NULL or

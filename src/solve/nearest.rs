@@ -139,6 +139,9 @@ struct Nearest<'a, 'p> {
     w: f64,
     /// The lowest-E state in equilibrium (ε∞ < tolerance) reached.
     feasible: Option<Best>,
+    /// Whether the held forces are the stress step's answer at the current heights (not
+    /// earlier forces kept there because the answer did worse).
+    held_answers: bool,
     /// Multipliers of the equilibrium rows (units of r̂), per row of `shape`.
     lambda: Vec<f64>,
     /// −p̄ √n λ / 2w per vertex, physical: the loads' shift in both steps.
@@ -203,6 +206,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             held: placeholder(),
             w: 0.0,
             feasible: None,
+            held_answers: true,
             lambda: vec![0.0; n_rows],
             load_offset: vec![0.0; positions.len()],
             best: Best {
@@ -326,7 +330,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 self.shift_loads();
             }
         }
-        let prior = self.previous_forces.take();
+        // Certified at the start heights, so that kept in place of a worse answer they carry
+        // their own residuals there.
+        let prior = (self.previous_forces.take())
+            .map(|p| p.at_heights(self.problem, &self.positions, &self.step_settings()));
         self.held = self.stress_step(prior.as_ref())?;
         let ended = self.after_stress_step();
         let settled = self.record();
@@ -606,7 +613,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
         }
         // A QP stopped at a looser gap (`inexact_gap`) holds its bounds and horizontal rows as
         // tightly as an exact one, and ε∞ is recomputed from its forces: its state counts.
-        let solved = self.held.status == StressStatus::Solved;
+        // Earlier forces kept at new heights count only where they still meet their bounds
+        // there (relative bounds move with the loads).
+        let solved = self.held.status == StressStatus::Solved
+            && (self.held_answers || self.meets_bounds(&self.held));
         if !(solved && self.held.eps_inf < self.settings.tolerance) {
             return false;
         }
@@ -657,16 +667,13 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 answer.status,
                 StressStatus::AlmostSolved | StressStatus::MaxIterations
             );
-        let answer = match held {
-            Some(h)
-                if short
-                    && settings.dual_length_smoothing == 0.0
-                    && self.merit(&self.positions, h) < self.merit(&self.positions, &answer) =>
-            {
-                h.clone()
-            }
-            _ => answer,
-        };
+        let kept = held.filter(|h| {
+            short
+                && settings.dual_length_smoothing == 0.0
+                && self.merit(&self.positions, h) < self.merit(&self.positions, &answer)
+        });
+        self.held_answers = kept.is_none();
+        let answer = kept.cloned().unwrap_or(answer);
         self.iterations += 1;
         self.history.push(answer.eps_inf);
         self.stress_seconds += t.elapsed().as_secs_f64();
