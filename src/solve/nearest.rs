@@ -139,6 +139,9 @@ struct Nearest<'a, 'p> {
     w: f64,
     /// The lowest-E state in equilibrium (ε∞ < tolerance) reached.
     feasible: Option<Best>,
+    /// Whether the held forces come from a QP solved to its full tolerances (not loosened by
+    /// `Nearest::inexact_gap`).
+    exact: bool,
     /// Whether the held forces are the stress step's answer at the current heights (not
     /// earlier forces kept there because the answer did worse).
     held_answers: bool,
@@ -206,6 +209,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             held: placeholder(),
             w: 0.0,
             feasible: None,
+            exact: true,
             held_answers: true,
             lambda: vec![0.0; n_rows],
             load_offset: vec![0.0; positions.len()],
@@ -611,11 +615,12 @@ impl<'a, 'p> Nearest<'a, 'p> {
         if first || (usable && self.held.eps_inf < self.best.eps) {
             self.best = current.clone();
         }
-        // A QP stopped at a looser gap (`inexact_gap`) holds its bounds and horizontal rows as
-        // tightly as an exact one, and ε∞ is recomputed from its forces: its state counts.
-        // Earlier forces kept at new heights count only where they still meet their bounds
-        // there (relative bounds move with the loads).
+        // An answer in equilibrium counts once its QP met the full tolerances, so that the
+        // horizontal rows hold as tightly as an analysis's (and an analysis of the shape afresh
+        // finds it standing: a looser answer's state did not always, on cheese). Earlier forces
+        // kept at new heights count only where they still meet their bounds there.
         let solved = self.held.status == StressStatus::Solved
+            && self.exact
             && (self.held_answers || self.meets_bounds(&self.held));
         if !(solved && self.held.eps_inf < self.settings.tolerance) {
             return false;
@@ -673,6 +678,9 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 && self.merit(&self.positions, h) < self.merit(&self.positions, &answer)
         });
         self.held_answers = kept.is_none();
+        if kept.is_none() {
+            self.exact = !self.cache.last_was_inexact();
+        }
         let answer = kept.cloned().unwrap_or(answer);
         self.iterations += 1;
         self.history.push(answer.eps_inf);
@@ -983,11 +991,10 @@ impl<'a, 'p> Nearest<'a, 'p> {
 /// heights (`held`): ε∞², at most `INEXACT_GAP_MAX`, where that is looser than the QP's
 /// own tolerance (an inexact Newton method's forcing term: a relative gap g leaves the
 /// residual vector within √(2g) of the optimum's, so the answer's residuals are right to about
-/// ε∞ of themselves). Far from balance the loop moves the shape anyway; near it the gap
-/// tightens with ε∞². The gap is the QP's optimality only: bounds and horizontal rows are held
-/// as tightly as in an exact QP, so an answer counts as a state in equilibrium by its
-/// recomputed ε∞ (`Nearest::record`). The smoothing-free loop judges every inexact answer by
-/// its merit (`Nearest::stress_step`).
+/// ε∞ of themselves). Far from balance the loop moves the shape anyway; near it the QPs are
+/// solved to their full tolerances, and only such answers count as states in equilibrium
+/// (`Nearest::record`). The smoothing-free loop judges every inexact answer by its merit
+/// (`Nearest::stress_step`).
 fn inexact_gap(held: &StressResult) -> Option<f64> {
     let gap = held.eps_inf.powi(2).min(INEXACT_GAP_MAX);
     gap.is_finite().then_some(gap)

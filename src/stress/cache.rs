@@ -93,10 +93,15 @@ impl StressCache {
     /// tolerances' (`None`: their own). The dual residual's tolerance is relaxed with it
     /// (by the square root of the ratio); bounds and horizontal balance are held as tightly.
     /// Form finding loosens early QPs, whose answers it judges by its own merit (a step
-    /// that does worse than the forces at hand is not taken), the gap tightening as the
-    /// shape nears balance.
+    /// that does worse than the forces at hand is not taken), and solves them exactly once
+    /// the shape nears balance.
     pub(crate) fn set_inexact(&mut self, gap: Option<f64>) {
         self.inexact = gap;
+    }
+
+    /// Whether the last step's answer was solved to the looser gap of `set_inexact` only.
+    pub(crate) fn last_was_inexact(&self) -> bool {
+        self.last_inexact
     }
 }
 
