@@ -396,6 +396,13 @@ fn a_barrel_with_free_sides_is_certified() {
     }
 }
 
+/// The plan points of an n × n grid over the unit square, row by row (as `grid_faces`).
+fn unit_grid(n: usize) -> Vec<[f64; 2]> {
+    (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
+        .collect()
+}
+
 /// Triangles of the grid of (nx + 1) × (ny + 1) points, row by row in x.
 fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
     let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
@@ -642,9 +649,7 @@ fn free_vault_without_its_edge_pushes_stalls_at_once() {
 #[test]
 fn a_thick_shallow_cap_has_no_greatest_thrust_or_load() {
     let n = 8;
-    let points: Vec<[f64; 2]> = (0..=n)
-        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
-        .collect();
+    let points = unit_grid(n);
     let pi = std::f64::consts::PI;
     let height = |u: [f64; 2]| 0.05 * (pi * u[0]).sin() * (pi * u[1]).sin();
     let edge = |u: [f64; 2], _| u.iter().any(|&x| !(1e-9..=1.0 - 1e-9).contains(&x));
@@ -847,9 +852,7 @@ fn assert_free_corners(result: &AssessResult, corners: &[u32]) {
 #[test]
 fn a_free_corner_holds_no_thrust_surface_in_any_envelope() {
     let n = 6;
-    let points: Vec<[f64; 2]> = (0..=n)
-        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
-        .collect();
+    let points = unit_grid(n);
     let height = |u: [f64; 2]| 0.1 * (1.0 + u[0] * (1.0 - u[0]) + u[1] * (1.0 - u[1]));
     let two_sides = |u: [f64; 2], _| u[0] < 1e-9 || u[1] < 1e-9;
     let mesh = generate::lift(&points, &grid_faces(n, n), height, two_sides).unwrap();

@@ -4,7 +4,7 @@
 //! d_e · c > 0 forces q = 0), and then nothing holds its load: no thrust surface exists in
 //! any envelope, however thick. An assessment answers so before any search.
 
-use super::model::{Model, Run, State};
+use super::model::{Model, Run};
 use super::Objective;
 use crate::solve::Termination;
 
@@ -55,15 +55,7 @@ fn is_corner(model: &Model, v: u32) -> bool {
 /// The answer where free corners exist: the middle surface without force (its residuals are
 /// the loads), with the termination naming the corners.
 pub(super) fn unbalanced(model: &Model, corners: &[u32]) -> Run {
-    let state = State {
-        y: vec![0.0; model.stress.s().ncols],
-        q: vec![0.0; model.stress.bounds.len()],
-        z: model.z_start.clone(),
-        t: match model.objective {
-            Objective::MinThickness => 1.0,
-            _ => 0.0,
-        },
-    };
+    let state = model.start_state();
     let ids: Vec<String> = corners.iter().map(|v| v.to_string()).collect();
     let (which, is) = match corners.len() {
         1 => ("vertex", "is a free corner"),

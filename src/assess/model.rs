@@ -203,6 +203,20 @@ impl<'a> Model<'a> {
     }
 
     /// The scale of the half extents at `state`.
+    /// The searches' start: the start heights without force (scale 1 for the least
+    /// thickness).
+    pub fn start_state(&self) -> State {
+        State {
+            y: vec![0.0; self.stress.s().ncols],
+            q: vec![0.0; self.stress.bounds.len()],
+            z: self.z_start.clone(),
+            t: match self.objective {
+                Objective::MinThickness => 1.0,
+                _ => 0.0,
+            },
+        }
+    }
+
     pub fn scale(&self, state: &State) -> f64 {
         if self.objective == Objective::MinThickness {
             state.t

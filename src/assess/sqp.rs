@@ -174,17 +174,7 @@ struct Search<'m, 'a> {
 
 impl<'m, 'a> Search<'m, 'a> {
     fn new(model: &'m Model<'a>, settings: &AssessSettings) -> Self {
-        let n = model.z_start.len();
-        let state = State {
-            y: vec![0.0; model.stress.s().ncols],
-            q: vec![0.0; model.stress.bounds.len()],
-            z: model.z_start.clone(),
-            t: match model.objective {
-                Objective::MinThickness => 1.0,
-                _ => 0.0,
-            },
-        };
-        debug_assert_eq!(state.z.len(), n);
+        let state = model.start_state();
         let nu = 10.0 / model.residual.len().max(1) as f64;
         let residual = model.violation(&state).0;
         Search {
