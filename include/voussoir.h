@@ -2034,7 +2034,8 @@ VsrStatus vsr_assessment_worst_joint(const struct VsrAssessment *assessment, dou
  * bound: the returned surface is certified, and its force densities (and load factor)
  * scaled by every s from some s₀ ≥ 1 on, with heights approaching a limit surface over the
  * same supports, give certified surfaces too (docs/method.md §16.4), so
- * `thrust_horizontal` or `load_factor` is a value reached, not the greatest; else 0. The pointer required; written only on success.
+ * `thrust_horizontal` or `load_factor` is a value reached, not the greatest; else 0. The
+ * pointer required; written only on success.
  *
  * # Safety
  * `assessment`: a valid handle; the out-pointer writable.

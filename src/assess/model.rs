@@ -202,7 +202,6 @@ impl<'a> Model<'a> {
         Ok(())
     }
 
-    /// The scale of the half extents at `state`.
     /// The searches' start: the start heights without force (scale 1 for the least
     /// thickness).
     pub fn start_state(&self) -> State {
@@ -217,6 +216,7 @@ impl<'a> Model<'a> {
         }
     }
 
+    /// The scale of the half extents at `state`.
     pub fn scale(&self, state: &State) -> f64 {
         if self.objective == Objective::MinThickness {
             state.t
