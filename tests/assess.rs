@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::assess::{check_certificate, distance_from_middle, shell};
+use common::assess::{check_certificate, distance_from_middle, grid_faces, shell, unit_grid};
 
 use voussoir::generate::{self, KnownPlan};
 use voussoir::{
@@ -396,27 +396,6 @@ fn a_barrel_with_free_sides_is_certified() {
     }
 }
 
-/// The plan points of an n × n grid over the unit square, row by row (as `grid_faces`).
-fn unit_grid(n: usize) -> Vec<[f64; 2]> {
-    (0..=n)
-        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
-        .collect()
-}
-
-/// Triangles of the grid of (nx + 1) × (ny + 1) points, row by row in x.
-fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
-    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut faces = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-            faces.push([a, b, c]);
-            faces.push([a, c, d]);
-        }
-    }
-    faces
-}
-
 /// A family whose bounds scale linearly about a fixed middle (a normal thickness read by the
 /// tangent plane) has the least-thickness analysis' answer: t_min = t · s.
 #[test]
@@ -799,112 +778,4 @@ fn dense_heights(mesh: &Mesh, q: &[f64], held: &[f64], p: &[f64]) -> Vec<f64> {
         z[free[c]] = (a[c][m] - tail) / a[c][c];
     }
     z
-}
-
-/// The free corners of `mesh`, found from its faces: the free boundary vertices whose faces'
-/// plan angles at them sum to less than a half turn, so that every edge leaves them on one
-/// side (the library finds them from the edges' directions).
-fn free_corners_of(mesh: &Mesh) -> Vec<u32> {
-    let p = mesh.positions();
-    let mut angle = vec![0.0; p.len()];
-    for f in mesh.faces() {
-        for k in 0..3 {
-            let [a, b, c] = [0, 1, 2].map(|d| f[(k + d) % 3] as usize);
-            let u = [p[b][0] - p[a][0], p[b][1] - p[a][1]];
-            let v = [p[c][0] - p[a][0], p[c][1] - p[a][1]];
-            angle[a] += (u[0] * v[1] - u[1] * v[0])
-                .abs()
-                .atan2(u[0] * v[0] + u[1] * v[1]);
-        }
-    }
-    (0..p.len())
-        .filter(|&v| mesh.on_boundary()[v] && !mesh.anchored()[v])
-        .filter(|&v| angle[v] < std::f64::consts::PI - 1e-6)
-        .map(|v| v as u32)
-        .collect()
-}
-
-/// Asserts the answer of a mesh with free corners: no certified surface, no search, no
-/// force, and the corners named.
-fn assert_free_corners(result: &AssessResult, corners: &[u32]) {
-    assert!(!result.feasible);
-    assert_eq!(result.iterations, 0);
-    assert!(result.force_densities.iter().all(|&q| q == 0.0));
-    let Termination::Infeasible { constraint } = &result.termination else {
-        panic!("{:?}", result.termination);
-    };
-    let ids: Vec<String> = corners.iter().map(|v| v.to_string()).collect();
-    let named = match corners {
-        [_] => format!("vertex {} is a free corner ", ids[0]),
-        _ => format!("vertices {} are free corners ", ids.join(", ")),
-    };
-    assert!(constraint.contains(&named), "{constraint}");
-}
-
-/// A free corner (method.md §16.3) has every edge leaving it on one side in plan, so
-/// compression balances it horizontally only by carrying nothing there, and its weight then
-/// hangs unbalanced: no envelope, however thick, holds a thrust surface. A vault over a
-/// square anchored along two sides has one, the corner between its free sides (its other
-/// free vertices lie on straight edges, a half turn apart); every analysis says so at once
-/// in a slab twenty times the rise. A live load at the corner is not refused (a factor of
-/// either sign may cancel its weight). Anchored all round, the same vault in the same slab
-/// has a surface.
-#[test]
-fn a_free_corner_holds_no_thrust_surface_in_any_envelope() {
-    let n = 6;
-    let points = unit_grid(n);
-    let height = |u: [f64; 2]| 0.1 * (1.0 + u[0] * (1.0 - u[0]) + u[1] * (1.0 - u[1]));
-    let two_sides = |u: [f64; 2], _| u[0] < 1e-9 || u[1] < 1e-9;
-    let mesh = generate::lift(&points, &grid_faces(n, n), height, two_sides).unwrap();
-    let corners = free_corners_of(&mesh);
-    assert_eq!(corners, [((n + 1) * (n + 1) - 1) as u32]);
-    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(1.0)).unwrap();
-    let mut pattern = vec![0.0; mesh.positions().len()];
-    pattern[n / 2 * (n + 2)] = 1.0;
-    for objective in [
-        Objective::Fit,
-        Objective::MinThickness,
-        Objective::MinThrust,
-        Objective::MaxThrust,
-        Objective::MaxLoad,
-    ] {
-        let mut settings = AssessSettings::default().with_objective(objective);
-        if objective == Objective::MaxLoad {
-            settings = settings.with_load_pattern(pattern.clone());
-        }
-        let result = run(mesh.clone(), &envelope, settings);
-        assert_free_corners(&result, &corners);
-    }
-    pattern[corners[0] as usize] = 1.0;
-    let settings = (AssessSettings::default().with_objective(Objective::MaxLoad))
-        .with_load_pattern(pattern)
-        .with_max_iterations(1);
-    let result = run(mesh.clone(), &envelope, settings);
-    assert!(result.iterations > 0, "{:?}", result.termination);
-    let all_round = |_, outer| outer;
-    let mesh = generate::lift(&points, &grid_faces(n, n), height, all_round).unwrap();
-    assert!(free_corners_of(&mesh).is_empty());
-    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(1.0)).unwrap();
-    let result = run(mesh.clone(), &envelope, AssessSettings::default());
-    check_certificate(&mesh, &envelope, &result, 1e-6);
-}
-
-/// vault_pq and dome_with_doors have free corners where their free edges meet at an angle
-/// (the faces' angles find 16 and 1): the least thickness is refused at once, naming exactly
-/// them.
-#[test]
-fn shared_models_with_free_corners_are_refused_at_once() {
-    let Some(dir) = common::models_dir() else {
-        return;
-    };
-    for (name, count) in [("vault_pq", 16), ("dome_with_doors", 1)] {
-        let problem = common::read_shared(&dir, name).unwrap();
-        let corners = free_corners_of(&problem.mesh);
-        assert_eq!(corners.len(), count, "{name}");
-        let t = 0.03 * common::assess::plan_diagonal(&problem.mesh);
-        let envelope = Envelope::from_thickness(&problem.mesh, &Thickness::Uniform(t)).unwrap();
-        let settings = AssessSettings::default().with_objective(Objective::MinThickness);
-        let result = assess(&problem, &envelope, &settings, None).unwrap();
-        assert_free_corners(&result, &corners);
-    }
 }

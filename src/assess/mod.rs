@@ -256,10 +256,11 @@ pub struct AssessResult {
 ///
 /// A search that ends without a certified surface proves nothing: the analysis then runs
 /// again from surfaces of a stricter problem and of the least thickness (docs/method.md
-/// §16.3) before it answers `feasible == false`. A free corner (a free boundary vertex whose
-/// edges all leave it on one side in plan) does prove it: no compression-only surface in any
-/// envelope balances its load, and the answer, without a search, is `feasible == false` with
-/// [`Termination::Infeasible`] naming the corners.
+/// §16.3) before it answers `feasible == false`. A stranded part of the plan does prove it:
+/// free corners (free vertices whose edges all leave them on one side in plan) and straight
+/// free edges carry no force off themselves, and a loaded part left with no compressive
+/// path to a support has no surface in any envelope. The answer, without a search, is then
+/// `feasible == false` with [`Termination::Infeasible`] naming the corners and the part.
 ///
 /// `progress` sees every step of every search (the start's `fit` search, the retries and the
 /// search for [`AssessResult::needed_scale`]), numbered as one sequence; returning false
@@ -278,9 +279,8 @@ pub fn assess(
         cancelled: false,
     };
     let model = model::Model::new(problem, envelope, settings)?;
-    let corners = corners::free_corners(&model, settings.tolerance);
-    if !corners.is_empty() {
-        let run = corners::unbalanced(&model, &corners);
+    if let Some(stranded) = corners::stranded(&model, settings.tolerance) {
+        let run = corners::unbalanced(&model, &stranded);
         return Ok(finish(&model, run, settings, &steps, start));
     }
     let run = analyse(&model, problem, envelope, settings, &mut steps)?;

@@ -64,7 +64,8 @@ pub unsafe extern "C" fn vsr_assessment_objective(
 /// least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
 /// when the objective's optimum was reached (else why the search stopped: max iterations,
 /// stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where free
-/// corners hold no thrust surface in any envelope: the termination message names them); the
+/// corners strand a part of the plan with no compressive path to a support, so that no
+/// thrust surface exists in any envelope: the termination message names them); the
 /// steps taken; the wall-clock seconds. Every pointer required; written only on success.
 ///
 /// # Safety
@@ -181,7 +182,7 @@ pub unsafe extern "C" fn vsr_assessment_certificate(
 /// A one-line description of the termination, as a NUL-terminated UTF-8 string copied into
 /// `out` (`len` bytes; `needed` counts the terminating NUL); for `VSR_TERMINATION_STALLED` it
 /// lists the vertices with the largest residuals, for `VSR_TERMINATION_INFEASIBLE` the free
-/// corners.
+/// corners and the stranded vertices.
 ///
 /// # Safety
 /// `assessment`: a valid handle; `out`: NULL or `len` writable bytes; `needed`: NULL or

@@ -223,3 +223,24 @@ pub fn distance_from_middle(mesh: &Mesh, middle: &[f64], positions: &[[f64; 3]])
     }
     (sum / area).sqrt()
 }
+
+/// The plan points of an n × n grid over the unit square, row by row (as `grid_faces`).
+pub fn unit_grid(n: usize) -> Vec<[f64; 2]> {
+    (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f64 / n as f64, j as f64 / n as f64]))
+        .collect()
+}
+
+/// Triangles of the grid of (nx + 1) × (ny + 1) points, row by row in x.
+pub fn grid_faces(nx: usize, ny: usize) -> Vec<[u32; 3]> {
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut faces = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            faces.push([a, b, c]);
+            faces.push([a, c, d]);
+        }
+    }
+    faces
+}
