@@ -38,13 +38,21 @@ pub(super) struct Stranded {
 /// when the live pattern loads none of its vertices (the factor may take either sign and
 /// cancel the dead load). A vertex with a prescribed horizontal force is never peeled.
 pub(super) fn stranded(model: &Model, tolerance: f64) -> Option<Stranded> {
-    let mut carries: Vec<bool> = model.stress.bounds.iter().map(Option::is_some).collect();
+    let with_force: Vec<bool> = model.stress.bounds.iter().map(Option::is_some).collect();
     let corners: Vec<u32> = (model.residual.iter().copied())
-        .filter(|&v| peelable(model, v) && is_corner(model, v, &carries))
+        .filter(|&v| peelable(model, v) && is_corner(model, v, &with_force))
         .collect();
-    peel(model, &mut carries);
-    let vertices = unsupported(model, &carries, tolerance);
+    let vertices = unsupported(model, &model.carries, tolerance);
     (!vertices.is_empty()).then_some(Stranded { corners, vertices })
+}
+
+/// Per edge: whether some compressive state in horizontal balance may load it, as far as
+/// peeling corners and straight free edges tells (an edge marked false carries nothing in
+/// every such state).
+pub(super) fn carrying(model: &Model) -> Vec<bool> {
+    let mut carries: Vec<bool> = model.stress.bounds.iter().map(Option::is_some).collect();
+    peel(model, &mut carries);
+    carries
 }
 
 fn peelable(model: &Model, v: u32) -> bool {

@@ -55,6 +55,10 @@ pub(super) struct Model<'a> {
     pub total_load: f64,
     /// Edge ids around each vertex.
     pub incident: Vec<Vec<u32>>,
+    /// Per edge: whether a compressive state in horizontal balance may load it (false for
+    /// edges without force and those that free corners and straight free edges idle,
+    /// docs/method.md §16.3).
+    pub carries: Vec<bool>,
     /// The springing joints of the free supports with a finite reach.
     pub joints: Vec<Joint>,
 }
@@ -165,11 +169,13 @@ impl<'a> Model<'a> {
             residual,
             supports,
             incident,
+            carries: Vec::new(),
             stress,
         };
         model.check_fixed_supports(settings)?;
         Ok(Model {
             total_load: model.residual.iter().map(|&v| model.dead[v as usize]).sum(),
+            carries: super::corners::carrying(&model),
             ..model
         })
     }

@@ -177,6 +177,7 @@ pub(super) fn solve_step(
     force_rows(model, layout, state, &mut rows);
     vertical_rows(model, layout, state, input.correction, &mut rows);
     horizontal_rows(model, layout, state, &mut rows);
+    idle_rows(model, layout, state, &mut rows);
     rows.n_zero = rows.next();
     bound_rows(model, layout, state, &mut rows);
     rows.n_nonneg = rows.next() - rows.n_zero;
@@ -466,6 +467,25 @@ fn horizontal_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Row
     }
 }
 
+/// q_e + dq_e = 0 on every edge that no compressive state in horizontal balance loads
+/// (method.md §16.3) and whose bounds admit 0: its bound q_e ≥ 0 would hold as an equality
+/// at every feasible point, leaving the interior-point solver no interior.
+fn idle_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+    for (e, col) in layout.q_col.iter().enumerate() {
+        if let (Some(col), true) = (col, pinned(model, e)) {
+            let row = rows.next();
+            rows.a.push(row, *col, 1.0);
+            rows.b.push(-state.q[e]);
+        }
+    }
+}
+
+/// Whether edge `e` is held at zero force by an equation instead of its bounds.
+fn pinned(model: &Model, e: usize) -> bool {
+    let admits_zero = (model.stress.bounds[e]).is_some_and(|(lo, hi)| lo <= 0.0 && hi >= 0.0);
+    !model.carries[e] && admits_zero
+}
+
 /// Force-density bounds, the envelope (scaled by s + ds for the least thickness), e± ≥ 0
 /// and s ≥ 0, as rows A d ≤ b.
 fn bound_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
@@ -473,6 +493,9 @@ fn bound_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
         let (Some((lo, hi)), Some(col)) = (bound, layout.q_col[e]) else {
             continue;
         };
+        if pinned(model, e) {
+            continue;
+        }
         let row = rows.next();
         rows.a.push(row, col, -1.0);
         rows.b.push(state.q[e] - lo);
