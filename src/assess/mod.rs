@@ -386,7 +386,10 @@ fn floored_surface(
         q_min: crate::stress::StressSettings::default().q_min,
         ..settings.clone()
     };
-    let model = model::Model::new(problem, envelope, &floored)?;
+    let mut model = model::Model::new(problem, envelope, &floored)?;
+    // The floor binds only edges that can carry force: on the others it would leave the
+    // stricter problem infeasible wherever the plan idles an edge.
+    model.release_idle_edges();
     let run = analyse(&model, problem, envelope, &floored, steps)?;
     let state = run.state.clone();
     let found = model.certify(run, &floored);

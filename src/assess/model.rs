@@ -180,6 +180,15 @@ impl<'a> Model<'a> {
         })
     }
 
+    /// Lowers the bound of every idled edge (`carries` false) to zero force.
+    pub fn release_idle_edges(&mut self) {
+        for (bound, &carries) in self.stress.bounds.iter_mut().zip(&self.carries) {
+            if let (Some((lo, _)), false) = (bound.as_mut(), carries) {
+                *lo = lo.min(0.0);
+            }
+        }
+    }
+
     /// Fixed supports must lie inside the envelope (at any scale, for the least thickness).
     fn check_fixed_supports(&self, settings: &AssessSettings) -> Result<()> {
         if !settings.fixed_supports {
