@@ -896,6 +896,8 @@ TEST(CppApi, AFreeCornerHoldsNoThrustSurface) {
     EXPECT_EQ(outcome.iterations, 0u);
     const std::string message = a.termination_message();
     EXPECT_NE(message.find("vertex 3 is a free corner"), std::string::npos) << message;
+    // The centre keeps the diagonal from 0 to 2, an arch between supports: only 3 is stranded.
+    EXPECT_EQ(a.stranded(), std::vector<std::uint32_t>{3});
 }
 
 TEST(CppApi, SpringingJointsReachTheCSetter) {

@@ -2007,6 +2007,18 @@ VsrStatus vsr_assessment_edges(const struct VsrAssessment *assessment, uint32_t 
 VsrStatus vsr_assessment_joint_vertices(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
 
 /**
+ * The vertices that no compressive state joins to a support (free corners and the parts
+ * they strand, docs/method.md §16.3), `uint32_t` in increasing order: where there are any,
+ * no thrust surface exists in any envelope and the analysis answered
+ * `VSR_TERMINATION_INFEASIBLE` without a search; none otherwise.
+ *
+ * # Safety
+ * `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+ * writable.
+ */
+VsrStatus vsr_assessment_stranded(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
+
+/**
  * The springing joints recomputed from the returned surface, #J by 9 doubles, row-major
  * (docs/method.md §16.1): the springing plane's height and the joint's reach at the
  * reported thickness scale; the horizontal reaction H (x, y) and the vertical reaction V

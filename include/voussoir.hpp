@@ -777,6 +777,8 @@ class Assessment {
     VOUSSOIR_DETAIL_GETTER(double, joints, vsr_assessment_joints, VsrAssessment)
     VOUSSOIR_DETAIL_GETTER(std::uint32_t, joint_vertices, vsr_assessment_joint_vertices,
                            VsrAssessment)
+    /// The vertices with no compressive path to a support (vsr_assessment_stranded).
+    VOUSSOIR_DETAIL_GETTER(std::uint32_t, stranded, vsr_assessment_stranded, VsrAssessment)
 
     VsrObjective objective() const {
         VsrObjective o = VSR_OBJECTIVE_FIT;

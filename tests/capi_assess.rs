@@ -155,6 +155,10 @@ fn assert_same_joints(a: *const VsrAssessment, r: &AssessResult) {
     assert_ok(unsafe { vsr_assessment_joint_vertices(a, vertices.as_mut_ptr(), n, &mut n) });
     let want: Vec<u32> = r.joints.iter().map(|j| j.vertex).collect();
     assert_eq!(vertices, want);
+    assert_ok(unsafe { vsr_assessment_stranded(a, null_mut(), 0, &mut n) });
+    let mut stranded = vec![u32::MAX; n];
+    assert_ok(unsafe { vsr_assessment_stranded(a, stranded.as_mut_ptr(), n, &mut n) });
+    assert_eq!(stranded, r.stranded);
     let (mut excess, mut vertex) = (f64::NAN, 7);
     assert_ok(unsafe { vsr_assessment_worst_joint(a, &mut excess, &mut vertex) });
     assert_eq!(excess.to_bits(), r.worst_joint.0.to_bits());

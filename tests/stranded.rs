@@ -139,17 +139,24 @@ fn stranded_by_lp(mesh: &Mesh) -> Vec<u32> {
         .collect()
 }
 
-/// What an assessment refused at once names: its corners' phrase and how many vertices it
-/// says have no compressive path besides them; `None` where it searched (cancelled at its
-/// first step).
-fn refusal(result: &AssessResult) -> Option<(String, usize)> {
+/// What an assessment refused at once says: its message, how many vertices the message
+/// counts besides the corners, and the stranded vertices it lists; `None` where it searched
+/// (cancelled at its first step).
+struct Refusal {
+    message: String,
+    others: usize,
+    stranded: Vec<u32>,
+}
+
+fn refusal(result: AssessResult) -> Option<Refusal> {
     if result.termination == Termination::Cancelled {
+        assert!(result.stranded.is_empty());
         return None;
     }
     assert!(!result.feasible);
     assert_eq!(result.iterations, 0);
     assert!(result.force_densities.iter().all(|&q| q == 0.0));
-    let Termination::Infeasible { constraint } = &result.termination else {
+    let Termination::Infeasible { constraint } = result.termination else {
         panic!("{:?}", result.termination);
     };
     let body = constraint.strip_prefix("the supports: ").unwrap();
@@ -161,7 +168,11 @@ fn refusal(result: &AssessResult) -> Option<(String, usize)> {
         Some(phrase) if phrase.starts_with("vertex ") => 1,
         Some(phrase) => phrase.split(' ').next().unwrap().parse().unwrap(),
     };
-    Some((constraint.clone(), others))
+    Some(Refusal {
+        message: constraint,
+        others,
+        stranded: result.stranded,
+    })
 }
 
 /// The phrase naming `corners` (the library's wording, ten named at most).
@@ -181,7 +192,7 @@ fn corners_phrase(corners: &[u32]) -> String {
 }
 
 /// Runs `objective` in a slab of thickness `t`, cancelled at the first step of any search.
-fn refused(mesh: &Mesh, t: f64, settings: AssessSettings) -> Option<(String, usize)> {
+fn refused(mesh: &Mesh, t: f64, settings: AssessSettings) -> Option<Refusal> {
     let envelope = Envelope::from_thickness(mesh, &Thickness::Uniform(t)).unwrap();
     let mut stop = |_: usize, _: f64| false;
     let result = assess(
@@ -190,12 +201,13 @@ fn refused(mesh: &Mesh, t: f64, settings: AssessSettings) -> Option<(String, usi
         &settings,
         Some(&mut stop),
     );
-    refusal(&result.unwrap())
+    refusal(result.unwrap())
 }
 
-/// Checks the library's answer on `mesh` against the reference: what it names is stranded
-/// by the programme too (counted: the corners, all loaded, strand themselves), and where
-/// the programme strands nothing it searches. Returns (library, reference) counts.
+/// Checks the library's answer on `mesh` against the reference: every vertex it lists as
+/// stranded is stranded by the programme too, its message names the corners and counts the
+/// rest, and where the programme strands nothing it searches. Returns (listed, reference)
+/// counts.
 fn compare(mesh: &Mesh, name: &str) -> (usize, usize) {
     let reference = stranded_by_lp(mesh);
     let corners = free_corners_of(mesh);
@@ -206,20 +218,24 @@ fn compare(mesh: &Mesh, name: &str) -> (usize, usize) {
             assert!(corners.is_empty(), "{name}: corners {corners:?}");
             (0, 0)
         }
-        Some((message, others)) => {
+        Some(Refusal {
+            message,
+            others,
+            stranded,
+        }) => {
             let named_corners = match corners.as_slice() {
                 [] => !message.contains("free corner"),
                 _ => message.contains(&corners_phrase(&corners)),
             };
             assert!(named_corners, "{name}: {message}");
-            assert!(corners.iter().all(|v| reference.binary_search(v).is_ok()));
-            let named = corners.len() + others;
-            assert!(
-                named <= reference.len(),
-                "{name}: {named} > {}",
-                reference.len()
-            );
-            (named, reference.len())
+            // Every corner strands itself here (no live load), so the list holds them all.
+            assert_eq!(stranded.len(), corners.len() + others, "{name}: {message}");
+            assert!(corners.iter().all(|v| stranded.binary_search(v).is_ok()));
+            let outside: Vec<&u32> = (stranded.iter())
+                .filter(|v| reference.binary_search(v).is_err())
+                .collect();
+            assert!(outside.is_empty(), "{name}: not stranded: {outside:?}");
+            (stranded.len(), reference.len())
         }
     }
 }
@@ -253,16 +269,22 @@ fn a_free_corner_strands_a_vault_anchored_on_two_sides() {
         if objective == Objective::MaxLoad {
             settings = settings.with_load_pattern(pattern.clone());
         }
-        let (message, others) = refused(&mesh, 1.0, settings).expect("refused");
+        let Refusal {
+            message,
+            others,
+            stranded,
+        } = refused(&mesh, 1.0, settings).expect("refused");
         assert!(message.contains(&corners_phrase(&corners)), "{message}");
         // The live load's vertex is stranded too but not counted: its factor may cancel it.
         let live = usize::from(objective == Objective::MaxLoad);
         assert_eq!(others, n * n - 1 - live, "{message}");
+        assert_eq!(stranded.len(), n * n - live, "{message}");
+        assert!(stranded.iter().all(|v| !mesh.anchored()[*v as usize]));
     }
     let everywhere = vec![1.0; mesh.positions().len()];
     let settings = (AssessSettings::default().with_objective(Objective::MaxLoad))
         .with_load_pattern(everywhere);
-    assert_eq!(refused(&mesh, 1.0, settings), None);
+    assert!(refused(&mesh, 1.0, settings).is_none());
     let all_round = |_, outer| outer;
     let mesh = generate::lift(&points, &grid_faces(n, n), height, all_round).unwrap();
     assert!(free_corners_of(&mesh).is_empty() && stranded_by_lp(&mesh).is_empty());

@@ -307,6 +307,7 @@ fn fields<'py>(
     d.set_item("worst_residual_vertex", r.worst_residual_vertex)?;
     let joint_vertices: Vec<u32> = r.joints.iter().map(|j| j.vertex).collect();
     d.set_item("joint_vertices", PyArray1::from_vec(py, joint_vertices))?;
+    d.set_item("stranded", PyArray1::from_vec(py, r.stranded.clone()))?;
     let joints: Vec<[f64; 9]> = r.joints.iter().map(|j| j.row()).collect();
     d.set_item("joints", matrix(py, &joints))?;
     d.set_item("worst_joint", r.worst_joint.0)?;

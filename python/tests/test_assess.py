@@ -616,7 +616,8 @@ def test_a_family_may_give_its_springing_joints():
 def test_a_free_corner_is_refused_at_once():
     """A vault over a square anchored along two sides has a free corner between its free
     sides: every edge leaves it on one side, so compression cannot hold it in any envelope.
-    The answer comes without a search and names the corner; anchored all round, it fits."""
+    The answer comes without a search, names the corner and lists the stranded vertices;
+    anchored all round, it fits."""
     n = 4
     v = np.array([(i / n, j / n, 0.1 + 0.1 * (i / n) * (1 - i / n) + 0.1 * (j / n) * (1 - j / n))
                   for j in range(n + 1) for i in range(n + 1)])
@@ -628,5 +629,9 @@ def test_a_free_corner_is_refused_at_once():
     r = voussoir.assess(voussoir.Mesh(v, f, two_sides), 1.0, objective="min-thickness")
     assert not r.feasible and r.termination == "infeasible" and r.iterations == 0
     assert f"vertex {vid(n, n)} is a free corner" in r.termination_message
+    # The corner strands its free edges' rows in turn: every free vertex, none anchored.
+    free = [k for k in range(len(v)) if k not in two_sides]
+    assert r.stranded.tolist() == free
     all_round = [k for k, p in enumerate(v) if p[0] in (0, 1) or p[1] in (0, 1)]
-    assert voussoir.assess(voussoir.Mesh(v, f, all_round), 1.0).feasible
+    fits = voussoir.assess(voussoir.Mesh(v, f, all_round), 1.0)
+    assert fits.feasible and len(fits.stranded) == 0

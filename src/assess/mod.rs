@@ -242,6 +242,11 @@ pub struct AssessResult {
     /// least thickness scale at which one was found (above 1: the envelope is too thin), and
     /// the vertex where that surface leaves the given envelope the most. None otherwise.
     pub needed_scale: Option<(f64, Option<u32>)>,
+    /// The non-anchored vertices that no compressive state joins to a support (free corners
+    /// and the parts they strand, docs/method.md §16.3), in increasing order. Where there
+    /// are any, no surface exists in any envelope: `feasible` is false and the analysis
+    /// answered without a search. Empty otherwise.
+    pub stranded: Vec<u32>,
     /// Wall time of the whole analysis (its start included), seconds.
     pub seconds: f64,
 }
@@ -281,7 +286,11 @@ pub fn assess(
     let model = model::Model::new(problem, envelope, settings)?;
     if let Some(stranded) = corners::stranded(&model, settings.tolerance) {
         let run = corners::unbalanced(&model, &stranded);
-        return Ok(finish(&model, run, settings, &steps, start));
+        let result = finish(&model, run, settings, &steps, start);
+        return Ok(AssessResult {
+            stranded: stranded.vertices,
+            ..result
+        });
     }
     let run = analyse(&model, problem, envelope, settings, &mut steps)?;
     let mut result = finish(&model, run, settings, &steps, start);

@@ -441,6 +441,7 @@ impl<'a> Model<'a> {
             worst_joint,
             worst_residual_vertex,
             needed_scale: None,
+            stranded: Vec::new(),
             seconds: run.seconds,
         }
     }

@@ -408,6 +408,31 @@ pub unsafe extern "C" fn vsr_assessment_joint_vertices(
     })
 }
 
+/// The vertices that no compressive state joins to a support (free corners and the parts
+/// they strand, docs/method.md §16.3), `uint32_t` in increasing order: where there are any,
+/// no thrust surface exists in any envelope and the analysis answered
+/// `VSR_TERMINATION_INFEASIBLE` without a search; none otherwise.
+///
+/// # Safety
+/// `assessment`: a valid handle; `out`: NULL or `len` writable elements; `needed`: NULL or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn vsr_assessment_stranded(
+    assessment: *const VsrAssessment,
+    out: *mut u32,
+    len: usize,
+    needed: *mut usize,
+) -> VsrStatus {
+    // SAFETY: forwarded caller's contract.
+    boundary!({
+        unsafe {
+            copy("assessment", assessment, out, len, needed, |a| {
+                Ok(a.result.stranded.clone())
+            })
+        }
+    })
+}
+
 /// The springing joints recomputed from the returned surface, #J by 9 doubles, row-major
 /// (docs/method.md §16.1): the springing plane's height and the joint's reach at the
 /// reported thickness scale; the horizontal reaction H (x, y) and the vertical reaction V

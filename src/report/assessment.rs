@@ -119,6 +119,9 @@ pub struct AssessmentFigures {
     /// Without a certified surface (but for `min-thickness`): the least thickness scale that
     /// holds one and the vertex where it leaves the envelope most; else null.
     pub needed_scale: Option<NeededScale>,
+    /// The vertices that no compressive state joins to a support: where there are any, no
+    /// surface exists in any envelope (docs/method.md §16.3).
+    pub stranded: Vec<u32>,
     /// The envelope at `thickness_scale`: the heights the thrust surface keeps within.
     pub bounds: Bounds,
     /// The envelope as given.
@@ -282,6 +285,7 @@ fn figures(
             .collect(),
         worst_joint: excess(r.worst_joint),
         needed_scale: (r.needed_scale).map(|(scale, vertex)| NeededScale { scale, vertex }),
+        stranded: r.stranded.clone(),
         bounds: Bounds {
             lower: r.lower.clone(),
             upper: r.upper.clone(),
