@@ -14,8 +14,8 @@ use common::assess::{check_certificate, grid_faces, plan_diagonal, unit_grid};
 use common::Rng;
 use voussoir::generate;
 use voussoir::{
-    assess, AssessResult, AssessSettings, Envelope, Mesh, Objective, Problem, Termination,
-    Thickness,
+    assess, form_find, AssessResult, AssessSettings, Envelope, FormFindSettings, Mesh, Objective,
+    Problem, TauMode, Termination, Thickness,
 };
 
 /// The free corners of `mesh`, found from its faces: the free boundary vertices whose faces'
@@ -392,4 +392,35 @@ fn stranded_parts_agree_with_the_programme_on_generated_vaults() {
         refused_count >= 4 && searched >= 4,
         "{refused_count} refused, {searched} searched"
     );
+}
+
+/// Form finding with τ = 0 and its default floor q_min > 0 needs force in every edge, so an
+/// idled edge makes it infeasible at once: its answer names the vertices at such edges. On
+/// the vault anchored along two sides, every free vertex (the programme idles every edge);
+/// anchored all round, none.
+#[test]
+fn form_finding_without_tau_names_the_vertices_of_idled_edges() {
+    let n = 6;
+    let points = unit_grid(n);
+    let height = |u: [f64; 2]| 0.1 * (1.0 + u[0] * (1.0 - u[0]) + u[1] * (1.0 - u[1]));
+    let mut settings = FormFindSettings::default();
+    settings.stress = settings.stress.with_tau(TauMode::Zero);
+    let two_sides = |u: [f64; 2], _| u[0] < 1e-9 || u[1] < 1e-9;
+    let mesh = generate::lift(&points, &grid_faces(n, n), height, two_sides).unwrap();
+    let edges = force_edges(&mesh);
+    assert!(carrying_by_lp(&mesh, &edges).iter().all(|&c| !c));
+    let result = form_find(&Problem::new(mesh), &settings, None).unwrap();
+    let Termination::Infeasible { constraint } = &result.termination else {
+        panic!("{:?}", result.termination);
+    };
+    let named = "no compressive state loads every edge at vertices ";
+    assert!(constraint.contains(named), "{constraint}");
+    assert!(
+        constraint.contains(&format!("({} in all)", n * n)),
+        "{constraint}"
+    );
+    let all_round = |_, outer| outer;
+    let mesh = generate::lift(&points, &grid_faces(n, n), height, all_round).unwrap();
+    let result = form_find(&Problem::new(mesh), &settings, None).unwrap();
+    assert_eq!(result.termination, Termination::Converged);
 }

@@ -9,7 +9,7 @@ mod warm;
 use crate::error::{ids, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
-use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus};
+use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus, TauMode};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -436,31 +436,81 @@ fn falls_short(new: &StressResult, coarse: bool, held: &StressResult) -> bool {
 }
 
 /// The settings to relax when the stress constraints admit no solution, each with the mesh
-/// features that make it bind: straight free edges, and rings of quads split along one
-/// diagonal (a triangulation with no strictly convex stress function, so no network with every
-/// q ≥ q_min > 0).
-fn infeasibility_hint(mesh: &crate::mesh::Mesh, s: &StressSettings) -> String {
+/// features that make it bind: edges that no compressive state can load (free corners and
+/// straight free edges without τ, named), straight free edges, and rings of quads split
+/// along one diagonal (a triangulation with no strictly convex stress function, so no network
+/// with every q ≥ q_min > 0).
+fn infeasibility_hint(problem: &Problem, s: &StressSettings) -> String {
+    let mesh = &problem.mesh;
     let mut parts = Vec::new();
     if !matches!(s.q_min, QBound::Absolute(v) | QBound::Relative(v) if v == 0.0) {
+        let idle = idle_floored_vertices(problem, s);
         let free_edges = mesh
             .edges
             .iter()
             .any(|e| e.is_boundary() && e.v.iter().any(|&v| !mesh.anchored[v as usize]));
-        parts.push(if free_edges {
+        parts.push(if !idle.is_empty() {
+            format!(
+                "q_min (no compressive state loads every edge at vertices {}: at a free \
+                 corner every edge leaves the vertex on one side in plan, and a straight free \
+                 edge carries force only along itself, unless τ pushes it; docs/method.md \
+                 §16.3)",
+                listed(&idle)
+            )
+        } else if free_edges {
             "q_min (a straight free edge cannot carry q_min > 0 without τ; nor can every edge \
              of a ring of quads all split along the same diagonal, as in a latitude-longitude \
              dome, unless the quads are read as polygons, whose diagonals q_min does not bind)"
+                .to_owned()
         } else {
             "q_min (not every edge of a ring of quads all split along the same diagonal, as in \
              a latitude-longitude dome, can carry q_min > 0 unless the quads are read as \
              polygons, whose diagonals q_min does not bind)"
+                .to_owned()
         });
     }
     if s.q_max.is_some() {
-        parts.push("q_max");
+        parts.push("q_max".to_owned());
     }
-    parts.push("prescribed horizontal forces or τ");
+    parts.push("prescribed horizontal forces or τ".to_owned());
     parts.join(", or ")
+}
+
+/// The vertices at an edge that q_min binds but no compressive state can load (peeled at
+/// the vertices that no τ or horizontal force balances, docs/method.md §16.3), increasing.
+fn idle_floored_vertices(problem: &Problem, s: &StressSettings) -> Vec<u32> {
+    let mesh = &problem.mesh;
+    let balanced: Vec<bool> = (0..mesh.positions.len())
+        .map(|v| {
+            let tau = match s.tau {
+                TauMode::Zero => false,
+                TauMode::Prescribed => problem.prescribed_tau[v] != 0.0,
+                TauMode::Optimized => mesh.on_boundary[v],
+            };
+            mesh.is_non_anchored(v) && !tau && problem.horizontal_forces[v] == [0.0, 0.0]
+        })
+        .collect();
+    let with_force: Vec<bool> = (0..mesh.edges.len())
+        .map(|e| crate::stress::carries_force(mesh, e))
+        .collect();
+    let carries = crate::stress::idle::carrying(mesh, &with_force, &balanced);
+    let mut vertices: Vec<u32> = (0..mesh.edges.len())
+        .filter(|&e| with_force[e] && !carries[e] && crate::stress::floored(problem, s, e))
+        .flat_map(|e| mesh.edges[e].v)
+        .filter(|&v| balanced[v as usize])
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}
+
+/// Up to ten ids, then "…" and how many in all.
+fn listed(ids: &[u32]) -> String {
+    let named: Vec<String> = ids.iter().take(10).map(u32::to_string).collect();
+    match ids.len() {
+        n if n > 10 => format!("{}, … ({n} in all)", named.join(", ")),
+        _ => named.join(", "),
+    }
 }
 
 /// The region a blocked loop names: `limited` (the vertices held at the height limit) with the

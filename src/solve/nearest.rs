@@ -715,7 +715,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         match self.held.status {
             StressStatus::Infeasible => {
                 return Some(Termination::Infeasible {
-                    constraint: infeasibility_hint(&self.problem.mesh, &self.settings.stress),
+                    constraint: infeasibility_hint(self.problem, &self.settings.stress),
                 })
             }
             StressStatus::NumericalError => {

@@ -261,7 +261,7 @@ fn failure(
 ) -> Option<Termination> {
     match status {
         StressStatus::Infeasible => Some(Termination::Infeasible {
-            constraint: infeasibility_hint(&problem.mesh, &settings.stress),
+            constraint: infeasibility_hint(problem, &settings.stress),
         }),
         StressStatus::NumericalError => Some(Termination::NumericalError {
             what: "stress QP failed".into(),

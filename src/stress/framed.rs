@@ -131,6 +131,18 @@ pub(super) fn horizontal_terms(
     (external, tau_normal)
 }
 
+/// Whether edge `e` may carry force: not a boundary edge between two anchored vertices.
+pub(crate) fn carries_force(mesh: &Mesh, e: usize) -> bool {
+    let edge = &mesh.edges[e];
+    !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize])
+}
+
+/// Whether q_min binds edge `e` (its scope, and never a polygon's diagonal).
+pub(crate) fn floored(problem: &Problem, settings: &StressSettings, e: usize) -> bool {
+    let interior = !problem.mesh.edges[e].is_boundary();
+    (settings.q_min_scope == EdgeScope::All || interior) && !problem.polygon_diagonal[e]
+}
+
 /// Per edge, None for an edge without force (boundary, both ends anchored), else its bounds
 /// (lower, upper) on q in frame units: q_min on the edges of its scope but polygon diagonals,
 /// q_max, and the dual length bounds of interior edges.
@@ -141,20 +153,15 @@ pub(super) fn edge_bounds(
     unit: f64,
 ) -> Vec<Option<(f64, f64)>> {
     let mesh = &problem.mesh;
-    let active = |e: usize| {
-        let edge = &mesh.edges[e];
-        !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize])
-    };
     let q_min = settings.q_min.physical(unit) / unit;
     let q_max = settings
         .q_max
         .map_or(f64::INFINITY, |b| b.physical(unit) / unit);
     (0..mesh.edges.len())
         .map(|e| {
-            active(e).then(|| {
+            carries_force(mesh, e).then(|| {
                 let interior = !mesh.edges[e].is_boundary();
-                let scoped = (settings.q_min_scope == EdgeScope::All || interior)
-                    && !problem.polygon_diagonal[e];
+                let scoped = floored(problem, settings, e);
                 let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
                 // Dual length d* = q l is p̄ q' l' in frame units: bounds on it are per-edge q bounds.
                 if let (Some((d_lo, d_hi)), true) = (settings.dual_length_bounds, interior) {
