@@ -1873,9 +1873,10 @@ VsrStatus vsr_assessment_objective(const struct VsrAssessment *assessment, VsrOb
  * every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
  * least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
  * when the objective's optimum was reached (else why the search stopped: max iterations,
- * stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where free
- * corners strand a part of the plan with no compressive path to a support, so that no
- * thrust surface exists in any envelope: the termination message names them); the
+ * stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where a loaded
+ * part of the plan has no compressive path to a support, cut off by free corners or
+ * straight free edges, so that no thrust surface exists in any envelope: the termination
+ * message names them); the
  * steps taken; the wall-clock seconds. Every pointer required; written only on success.
  *
  * # Safety
@@ -2007,9 +2008,10 @@ VsrStatus vsr_assessment_edges(const struct VsrAssessment *assessment, uint32_t 
 VsrStatus vsr_assessment_joint_vertices(const struct VsrAssessment *assessment, uint32_t *out, size_t len, size_t *needed);
 
 /**
- * The vertices that no compressive state joins to a support (free corners and the parts
- * they strand, docs/method.md §16.3), `uint32_t` in increasing order: where there are any,
- * no thrust surface exists in any envelope and the analysis answered
+ * The vertices of the loaded parts that no compressive state joins to a support (cut off
+ * by free corners or straight free edges, docs/method.md §16.3; a part a `max-load` live
+ * load reaches is left to the search), `uint32_t` in increasing order: where there are
+ * any, no thrust surface exists in any envelope and the analysis answered
  * `VSR_TERMINATION_INFEASIBLE` without a search; none otherwise.
  *
  * # Safety

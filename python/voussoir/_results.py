@@ -190,9 +190,10 @@ class AssessmentResult:
     joint_vertices: np.ndarray
     """(J,) uint32: the free supports with a springing joint (none with fixed supports)."""
     stranded: np.ndarray
-    """(S,) uint32, increasing: the vertices that no compressive state joins to a support
-    (free corners and the parts they strand, docs/method.md section 16.3). Where there are
-    any, no thrust surface exists in any envelope and the answer came without a search
+    """(S,) uint32, increasing: the vertices of the loaded parts that no compressive state
+    joins to a support (cut off by free corners or straight free edges, docs/method.md
+    section 16.3; a part a max-load live load reaches is left to the search). Where there
+    are any, no thrust surface exists in any envelope and the answer came without a search
     (termination "infeasible"); empty otherwise."""
     joints: np.ndarray
     """(J, 9) float64 per joint, recomputed from the returned surface (docs/method.md §16.1):

@@ -5,9 +5,10 @@
 //! assessment answers so before any search.
 
 use super::model::{Model, Run};
-use super::Objective;
+use super::{AssessSettings, Objective};
 use crate::solve::Termination;
 use crate::stress::idle;
+use crate::stress::QBound;
 
 /// How many stranded vertices (besides the corners) a message names before it only counts.
 const NAMED: usize = 10;
@@ -99,6 +100,38 @@ impl Parts {
     fn join(&mut self, a: usize, b: usize) {
         let (a, b) = (self.root(a), self.root(b));
         self.0[a.max(b)] = a.min(b);
+    }
+}
+
+/// With a floor q_min > 0: the vertices (increasing) at an edge the floor binds (not a
+/// polygon's diagonal) that no compressive state loads, where the floor cannot hold.
+pub(super) fn floored_idle(model: &Model, settings: &AssessSettings) -> Vec<u32> {
+    let (QBound::Absolute(q) | QBound::Relative(q)) = settings.q_min;
+    if q <= 0.0 {
+        return Vec::new();
+    }
+    let mesh = &model.problem.mesh;
+    let mut vertices: Vec<u32> = (0..model.carries.len())
+        .filter(|&e| model.stress.bounds[e].is_some() && !model.carries[e])
+        .filter(|&e| !model.problem.polygon_diagonal[e])
+        .flat_map(|e| mesh.edges[e].v)
+        .filter(|&v| mesh.is_non_anchored(v as usize))
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}
+
+/// The answer where a floor cannot hold at `idle`: the middle surface without force.
+pub(super) fn unfloored(model: &Model, idle: &[u32]) -> Run {
+    Run {
+        state: model.start_state(),
+        termination: Termination::Infeasible {
+            constraint: idle::floor_reason(idle),
+        },
+        iterations: 0,
+        seconds: 0.0,
+        unbounded: false,
     }
 }
 

@@ -242,10 +242,11 @@ pub struct AssessResult {
     /// least thickness scale at which one was found (above 1: the envelope is too thin), and
     /// the vertex where that surface leaves the given envelope the most. None otherwise.
     pub needed_scale: Option<(f64, Option<u32>)>,
-    /// The non-anchored vertices that no compressive state joins to a support (free corners
-    /// and the parts they strand, docs/method.md §16.3), in increasing order. Where there
-    /// are any, no surface exists in any envelope: `feasible` is false and the analysis
-    /// answered without a search. Empty otherwise.
+    /// The vertices of the loaded parts that no compressive state joins to a support (cut
+    /// off by free corners or straight free edges, docs/method.md §16.3; a part a `max-load`
+    /// live load reaches is left to the search), in increasing order. Where there are any,
+    /// no surface exists in any envelope: `feasible` is false and the analysis answered
+    /// without a search. Empty otherwise.
     pub stranded: Vec<u32>,
     /// Wall time of the whole analysis (its start included), seconds.
     pub seconds: f64,
@@ -291,6 +292,11 @@ pub fn assess(
             stranded: stranded.vertices,
             ..result
         });
+    }
+    let idle = corners::floored_idle(&model, settings);
+    if !idle.is_empty() {
+        let run = corners::unfloored(&model, &idle);
+        return Ok(finish(&model, run, settings, &steps, start));
     }
     let run = analyse(&model, problem, envelope, settings, &mut steps)?;
     let mut result = finish(&model, run, settings, &steps, start);
@@ -395,10 +401,7 @@ fn floored_surface(
         q_min: crate::stress::StressSettings::default().q_min,
         ..settings.clone()
     };
-    let mut model = model::Model::new(problem, envelope, &floored)?;
-    // The floor binds only edges that can carry force: on the others it would leave the
-    // stricter problem infeasible wherever the plan idles an edge.
-    model.release_idle_edges();
+    let model = model::Model::new(problem, envelope, &floored)?;
     let run = analyse(&model, problem, envelope, &floored, steps)?;
     let state = run.state.clone();
     let found = model.certify(run, &floored);

@@ -173,15 +173,19 @@ impl<'a> Model<'a> {
             stress,
         };
         model.check_fixed_supports(settings)?;
-        Ok(Model {
+        let mut model = Model {
             total_load: model.residual.iter().map(|&v| model.dead[v as usize]).sum(),
             carries: super::corners::carrying(&model),
             ..model
-        })
+        };
+        model.release_idle_edges();
+        Ok(model)
     }
 
-    /// Lowers the bound of every idled edge (`carries` false) to zero force.
-    pub fn release_idle_edges(&mut self) {
+    /// Lowers the bound of every idled edge (`carries` false) to zero force: a floor there
+    /// could never hold (the retry's floor; a user's q_min > 0 is refused before any search,
+    /// `corners::floored_idle`).
+    fn release_idle_edges(&mut self) {
         for (bound, &carries) in self.stress.bounds.iter_mut().zip(&self.carries) {
             if let (Some((lo, _)), false) = (bound.as_mut(), carries) {
                 *lo = lo.min(0.0);

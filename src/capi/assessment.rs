@@ -63,9 +63,10 @@ pub unsafe extern "C" fn vsr_assessment_objective(
 /// every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
 /// least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
 /// when the objective's optimum was reached (else why the search stopped: max iterations,
-/// stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where free
-/// corners strand a part of the plan with no compressive path to a support, so that no
-/// thrust surface exists in any envelope: the termination message names them); the
+/// stalled, cancelled, ...; `VSR_TERMINATION_INFEASIBLE`, without a search, where a loaded
+/// part of the plan has no compressive path to a support, cut off by free corners or
+/// straight free edges, so that no thrust surface exists in any envelope: the termination
+/// message names them); the
 /// steps taken; the wall-clock seconds. Every pointer required; written only on success.
 ///
 /// # Safety
@@ -408,9 +409,10 @@ pub unsafe extern "C" fn vsr_assessment_joint_vertices(
     })
 }
 
-/// The vertices that no compressive state joins to a support (free corners and the parts
-/// they strand, docs/method.md §16.3), `uint32_t` in increasing order: where there are any,
-/// no thrust surface exists in any envelope and the analysis answered
+/// The vertices of the loaded parts that no compressive state joins to a support (cut off
+/// by free corners or straight free edges, docs/method.md §16.3; a part a `max-load` live
+/// load reaches is left to the search), `uint32_t` in increasing order: where there are
+/// any, no thrust surface exists in any envelope and the analysis answered
 /// `VSR_TERMINATION_INFEASIBLE` without a search; none otherwise.
 ///
 /// # Safety

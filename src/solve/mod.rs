@@ -450,13 +450,7 @@ fn infeasibility_hint(problem: &Problem, s: &StressSettings) -> String {
             .iter()
             .any(|e| e.is_boundary() && e.v.iter().any(|&v| !mesh.anchored[v as usize]));
         parts.push(if !idle.is_empty() {
-            format!(
-                "q_min (no compressive state loads every edge at vertices {}: at a free \
-                 corner every edge leaves the vertex on one side in plan, and a straight free \
-                 edge carries force only along itself, unless τ pushes it; docs/method.md \
-                 §16.3)",
-                listed(&idle)
-            )
+            crate::stress::idle::floor_reason(&idle)
         } else if free_edges {
             "q_min (a straight free edge cannot carry q_min > 0 without τ; nor can every edge \
              of a ring of quads all split along the same diagonal, as in a latitude-longitude \
@@ -502,15 +496,6 @@ fn idle_floored_vertices(problem: &Problem, s: &StressSettings) -> Vec<u32> {
     vertices.sort_unstable();
     vertices.dedup();
     vertices
-}
-
-/// Up to ten ids, then "…" and how many in all.
-fn listed(ids: &[u32]) -> String {
-    let named: Vec<String> = ids.iter().take(10).map(u32::to_string).collect();
-    match ids.len() {
-        n if n > 10 => format!("{}, … ({n} in all)", named.join(", ")),
-        _ => named.join(", "),
-    }
 }
 
 /// The region a blocked loop names: `limited` (the vertices held at the height limit) with the

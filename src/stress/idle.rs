@@ -68,9 +68,16 @@ fn idle_edges(mesh: &Mesh, v: u32, carries: &[bool]) -> Vec<u32> {
     if orient2d(pa, plan(mesh, v), pb) != 0.0 {
         return Vec::new();
     }
-    (edges.into_iter().map(|(e, _)| e))
-        .filter(|&e| orient2d(pa, pb, at(e)) != 0.0)
-        .collect()
+    let side: Vec<(u32, f64)> = (edges.into_iter())
+        .map(|(e, _)| (e, orient2d(pa, pb, at(e))))
+        .filter(|&(_, o)| o != 0.0)
+        .collect();
+    // The angle sort put them on one side; a direction within rounding of the line could
+    // sit on the other, and then the vertex is not proved to balance along the line only.
+    if side.iter().any(|&(_, o)| o > 0.0) && side.iter().any(|&(_, o)| o < 0.0) {
+        return Vec::new();
+    }
+    side.into_iter().map(|(e, _)| e).collect()
 }
 
 fn plan(mesh: &Mesh, v: u32) -> Coord<f64> {
@@ -104,4 +111,24 @@ fn widest_gap(edges: &[(u32, f64)]) -> (f64, [usize; 2]) {
         }
     }
     widest
+}
+
+/// Why a floor q_min > 0 cannot hold: at `vertices` (increasing) an edge it binds is one no
+/// compressive state loads.
+pub(crate) fn floor_reason(vertices: &[u32]) -> String {
+    format!(
+        "q_min (no compressive state loads every edge at vertices {}: at a free corner every \
+         edge leaves the vertex on one side in plan, and a straight free edge carries force \
+         only along itself; docs/method.md §16.3)",
+        listed(vertices)
+    )
+}
+
+/// Up to ten ids, then "…" and how many in all.
+fn listed(ids: &[u32]) -> String {
+    let named: Vec<String> = ids.iter().take(10).map(u32::to_string).collect();
+    match ids.len() {
+        n if n > 10 => format!("{}, … ({n} in all)", named.join(", ")),
+        _ => named.join(", "),
+    }
 }
