@@ -193,14 +193,13 @@ fn corners_phrase(corners: &[u32]) -> String {
 
 /// Runs `objective` in a slab of thickness `t`, cancelled at the first step of any search.
 fn refused(mesh: &Mesh, t: f64, settings: AssessSettings) -> Option<Refusal> {
-    let envelope = Envelope::from_thickness(mesh, &Thickness::Uniform(t)).unwrap();
+    refused_problem(&Problem::new(mesh.clone()), t, settings)
+}
+
+fn refused_problem(problem: &Problem, t: f64, settings: AssessSettings) -> Option<Refusal> {
+    let envelope = Envelope::from_thickness(&problem.mesh, &Thickness::Uniform(t)).unwrap();
     let mut stop = |_: usize, _: f64| false;
-    let result = assess(
-        &Problem::new(mesh.clone()),
-        &envelope,
-        &settings,
-        Some(&mut stop),
-    );
+    let result = assess(problem, &envelope, &settings, Some(&mut stop));
     refusal(result.unwrap())
 }
 
@@ -455,4 +454,28 @@ fn a_floor_on_edges_no_compression_loads_is_refused_at_once() {
         constraint.contains(&format!("({} in all)", idle.len())),
         "{constraint}"
     );
+}
+
+/// A prescribed horizontal force at a free corner (a tie pulling it) may balance its edges,
+/// so the corner is not peeled and the analysis searches. The square of four triangles
+/// around a raised centre, anchored at three corners: the fourth is stranded alone without
+/// the force (the centre keeps the diagonal between two supports), searched with it.
+#[test]
+fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
+    let positions = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.5, 0.5, 0.3],
+    ];
+    let faces = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+    let mesh = Mesh::new(positions, faces, &[0, 1, 2]).unwrap();
+    let free = Problem::new(mesh.clone());
+    let refusal = refused_problem(&free, 1.0, AssessSettings::default()).expect("refused");
+    assert_eq!(refusal.stranded, [3]);
+    let mut forces = vec![[0.0; 2]; 5];
+    forces[3] = [0.1, -0.1];
+    let tied = Problem::new(mesh).with_horizontal_forces(forces).unwrap();
+    assert!(refused_problem(&tied, 1.0, AssessSettings::default()).is_none());
 }
