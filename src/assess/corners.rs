@@ -57,12 +57,12 @@ fn peelable(model: &Model, v: u32) -> bool {
 /// The vertices of the loaded parts that the carrying edges join to no support.
 fn unsupported(model: &Model, carries: &[bool], tolerance: f64) -> Vec<u32> {
     let mesh = &model.problem.mesh;
-    let mut parts = Parts::new(mesh.positions().len());
+    let n = mesh.positions().len();
+    let mut parts = Parts::new(n);
     for (e, _) in carries.iter().enumerate().filter(|(_, &c)| c) {
         let [a, b] = mesh.edges()[e].v;
         parts.join(a as usize, b as usize);
     }
-    let n = mesh.positions().len();
     let (mut supported, mut live) = (vec![false; n], vec![false; n]);
     let (mut load, mut count) = (vec![0.0; n], vec![0usize; n]);
     for &v in &model.supports {
@@ -110,16 +110,16 @@ pub(super) fn floored_idle(model: &Model, settings: &AssessSettings) -> Vec<u32>
     if q <= 0.0 {
         return Vec::new();
     }
-    let mesh = &model.problem.mesh;
-    let mut vertices: Vec<u32> = (0..model.carries.len())
-        .filter(|&e| model.stress.bounds[e].is_some() && !model.carries[e])
-        .filter(|&e| !model.problem.polygon_diagonal[e])
-        .flat_map(|e| mesh.edges[e].v)
-        .filter(|&v| mesh.is_non_anchored(v as usize))
-        .collect();
-    vertices.sort_unstable();
-    vertices.dedup();
-    vertices
+    let problem = model.problem;
+    let floored = |e: usize| !problem.polygon_diagonal[e];
+    let keep = |v: u32| problem.mesh.is_non_anchored(v as usize);
+    idle::floored_idle(
+        &problem.mesh,
+        &with_force(model),
+        &model.carries,
+        floored,
+        keep,
+    )
 }
 
 /// The answer where a floor cannot hold at `idle`: the middle surface without force.

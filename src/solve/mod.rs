@@ -488,14 +488,10 @@ fn idle_floored_vertices(problem: &Problem, s: &StressSettings) -> Vec<u32> {
         .map(|e| crate::stress::carries_force(mesh, e))
         .collect();
     let carries = crate::stress::idle::carrying(mesh, &with_force, &balanced);
-    let mut vertices: Vec<u32> = (0..mesh.edges.len())
-        .filter(|&e| with_force[e] && !carries[e] && crate::stress::floored(problem, s, e))
-        .flat_map(|e| mesh.edges[e].v)
-        .filter(|&v| balanced[v as usize])
-        .collect();
-    vertices.sort_unstable();
-    vertices.dedup();
-    vertices
+    let floored = |e| crate::stress::floored(problem, s, e);
+    crate::stress::idle::floored_idle(mesh, &with_force, &carries, floored, |v| {
+        balanced[v as usize]
+    })
 }
 
 /// The region a blocked loop names: `limited` (the vertices held at the height limit) with the

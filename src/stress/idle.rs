@@ -113,6 +113,25 @@ fn widest_gap(edges: &[(u32, f64)]) -> (f64, [usize; 2]) {
     widest
 }
 
+/// The vertices (increasing) where `keep` holds at the edges of `with_force` that peeling
+/// idled (`carries` false) and a floor binds (`floored`): where a floor q_min > 0 cannot hold.
+pub(crate) fn floored_idle(
+    mesh: &Mesh,
+    with_force: &[bool],
+    carries: &[bool],
+    floored: impl Fn(usize) -> bool,
+    keep: impl Fn(u32) -> bool,
+) -> Vec<u32> {
+    let mut vertices: Vec<u32> = (0..carries.len())
+        .filter(|&e| with_force[e] && !carries[e] && floored(e))
+        .flat_map(|e| mesh.edges[e].v)
+        .filter(|&v| keep(v))
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
+}
+
 /// Why a floor q_min > 0 cannot hold: at `vertices` (increasing) an edge it binds is one no
 /// compressive state loads.
 pub(crate) fn floor_reason(vertices: &[u32]) -> String {
