@@ -305,6 +305,35 @@ fn thickness_envelopes_assess_as_the_rust_api_does() {
     unsafe { vsr_mesh_destroy(mesh) };
 }
 
+/// A square anchored at three corners has a free corner at the fourth: the C assessment
+/// refuses it at once and lists that vertex as stranded, as the Rust one does.
+#[test]
+fn a_stranded_vertex_is_listed_as_the_rust_api_lists_it() {
+    let d = Dome {
+        positions: vec![
+            0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.5, 0.5, 0.3,
+        ],
+        triangles: vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
+        anchored: vec![0, 1, 2],
+    };
+    let mesh = d.create();
+    let e = envelope_of(mesh, &[1.0]);
+    let s = assess_settings();
+    let a = run(mesh, e, s);
+    let rust = rust_mesh(&d);
+    let env = Envelope::from_thickness(&rust, &Thickness::Uniform(1.0)).unwrap();
+    let r = assess(&Problem::new(rust), &env, &AssessSettings::default(), None).unwrap();
+    assert!(matches!(r.termination, Termination::Infeasible { .. }));
+    assert_eq!(r.stranded, [3]);
+    assert_same(a, &r);
+    unsafe {
+        vsr_assessment_destroy(a);
+        vsr_assess_settings_destroy(s);
+        vsr_envelope_destroy(e);
+        vsr_mesh_destroy(mesh);
+    }
+}
+
 trait ObjectiveOf {
     fn of_test(o: Objective) -> VsrObjective;
 }

@@ -479,3 +479,33 @@ fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
     let tied = Problem::new(mesh).with_horizontal_forces(forces).unwrap();
     assert!(refused_problem(&tied, 1.0, AssessSettings::default()).is_none());
 }
+
+/// A free corner whose load is below what the certificate forgives strands nothing: the
+/// apex of a sliver 1e-8 outside a square anchored all round (a corner by 4e-8 rad beyond a
+/// half turn) is searched, while the same apex 0.05 outside is refused and listed alone.
+/// With one more corner of the square freed, the refusal names that corner only, not the
+/// sliver's.
+#[test]
+fn a_corner_below_the_tolerance_is_left_to_the_search() {
+    let sliver = |depth: f64, anchored: &[u32]| {
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.5, 0.5, 0.3],
+            [0.5, -depth, 0.0],
+        ];
+        let faces = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [0, 5, 1]];
+        let mesh = Mesh::new(positions, faces, anchored).unwrap();
+        refused(&mesh, 1.0, AssessSettings::default())
+    };
+    assert!(sliver(1e-8, &[0, 1, 2, 3]).is_none());
+    let refusal = sliver(0.05, &[0, 1, 2, 3]).expect("refused");
+    assert_eq!(refusal.stranded, [5]);
+    assert!(refusal.message.contains(&corners_phrase(&[5])));
+    let refusal = sliver(1e-8, &[0, 1, 2]).expect("refused");
+    assert_eq!(refusal.stranded, [3]);
+    assert!(refusal.message.contains(&corners_phrase(&[3])));
+    assert!(!refusal.message.contains('5'), "{}", refusal.message);
+}

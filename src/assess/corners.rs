@@ -13,9 +13,10 @@ use crate::stress::QBound;
 /// How many stranded vertices (besides the corners) a message names before it only counts.
 const NAMED: usize = 10;
 
-/// What the plan alone proves infeasible: the free corners of the plan as drawn, and every
-/// vertex of a loaded part left with no compressive path to a support (corners included
-/// where they are stranded themselves), both in increasing order.
+/// What the plan alone proves infeasible: the free corners of the plan as drawn that are
+/// stranded or border a stranded vertex, and every vertex of a loaded part left with no
+/// compressive path to a support (corners included where they are stranded themselves),
+/// both in increasing order.
 pub(super) struct Stranded {
     pub corners: Vec<u32>,
     pub vertices: Vec<u32>,
@@ -28,10 +29,13 @@ pub(super) struct Stranded {
 pub(super) fn stranded(model: &Model, tolerance: f64) -> Option<Stranded> {
     let mesh = &model.problem.mesh;
     let with_force = with_force(model);
+    let vertices = unsupported(model, &model.carries, tolerance);
+    let listed = |v: u32| vertices.binary_search(&v).is_ok();
+    // A corner elsewhere (exempt by its live load or its small load) explains nothing here.
     let corners: Vec<u32> = (model.residual.iter().copied())
         .filter(|&v| peelable(model, v) && idle::is_corner(mesh, v, &with_force))
+        .filter(|&v| listed(v) || mesh.neighbours(v).any(listed))
         .collect();
-    let vertices = unsupported(model, &model.carries, tolerance);
     (!vertices.is_empty()).then_some(Stranded { corners, vertices })
 }
 
