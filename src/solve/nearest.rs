@@ -652,10 +652,12 @@ impl<'a, 'p> Nearest<'a, 'p> {
         });
         self.cache
             .far_from_balance(held.is_some_and(|s| s.eps_inf > FAR_FROM_BALANCE));
-        // Only where the merit judges a loosened answer (see below).
+        // Only where the merit judges a loosened answer (see below), and only until a state
+        // has reached the tolerance: from then on every answer must be able to count.
         let judged = settings.dual_length_smoothing == 0.0;
+        let balanced = self.best.eps < self.settings.tolerance;
         self.cache
-            .set_inexact(held.filter(|_| judged).and_then(inexact_gap));
+            .set_inexact(held.filter(|_| judged && !balanced).and_then(inexact_gap));
         let answer = analyse_cached(
             self.problem,
             &self.positions,
@@ -1117,6 +1119,25 @@ mod tests {
             }
         }
         assert!(moves >= 10, "only {moves} height steps were taken");
+    }
+
+    /// Far from balance a stress step stops at its loosened gap; once some state has reached
+    /// the tolerance, the same step is solved to the full tolerances, so that it can count.
+    #[test]
+    fn qps_are_exact_once_a_state_has_reached_the_tolerance() {
+        let settings = FormFindSettings::default();
+        assert_eq!(settings.stress.dual_length_smoothing, 0.0);
+        let truth = generate::self_supporting(KnownPlan::Disk, 300, &settings).unwrap();
+        let problem = Problem::new(generate::perturb(&truth, Perturbation::Dent, 1));
+        let mut s = Nearest::new(&problem, &settings, None).unwrap();
+        s.held = s.stress_step(None).unwrap();
+        let prior = s.held.clone();
+        assert!(prior.eps_inf > 1e-2, "{}", prior.eps_inf);
+        s.stress_step(Some(&prior)).unwrap();
+        assert!(s.cache.last_was_inexact());
+        s.best.eps = 0.5 * settings.tolerance;
+        s.stress_step(Some(&prior)).unwrap();
+        assert!(!s.cache.last_was_inexact());
     }
 
     #[test]
