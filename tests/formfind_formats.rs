@@ -288,8 +288,7 @@ fn plan_slivers_are_repaired_and_listed_or_rejected_with_strict() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains("faces with zero plan area: 31")
-            || stderr.contains("flipped against the majority: 31"),
+        stderr.contains("--strict: ") && stderr.contains("faces 28, 31 have a plan area"),
         "{stderr}"
     );
     assert_eq!(dir.listing(), before);

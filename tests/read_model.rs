@@ -347,3 +347,50 @@ fn read_model_welds_unless_told_not_to_and_checks_its_options() {
     let e = read_model(&dir.path("none.obj"), &missing).unwrap_err();
     assert!(!missing.blames_supports_file(&e), "{e}");
 }
+
+/// A file with no vertex, or with vertices but no face, is an empty mesh whatever supports
+/// are asked for, not an anchored id out of range.
+#[test]
+fn an_empty_mesh_file_is_called_empty_before_its_supports_are_read() {
+    let dir = Scratch::new("read-model-empty");
+    let supports = dir.path("supports.json");
+    fs::write(&supports, r#"{"anchored": [0, 1, 2]}"#).unwrap();
+    for (name, text) in [("none.obj", ""), ("points.obj", "v 0 0 0\nv 1 0 0\n")] {
+        let path = dir.path(name);
+        fs::write(&path, text).unwrap();
+        for options in [
+            ReadOptions::new(Supports::File(supports.clone())),
+            ReadOptions::new(Supports::Ids(vec![0, 1, 2])),
+            ReadOptions::new(Supports::Boundary),
+        ] {
+            let e = read_model(&path, &options).unwrap_err();
+            assert!(matches!(e, voussoir::Error::EmptyMesh), "{name}: {e}");
+        }
+    }
+}
+
+/// A face of tiny but positive plan area (a near-vertical strip as exporters write it) is
+/// mended by default and, with no repair asked for, an error naming it: left as drawn it
+/// passes validation but carries force densities many orders of magnitude apart.
+#[test]
+fn no_repair_rejects_the_slivers_the_default_mends() {
+    let dir = Scratch::new("read-model-sliver");
+    let path = dir.path("sliver.obj");
+    // A unit square split at its centre, with a fifth vertex 1e-7 outside the bottom edge.
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 0.3\nv 0.5 -1e-7 0\n\
+                f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\nf 1 6 2\n";
+    fs::write(&path, text).unwrap();
+    let mended = read_model(&path, &ReadOptions::new(Supports::Boundary)).unwrap();
+    assert!(!mended.repairs.is_empty());
+    let strict = ReadOptions::new(Supports::Boundary).with_repair_tolerance(0.0);
+    match read_model(&path, &strict) {
+        Err(voussoir::Error::InvalidArgument { name, reason }) => {
+            assert_eq!(name, "repair_tolerance");
+            assert!(
+                reason.contains("faces 0, 4") || reason.contains("faces 4"),
+                "{reason}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}

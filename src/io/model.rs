@@ -98,8 +98,9 @@ pub struct ReadOptions {
     /// `Some(DEFAULT_WELD_TOLERANCE)`.
     pub weld_tolerance: Option<f64>,
     /// Faces whose plan area is below this × the median plan area are mended by
-    /// [`repair_plan`] before validation (0: none, such faces are rejected). Finite and >= 0.
-    /// Default [`DEFAULT_REPAIR_TOLERANCE`].
+    /// [`repair_plan`] before validation (0: none, and the faces the default tolerance would
+    /// mend are rejected, [`Error::InvalidArgument`] naming them). Finite and >= 0. Default
+    /// [`DEFAULT_REPAIR_TOLERANCE`].
     pub repair_tolerance: f64,
     /// The file's up axis. Default z.
     pub up: UpAxis,
@@ -222,6 +223,34 @@ impl Model {
     }
 }
 
+/// With no repair asked for (tolerance 0), the faces the default tolerance would mend are an
+/// error naming them: a plan sliver left as drawn carries force densities many orders of
+/// magnitude apart, which no step balances to the tolerance.
+fn reject_slivers(positions: &[[f64; 3]], faces: &[[u32; 3]], anchored: &[u32]) -> Result<()> {
+    let (mut p, mut f) = (positions.to_vec(), faces.to_vec());
+    let repairs = repair_plan(&mut p, &mut f, anchored, DEFAULT_REPAIR_TOLERANCE)?;
+    let mut slivers: Vec<usize> = (repairs.iter())
+        .flat_map(|r| match r {
+            PlanRepair::Flip { faces, .. } => faces.to_vec(),
+            PlanRepair::Nudge { face, .. } => vec![*face],
+        })
+        .collect();
+    slivers.sort_unstable();
+    slivers.dedup();
+    if slivers.is_empty() {
+        return Ok(());
+    }
+    Err(Error::InvalidArgument {
+        name: "repair_tolerance",
+        reason: format!(
+            "no repair (tolerance 0) rejects plan slivers: faces {} have a plan area below \
+             {DEFAULT_REPAIR_TOLERANCE:e} of the median or are slightly inverted (the default \
+             tolerance mends them)",
+            crate::error::ids(&slivers)
+        ),
+    })
+}
+
 /// Reads a mesh file (OBJ, OFF, STL or PLY, by its extension; polygons split into fans) into a
 /// problem: the options are checked; the file is read and turned Z-up; the supports file, if
 /// any, is read; the vertices are welded; the supports are chosen (file ids mapped onto
@@ -236,6 +265,10 @@ impl Model {
 pub fn read_model(path: &Path, options: &ReadOptions) -> Result<Model> {
     options.validate()?;
     let ((positions, faces), diagonals) = read_mesh_with_diagonals(path)?;
+    // Before the supports are mapped onto it: an id is out of range of an empty file too.
+    if positions.is_empty() || faces.is_empty() {
+        return Err(Error::EmptyMesh);
+    }
     let positions: Vec<[f64; 3]> = match options.up {
         UpAxis::Z => positions,
         up => positions.into_iter().map(|p| up.to_z_up(p)).collect(),
@@ -279,6 +312,9 @@ pub fn read_model(path: &Path, options: &ReadOptions) -> Result<Model> {
         welded_id,
         ..
     } = welded;
+    if options.repair_tolerance == 0.0 {
+        reject_slivers(&positions, &faces, &anchored)?;
+    }
     let repairs = repair_plan(
         &mut positions,
         &mut faces,
