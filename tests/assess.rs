@@ -779,3 +779,70 @@ fn dense_heights(mesh: &Mesh, q: &[f64], held: &[f64], p: &[f64]) -> Vec<f64> {
     }
     z
 }
+
+/// The envelope of a dome scaled by 1e80 or 1e-100 (inside the coordinate range the mesh
+/// accepts) is the unit dome's scaled alike: the normals that read a normal thickness
+/// vertically neither overflow nor underflow.
+#[test]
+fn envelopes_scale_with_the_mesh_at_extreme_sizes() {
+    let unit = generate::cap_dome(0.8, 60).unwrap();
+    let reference = Envelope::from_thickness(&unit, &Thickness::Uniform(0.1)).unwrap();
+    for scale in [1e80, 1e-100] {
+        let positions: Vec<[f64; 3]> = (unit.positions().iter())
+            .map(|p| p.map(|c| c * scale))
+            .collect();
+        let anchored: Vec<u32> = (0..positions.len() as u32)
+            .filter(|&v| unit.anchored()[v as usize])
+            .collect();
+        let mesh = Mesh::new(positions, unit.faces().to_vec(), &anchored).unwrap();
+        let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1 * scale)).unwrap();
+        for (a, b) in [
+            (&envelope.lower, &reference.lower),
+            (&envelope.upper, &reference.upper),
+        ] {
+            for (x, y) in a.iter().zip(b.iter()) {
+                assert!(
+                    (x / scale - y).abs() <= 1e-12,
+                    "{scale}: {} against {y}",
+                    x / scale
+                );
+            }
+        }
+    }
+}
+
+/// An intrados and an extrados that meet at the crown (zero thickness there, read apart by
+/// their interpolation's rounding) make an envelope, closed at that vertex; one truly above
+/// the other by a thousandth is still named.
+#[test]
+fn surfaces_that_meet_make_an_envelope() {
+    let mesh = generate::cap_dome(0.8, 60).unwrap();
+    let crown = (0..mesh.positions().len())
+        .max_by(|&a, &b| mesh.positions()[a][2].total_cmp(&mesh.positions()[b][2]))
+        .unwrap();
+    let c = mesh.positions()[crown];
+    let above = |gap: f64| -> Vec<[f64; 3]> {
+        (mesh.positions().iter())
+            .map(|p| {
+                let r2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+                [p[0], p[1], p[2] + 0.05 * r2 - gap]
+            })
+            .collect()
+    };
+    let extrados = above(0.0);
+    let envelope = Envelope::from_surfaces(
+        &mesh,
+        (mesh.positions(), mesh.faces()),
+        (&extrados, mesh.faces()),
+    )
+    .unwrap();
+    assert!((envelope.upper[crown] - envelope.lower[crown]).abs() <= 1e-12);
+    let below = above(1e-3);
+    let e = Envelope::from_surfaces(
+        &mesh,
+        (mesh.positions(), mesh.faces()),
+        (&below, mesh.faces()),
+    );
+    let text = message(e.unwrap_err());
+    assert!(text.contains(&format!("vertex {crown}")), "{text}");
+}

@@ -101,11 +101,17 @@ impl Envelope {
         intrados: (&[[f64; 3]], &[[u32; 3]]),
         extrados: (&[[f64; 3]], &[[u32; 3]]),
     ) -> Result<Envelope> {
-        let lower = sample(mesh, intrados, "intrados", Pick::Highest)?;
-        let upper = sample(mesh, extrados, "extrados", Pick::Lowest)?;
+        let mut lower = sample(mesh, intrados, "intrados", Pick::Highest)?;
+        let mut upper = sample(mesh, extrados, "extrados", Pick::Lowest)?;
         let n = mesh.positions.len();
         let mut middle = vec![0.0; n];
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
+            // Surfaces that meet at a vertex read apart by their interpolation's rounding.
+            let rounding = 1e-12 * lower[v].abs().max(upper[v].abs());
+            if lower[v] > upper[v] && lower[v] - upper[v] <= rounding {
+                let meet = 0.5 * (lower[v] + upper[v]);
+                (lower[v], upper[v]) = (meet, meet);
+            }
             if lower[v] > upper[v] {
                 return Err(Error::InvalidArgument {
                     name: "intrados",
@@ -322,8 +328,15 @@ fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+/// The Euclidean length, scaled so that its squares neither overflow nor underflow at any
+/// coordinate scale the mesh accepts.
 fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+    let m = a.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if m == 0.0 || !m.is_finite() {
+        return m;
+    }
+    let [x, y, z] = a.map(|c| c / m);
+    m * (x * x + y * y + z * z).sqrt()
 }
 
 #[derive(Clone, Copy)]

@@ -416,6 +416,7 @@ impl<'a> Model<'a> {
             .sum();
         let (joints, worst_joint) = self.joints_of(&positions, &force_densities, &loads, s, mean);
         let feasible = eps_inf < settings.tolerance
+            && horizontal / mean < settings.tolerance
             && q_ok
             && worst_bound.0 <= 1e-9 * diag
             && worst_joint.0 < settings.tolerance
