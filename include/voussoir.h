@@ -1187,7 +1187,7 @@ VsrStatus vsr_result_timings(const struct VsrResult *result, double *stress_seco
  * |---|---|
  * | method | `VSR_METHOD_NEAREST` |
  * | fairness γ (nearest method) | 0.03 |
- * | max height change (nearest method) | 1 plan diagonal |
+ * | max height change | 1 plan diagonal |
  * | tolerance (on ε∞) | 1e-6 |
  * | max iterations (stress steps) | 100 |
  * | stall window | 8 iterations |
@@ -1319,9 +1319,9 @@ VsrStatus vsr_settings_set_method(struct VsrSettings *settings, uint32_t method)
 VsrStatus vsr_settings_set_fairness(struct VsrSettings *settings, double gamma);
 
 /**
- * Sets the largest height change the nearest method may make at any vertex, in plan
- * bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
- * `VSR_TERMINATION_BLOCKED`.
+ * Sets the largest height change form finding may make at any vertex (either method), in
+ * plan bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within
+ * it ends `VSR_TERMINATION_BLOCKED`.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

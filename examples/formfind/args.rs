@@ -129,8 +129,8 @@ Solver:
                          (least area-weighted squared height change), or
                          the paper's loop                                  [{method}]
   --fairness G           nearest method: weight of the change's smoothness [{fairness}]
-  --max-height-change H  nearest method: no vertex moves more than H plan
-                         diagonals                                         [{limit}]
+  --max-height-change H  no vertex moves more than H plan diagonals (either
+                         method)                                           [{limit}]
   --solver S             {solvers}                              [{solver}]
   --qp Q                 {qps}: the QP solver (native falls
                          back to clarabel when it does not converge)       [{qp}]

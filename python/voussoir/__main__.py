@@ -112,7 +112,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--method", choices=names["method"], default=d["method"], help=f"[{d['method']}]")
     p.add_argument("--fairness", type=float, help=f"nearest method: smoothness weight [{d['fairness']}]")
     p.add_argument("--max-height-change", type=float,
-                   help=f"nearest method: largest height change, plan diagonals [{d['max_height_change']}]")
+                   help=f"largest height change, plan diagonals [{d['max_height_change']}]")
     p.add_argument("--solver", choices=names["formulation"], help=f"[{d['formulation']}]")
     p.add_argument("--qp", choices=names["qp_solver"], help=f"QP solver [{d['qp_solver']}]")
     p.add_argument("--tol", type=float, help=f"stop when eps_inf < T [{d['tolerance']:g}]")

@@ -18,7 +18,7 @@ class Settings(TypedDict, total=False):
     fairness: float
     """Nearest method: weight gamma of the height change's smoothness [dimensionless, >= 0]."""
     max_height_change: float
-    """Nearest method: largest height change at any vertex [plan diagonals, > 0]."""
+    """Largest height change at any vertex, either method [plan diagonals, > 0]."""
     tolerance: float
     """Stop when eps_inf = max |r_i| / mean load < tolerance [dimensionless, > 0]."""
     max_iterations: int

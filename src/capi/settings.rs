@@ -102,7 +102,7 @@ pub struct VsrSettings {
 /// |---|---|
 /// | method | `VSR_METHOD_NEAREST` |
 /// | fairness γ (nearest method) | 0.03 |
-/// | max height change (nearest method) | 1 plan diagonal |
+/// | max height change | 1 plan diagonal |
 /// | tolerance (on ε∞) | 1e-6 |
 /// | max iterations (stress steps) | 100 |
 /// | stall window | 8 iterations |
@@ -399,9 +399,9 @@ pub unsafe extern "C" fn vsr_settings_set_fairness(
     })
 }
 
-/// Sets the largest height change the nearest method may make at any vertex, in plan
-/// bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within it ends
-/// `VSR_TERMINATION_BLOCKED`.
+/// Sets the largest height change form finding may make at any vertex (either method), in
+/// plan bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within
+/// it ends `VSR_TERMINATION_BLOCKED`.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.

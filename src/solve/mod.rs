@@ -9,7 +9,9 @@ mod warm;
 use crate::error::{ids, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
-use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus, TauMode};
+use crate::stress::{
+    EdgeScope, QBound, QpSolver, StressResult, StressSettings, StressStatus, TauMode,
+};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -114,8 +116,8 @@ pub struct FormFindSettings {
     /// change (nearest method only; frame units, so γ is dimensionless). 0: the plain nearest
     /// shape; larger values spread a change over a wider, smoother patch. Default 0.03.
     pub fairness: f64,
-    /// Largest height change allowed at any vertex, in plan bounding-box diagonals (nearest
-    /// method only). A shape that cannot stand within it ends `Blocked`. Default 1.
+    /// Largest height change allowed at any vertex, in plan bounding-box diagonals (both
+    /// methods). A shape that cannot stand within it ends `Blocked`. Default 1.
     pub max_height_change: f64,
     /// Stop when ε∞ = max|r_i| / mean p_i < tolerance. Default 1e-6.
     pub tolerance: f64,
@@ -497,6 +499,96 @@ fn idle_floored_vertices(problem: &Problem, s: &StressSettings) -> Vec<u32> {
 /// The region a blocked loop names: `limited` (the vertices held at the height limit) with the
 /// non-anchored vertices furthest from balance in `s`, the state answered (residual above a
 /// tenth of the largest), sorted.
+/// Whether `s`, forces certified at `positions`, is a state in equilibrium that form finding
+/// may answer as converged: ε∞ and the largest horizontal imbalance over the same mean load
+/// below the tolerance, and its force densities within their bounds (`meets_bounds`; `fresh`:
+/// the QP's own answer at these heights).
+fn certified(
+    problem: &Problem,
+    settings: &FormFindSettings,
+    positions: &[[f64; 3]],
+    s: &StressResult,
+    fresh: bool,
+) -> bool {
+    let tolerance = settings.tolerance;
+    s.eps_inf < tolerance
+        && horizontal_eps(problem, s) < tolerance
+        && meets_bounds(problem, &settings.stress, positions, s, fresh)
+}
+
+/// The largest horizontal imbalance at a non-anchored vertex over their mean load (ε∞'s
+/// normalisation). Reduced coordinates make it vanish up to rounding, which force densities
+/// many orders of magnitude apart can make large.
+fn horizontal_eps(problem: &Problem, s: &StressResult) -> f64 {
+    let mesh = &problem.mesh;
+    let free: Vec<usize> = (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .collect();
+    let largest = (free.iter())
+        .map(|&v| s.horizontal_imbalance[v][0].hypot(s.horizontal_imbalance[v][1]))
+        .fold(0.0, f64::max);
+    largest / free_mean_load(s, &free)
+}
+
+/// The mean load over the vertices `free` (1 when not positive, as the stress step's scale).
+fn free_mean_load(s: &StressResult, free: &[usize]) -> f64 {
+    let mean = free.iter().map(|&v| s.loads[v]).sum::<f64>() / free.len().max(1) as f64;
+    if mean > 0.0 {
+        mean
+    } else {
+        1.0
+    }
+}
+
+/// Whether the force densities of `s` meet their bounds at `positions`. `fresh`: the QP's
+/// own answer at these heights, which met its bounds to the solver's accuracy, is held to
+/// compression alone (q ≥ 0, to a millionth of the unit force density p̄/L₀), which a QP
+/// with force densities many orders of magnitude apart can miss. Otherwise forces kept
+/// from other heights are held to the stress settings' bounds there (relative ones move with
+/// the loads), to a millionth of the bound or of p̄/L₀ where the bound is 0.
+fn meets_bounds(
+    problem: &Problem,
+    st: &StressSettings,
+    positions: &[[f64; 3]],
+    s: &StressResult,
+    fresh: bool,
+) -> bool {
+    let mesh = &problem.mesh;
+    let free: Vec<usize> = (0..mesh.positions.len())
+        .filter(|&v| mesh.is_non_anchored(v))
+        .collect();
+    let p_bar = free_mean_load(s, &free);
+    let unit = p_bar / crate::geometry::Frame::of(mesh, positions).scale;
+    let q_min = st.q_min.physical(unit);
+    let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
+    let slack = |bound: f64| 1e-6 * if bound != 0.0 { bound.abs() } else { unit };
+    let diagonal = &problem.polygon_diagonal;
+    (mesh.edges.iter().zip(&s.force_densities).zip(diagonal)).all(|((edge, &q), &diagonal)| {
+        let active = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
+        if !active {
+            return true;
+        }
+        if fresh {
+            return q >= -slack(0.0);
+        }
+        let interior = !edge.is_boundary();
+        let scoped = (st.q_min_scope == EdgeScope::All || interior) && !diagonal;
+        let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
+        if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
+            let [a, b] = edge.v.map(|v| positions[v as usize]);
+            let length = (a[0] - b[0]).hypot(a[1] - b[1]);
+            lo = lo.max(d_lo * p_bar / length);
+            hi = hi.min(d_hi * p_bar / length);
+        }
+        q >= lo - slack(lo) && q <= hi + slack(hi)
+    })
+}
+
+/// What blocks a loop whose heights reached the limit, where q_max does not.
+const LIMIT_HINT: &str =
+    "the shape cannot stand within the height limit: the vertices that reached \
+    it, and those furthest from balance in the answer (raise max_height_change)";
+
 fn blocked_region(problem: &Problem, limited: &[u32], s: &StressResult) -> Vec<u32> {
     let mesh = &problem.mesh;
     let r_max = (0..mesh.positions.len())

@@ -17,8 +17,9 @@
 use super::paper::{paper_within, HeightLimit};
 use super::warm::{faces_fingerprint, Continuation};
 use super::{
-    area_shares, blocked_region, blocking_vertices, finish, infeasibility_hint, FormFindResult,
-    FormFindSettings, Progress, Run, Termination, FAR_FROM_BALANCE,
+    area_shares, blocked_region, blocking_vertices, certified, finish, infeasibility_hint,
+    meets_bounds, FormFindResult, FormFindSettings, Progress, Run, Termination, FAR_FROM_BALANCE,
+    LIMIT_HINT,
 };
 use crate::error::Result;
 use crate::geometry::Frame;
@@ -26,8 +27,7 @@ use crate::problem::Problem;
 use crate::shape::ShapeStep;
 use crate::smooth::Odt;
 use crate::stress::{
-    analyse_cached, EdgeScope, Prior, QpSolver, StressCache, StressResult, StressSettings,
-    StressStatus,
+    analyse_cached, Prior, QpSolver, StressCache, StressResult, StressSettings, StressStatus,
 };
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -55,10 +55,6 @@ const SETTLED: f64 = 1e-3;
 /// The pull towards the input in the solve for the unloaded surface over the supports
 /// (`Nearest::hanging_mirror`), relative to the mean diagonal of KᵀK per vertex.
 const MEMBRANE_PULL: f64 = 1e-12;
-/// What blocks a loop whose heights reached the limit, where q_max does not.
-const LIMIT_HINT: &str =
-    "the shape cannot stand within the height limit: the vertices that reached \
-    it, and those furthest from balance in the answer (raise max_height_change)";
 /// The loosest relative gap of an inexact stress QP (see `Nearest::inexact_gap`).
 const INEXACT_GAP_MAX: f64 = 1e-4;
 
@@ -562,39 +558,29 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// equilibrium where it is one and its forces still meet their bounds at these heights
     /// (relative bounds move with the loads); see [`Nearest::record`].
     fn record_height_state(&mut self) -> bool {
-        if self.held.eps_inf >= self.settings.tolerance || !self.meets_bounds(&self.held) {
+        if !self.balances(&self.held, false) {
             return false;
         }
         self.history.push(self.held.eps_inf);
         self.record()
     }
 
-    /// Whether the force densities of `s` meet the stress settings' bounds at the current
-    /// heights, to a relative 1e-6.
-    fn meets_bounds(&self, s: &StressResult) -> bool {
-        let mesh = &self.problem.mesh;
-        let st = &self.settings.stress;
-        let p_bar = mean_load(s, self.shape.vertices());
-        let unit = p_bar / self.l0;
-        let q_min = st.q_min.physical(unit);
-        let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
-        let diagonal = &self.problem.polygon_diagonal;
-        (mesh.edges.iter().zip(&s.force_densities).zip(diagonal)).all(|((edge, &q), &diagonal)| {
-            let active = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
-            if !active {
-                return true;
-            }
-            let interior = !edge.is_boundary();
-            let scoped = (st.q_min_scope == EdgeScope::All || interior) && !diagonal;
-            let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
-            if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
-                let [a, b] = edge.v.map(|v| self.positions[v as usize]);
-                let length = (a[0] - b[0]).hypot(a[1] - b[1]);
-                lo = lo.max(d_lo * p_bar / length);
-                hi = hi.min(d_hi * p_bar / length);
-            }
-            q >= lo * (1.0 - 1e-6) && q <= hi * (1.0 + 1e-6)
-        })
+    /// Whether `s` is a state in equilibrium at the current heights: balanced vertically and
+    /// horizontally to the tolerance, its forces within their bounds (see `certified`;
+    /// `fresh`: the last stress step's own answer).
+    fn balances(&self, s: &StressResult, fresh: bool) -> bool {
+        certified(self.problem, self.settings, &self.positions, s, fresh)
+    }
+
+    /// Whether the force densities of `s` meet their bounds at the current heights.
+    fn meets_bounds(&self, s: &StressResult, fresh: bool) -> bool {
+        meets_bounds(
+            self.problem,
+            &self.settings.stress,
+            &self.positions,
+            s,
+            fresh,
+        )
     }
 
     /// Records the current state as the best so far where it is; true when it is in
@@ -611,18 +597,19 @@ impl<'a, 'p> Nearest<'a, 'p> {
             positions: self.positions.clone(),
             stress: self.held.clone(),
         };
+        // Forces outside their bounds are no answer, however well they balance.
         let first = self.best.stress.force_densities.is_empty();
-        if first || (usable && self.held.eps_inf < self.best.eps) {
+        let better = usable && self.held.eps_inf < self.best.eps;
+        if first || (better && self.meets_bounds(&self.held, self.held_answers)) {
             self.best = current.clone();
         }
         // An answer in equilibrium counts once its QP met the full tolerances, so that the
         // horizontal rows hold as tightly as an analysis's (and an analysis of the shape afresh
-        // finds it standing: a looser answer's state did not always, on cheese). Earlier forces
-        // kept at new heights count only where they still meet their bounds there.
-        let solved = self.held.status == StressStatus::Solved
-            && self.exact
-            && (self.held_answers || self.meets_bounds(&self.held));
-        if !(solved && self.held.eps_inf < self.settings.tolerance) {
+        // finds it standing: a looser answer's state did not always, on cheese), and only where
+        // the recomputed certificate holds (bounds and horizontal balance included: force
+        // densities many orders of magnitude apart can leave a solved QP's rows loose).
+        let solved = self.held.status == StressStatus::Solved && self.exact;
+        if !(solved && self.balances(&self.held, self.held_answers)) {
             return false;
         }
         let settled = match &self.feasible {
@@ -1138,6 +1125,65 @@ mod tests {
         s.best.eps = 0.5 * settings.tolerance;
         s.stress_step(Some(&prior)).unwrap();
         assert!(!s.cache.last_was_inexact());
+    }
+
+    /// The certificate a converged answer needs, recomputed: a form-found state passes; the
+    /// same state with one force density 1% below q_min (kept from other heights), in tension
+    /// (the QP's own answer), or with a horizontal imbalance of 1e-3 of the mean load at one
+    /// vertex, does not.
+    #[test]
+    fn the_certificate_checks_bounds_and_horizontal_balance() {
+        let settings = FormFindSettings::default();
+        let truth = generate::self_supporting(KnownPlan::Disk, 300, &settings).unwrap();
+        let problem = Problem::new(truth);
+        let r = crate::form_find(&problem, &settings, None).unwrap();
+        assert_eq!(r.termination, Termination::Converged);
+        let positions = &r.positions;
+        assert!(certified(&problem, &settings, positions, &r.stress, false));
+        let mesh = &problem.mesh;
+        let free: Vec<usize> = (0..mesh.positions.len())
+            .filter(|&v| mesh.is_non_anchored(v))
+            .collect();
+        let p_bar = free.iter().map(|&v| r.stress.loads[v]).sum::<f64>() / free.len() as f64;
+        let unit = p_bar / Frame::of(mesh, positions).scale;
+        let q_min = settings.stress.q_min.physical(unit);
+        let interior = (mesh.edges.iter()).position(|e| !e.is_boundary()).unwrap();
+        let mut short = r.stress.clone();
+        short.force_densities[interior] = 0.99 * q_min;
+        assert!(!meets_bounds(
+            &problem,
+            &settings.stress,
+            positions,
+            &short,
+            false
+        ));
+        assert!(!certified(&problem, &settings, positions, &short, false));
+        // A QP's own answer is held to compression: 1% short of q_min passes, tension not.
+        assert!(meets_bounds(
+            &problem,
+            &settings.stress,
+            positions,
+            &short,
+            true
+        ));
+        short.force_densities[interior] = -1e-3 * q_min;
+        assert!(!meets_bounds(
+            &problem,
+            &settings.stress,
+            positions,
+            &short,
+            true
+        ));
+        let mut loose = r.stress.clone();
+        loose.horizontal_imbalance[free[0]] = [1e-3 * p_bar, 0.0];
+        assert!(meets_bounds(
+            &problem,
+            &settings.stress,
+            positions,
+            &loose,
+            false
+        ));
+        assert!(!certified(&problem, &settings, positions, &loose, true));
     }
 
     #[test]

@@ -3,10 +3,11 @@
 //! heights, repeated.
 
 use super::{
-    blocking_vertices, falls_short, finish, infeasibility_hint, FormFindResult, FormFindSettings,
-    Progress, Run, Termination, FAR_FROM_BALANCE,
+    blocked_region, blocking_vertices, falls_short, finish, infeasibility_hint, meets_bounds,
+    FormFindResult, FormFindSettings, Progress, Run, Termination, FAR_FROM_BALANCE, LIMIT_HINT,
 };
 use crate::error::Result;
+use crate::geometry::Frame;
 use crate::problem::Problem;
 use crate::shape::ShapeStep;
 use crate::smooth::Odt;
@@ -16,9 +17,9 @@ use crate::stress::{
 use std::borrow::Cow;
 use std::time::Instant;
 
-/// A bound on every height's change from reference heights: the nearest method's
-/// `max_height_change`, which the paper's loop holds when it continues from the nearest
-/// method's best state (`Nearest::polish`).
+/// A bound on every height's change from reference heights: `max_height_change`, which the
+/// paper's loop holds from its own input, and from the nearest method's input when it
+/// continues from that method's best state (`Nearest::polish`).
 pub(super) struct HeightLimit<'a> {
     /// The reference heights, per vertex.
     pub(super) z0: &'a [f64],
@@ -45,13 +46,34 @@ fn set_heights(positions: &mut [[f64; 3]], z: Vec<f64>, mut limit: Option<&mut H
 }
 
 /// The paper's loop: stress step, then a height step pulled towards the current heights with
-/// inverse-residual weights and a geometric schedule, repeated until ε∞ < tolerance.
+/// inverse-residual weights and a geometric schedule, repeated until ε∞ < tolerance; every
+/// height held within `max_height_change` of the input, and a loop that did not converge
+/// with heights held back is `Blocked` there.
 pub(super) fn paper(
     problem: &Problem,
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
 ) -> Result<FormFindResult> {
-    paper_within(problem, settings, progress, None)
+    let mesh = &problem.mesh;
+    let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
+    let frame = Frame::of(mesh, &mesh.positions);
+    let mut limit = HeightLimit {
+        z0: &z0,
+        limit: settings.max_height_change * 2.0 * frame.scale,
+        held: Vec::new(),
+    };
+    let mut result = paper_within(problem, settings, progress, Some(&mut limit))?;
+    let unfinished = matches!(
+        result.termination,
+        Termination::MaxIterations | Termination::Stalled { .. }
+    );
+    if unfinished && !limit.held.is_empty() {
+        result.termination = Termination::Blocked {
+            vertices: blocked_region(problem, &limit.held, &result.stress),
+            hint: LIMIT_HINT.into(),
+        };
+    }
+    Ok(result)
 }
 
 /// The paper's loop with every height step brought back within `limit` (None: unbounded).
@@ -94,12 +116,15 @@ pub(super) fn paper_within(
         let stress = analyse_cached(problem, &positions, stress_settings, prior, &mut cache)?;
         solvers.push(stress.solver);
         qp_iterations.push(stress.iterations);
-        let stress = keep_better(stress, last.take(), &cache, stress_settings, plan_settled);
+        let (stress, fresh) =
+            keep_better(stress, last.take(), &cache, stress_settings, plan_settled);
         stress_s += t.elapsed().as_secs_f64();
         history.push(stress.eps_inf);
         let status = stress.status;
         let eps = stress.eps_inf;
-        lowest.offer(&positions, &stress);
+        let balanced = super::certified(problem, settings, &positions, &stress, fresh);
+        let within = meets_bounds(problem, stress_settings, &positions, &stress, fresh);
+        lowest.offer(&positions, &stress, within);
         last = Some(stress);
         if let Some(cb) = progress.as_mut() {
             if !cb(k, eps) {
@@ -111,7 +136,7 @@ pub(super) fn paper_within(
             termination = failed;
             break;
         }
-        if eps < settings.tolerance {
+        if balanced {
             termination = Termination::Converged;
             break;
         }
@@ -140,13 +165,14 @@ pub(super) fn paper_within(
         // Late shape steps balance the given forces almost exactly: when these forces already
         // balance the new shape, the next stress step (the most expensive one: its optimum is
         // nearly degenerate) would only confirm it. The certificate is recomputed from the
-        // forces and the new heights, as for a stress step.
+        // forces and the new heights, as for a stress step; relative bounds move with the
+        // loads, so the same forces may fall short of them at the new heights.
         let certified = s.at_heights(problem, &positions, stress_settings);
         shape_s += t.elapsed().as_secs_f64();
-        let certified_eps = certified.eps_inf;
+        let balanced = super::certified(problem, settings, &positions, &certified, false);
+        history.extend(balanced.then_some(certified.eps_inf));
         last = Some(certified);
-        if certified_eps < settings.tolerance {
-            history.push(certified_eps);
+        if balanced {
             termination = Termination::Converged;
             break;
         }
@@ -181,12 +207,15 @@ struct Lowest {
 }
 
 impl Lowest {
-    fn offer(&mut self, positions: &[[f64; 3]], stress: &StressResult) {
+    /// Offers a state; `within`: whether its forces meet their bounds, without which it is
+    /// no answer however well it balances.
+    fn offer(&mut self, positions: &[[f64; 3]], stress: &StressResult, within: bool) {
         let usable = !matches!(
             stress.status,
             StressStatus::Infeasible | StressStatus::NumericalError
         );
         if usable
+            && within
             && self
                 .state
                 .as_ref()
@@ -234,22 +263,22 @@ fn faded(settings: &FormFindSettings, k: usize) -> Cow<'_, StressSettings> {
     }
 }
 
-/// The stress step's answer, or the forces at hand (the previous ones, certified at these
-/// heights) when the step stopped short of its optimum and balances the shape worse, unless
-/// ODT has just moved the plan under them (`plan_settled` false).
+/// The stress step's answer (with true), or the forces at hand (the previous ones, certified
+/// at these heights; with false) when the step stopped short of its optimum and balances the
+/// shape worse, unless ODT has just moved the plan under them (`plan_settled` false).
 fn keep_better(
     stress: StressResult,
     held: Option<StressResult>,
     cache: &StressCache,
     settings: &StressSettings,
     plan_settled: bool,
-) -> StressResult {
+) -> (StressResult, bool) {
     // A smoothed step trades residual for smoothness on purpose: only once the smoothing has
     // faded is a coarse one judged by its residual.
     let coarse = cache.last_was_coarse() && settings.dual_length_smoothing == 0.0;
     match held {
-        Some(held) if plan_settled && falls_short(&stress, coarse, &held) => held,
-        _ => stress,
+        Some(held) if plan_settled && falls_short(&stress, coarse, &held) => (held, false),
+        _ => (stress, true),
     }
 }
 
