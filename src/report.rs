@@ -194,6 +194,9 @@ pub struct Report {
     pub step_solvers: Vec<QpSolver>,
     /// ε∞ of the final forces: max |r_i| / mean load.
     pub eps_inf: f64,
+    /// Largest horizontal imbalance at a non-anchored vertex over the mean load; a converged
+    /// answer has it below the tolerance too.
+    pub horizontal_imbalance: f64,
     /// ε∞ after each stress step (see [`FormFindResult::history`]).
     pub history: Vec<f64>,
     /// The final vertex positions (Z-up).
@@ -284,6 +287,7 @@ impl Report {
             iterations,
             step_solvers: solvers,
             eps_inf: stress.eps_inf,
+            horizontal_imbalance: crate::solve::horizontal_eps(p, stress),
             history,
             positions: positions.clone(),
             edges: mesh.edges.iter().map(|e| e.v).collect(),

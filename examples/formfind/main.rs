@@ -381,6 +381,13 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.tolerance,
                 outcome.before.eps_inf
             );
+            let horizontal = report["horizontal_imbalance"].as_f64().unwrap_or(0.0);
+            if report["termination"] != "converged" && s.eps_inf < outcome.tolerance {
+                say!(
+                    "  balanced vertically but not certified: horizontal imbalance {horizontal:.2e} \
+                     of the mean load, or forces outside their bounds"
+                );
+            }
             // A stall with no vertex to name has nothing to add to its own line.
             let vertices = &report["termination_vertices"];
             if vertices.as_array().is_some_and(|v| !v.is_empty()) {

@@ -519,7 +519,7 @@ fn certified(
 /// The largest horizontal imbalance at a non-anchored vertex over their mean load (ε∞'s
 /// normalisation). Reduced coordinates make it vanish up to rounding, which force densities
 /// many orders of magnitude apart can make large.
-fn horizontal_eps(problem: &Problem, s: &StressResult) -> f64 {
+pub(crate) fn horizontal_eps(problem: &Problem, s: &StressResult) -> f64 {
     let mesh = &problem.mesh;
     let free: Vec<usize> = (0..mesh.positions.len())
         .filter(|&v| mesh.is_non_anchored(v))
