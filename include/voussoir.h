@@ -644,8 +644,8 @@ const char *vsr_status_name(uint32_t status);
  *   area), tiny or slightly inverted, are mended before validation by plan edge flips or the
  *   smallest plan move of a non-anchored vertex (see `vsr_mesh_plan_flips` and
  *   `vsr_mesh_plan_nudges`); 0 mends nothing and rejects the faces a tolerance of 1e-4 would
- *   mend (`VSR_STATUS_INVALID_ARGUMENT` naming them). Finite and >= 0; the Rust API's
- *   default is 1e-4.
+ *   mend (`VSR_STATUS_INVALID_PLAN` naming them). Finite and >= 0; the Rust API's default is
+ *   1e-4.
  * - `n_merged`: receives how many of the file's vertices were merged into another; may be
  *   NULL.
  * - `out`: receives a new handle on success, owned by the caller (free with

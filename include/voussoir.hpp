@@ -201,7 +201,7 @@ struct ReadOptions {
     std::string supports_path;            ///< JSON file of anchored ids; empty: `anchored`
     std::vector<std::uint32_t> anchored;  ///< the file's vertex ids of the supports
     double weld_tolerance = 1e-9;         ///< × bounding-box diagonal
-    double repair_tolerance = 1e-4;       ///< × median plan area; 0 mends nothing
+    double repair_tolerance = 1e-4;       ///< × median plan area; 0 mends nothing, rejects those 1e-4 mends
 };
 
 /// A validated triangle mesh, its supports and loads (VsrMesh).

@@ -175,7 +175,7 @@ impl fmt::Display for Error {
                 write!(f, "face {face} has the same vertices as face {first}")
             }
             DegenerateFaces { faces } => {
-                write!(f, "faces with zero plan area: {}", ids(faces))
+                write!(f, "faces with (almost) zero plan area: {}", ids(faces))
             }
             NonManifoldEdge { edge, faces } => write!(
                 f,

@@ -456,12 +456,8 @@ fn a_floor_on_edges_no_compression_loads_is_refused_at_once() {
     );
 }
 
-/// A prescribed horizontal force at a free corner (a tie pulling it) may balance its edges,
-/// so the corner is not peeled and the analysis searches. The square of four triangles
-/// around a raised centre, anchored at three corners: the fourth is stranded alone without
-/// the force (the centre keeps the diagonal between two supports), searched with it.
-#[test]
-fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
+/// The unit square of four triangles around a centre raised by 0.3, flat otherwise.
+fn square_around_a_centre() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let positions = vec![
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
@@ -469,7 +465,16 @@ fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
         [0.0, 1.0, 0.0],
         [0.5, 0.5, 0.3],
     ];
-    let faces = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+    (positions, vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]])
+}
+
+/// A prescribed horizontal force at a free corner (a tie pulling it) may balance its edges,
+/// so the corner is not peeled and the analysis searches. The square of four triangles
+/// around a raised centre, anchored at three corners: the fourth is stranded alone without
+/// the force (the centre keeps the diagonal between two supports), searched with it.
+#[test]
+fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
+    let (positions, faces) = square_around_a_centre();
     let mesh = Mesh::new(positions, faces, &[0, 1, 2]).unwrap();
     let free = Problem::new(mesh.clone());
     let refusal = refused_problem(&free, 1.0, AssessSettings::default()).expect("refused");
@@ -488,15 +493,9 @@ fn a_horizontal_force_at_a_corner_leaves_it_to_the_search() {
 #[test]
 fn a_corner_below_the_tolerance_is_left_to_the_search() {
     let sliver = |depth: f64, anchored: &[u32]| {
-        let positions = vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [1.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.5, 0.5, 0.3],
-            [0.5, -depth, 0.0],
-        ];
-        let faces = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [0, 5, 1]];
+        let (mut positions, mut faces) = square_around_a_centre();
+        positions.push([0.5, -depth, 0.0]);
+        faces.push([0, 5, 1]);
         let mesh = Mesh::new(positions, faces, anchored).unwrap();
         refused(&mesh, 1.0, AssessSettings::default())
     };

@@ -106,10 +106,6 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
             name: "weld tolerance",
             reason,
         }) => return Err(format!("--weld: {reason} (or --no-weld)")),
-        Err(voussoir::Error::InvalidArgument {
-            name: "repair_tolerance",
-            reason,
-        }) if o.strict => return Err(format!("--strict: {reason}")),
         Err(e @ voussoir::Error::InvalidAnchor { .. }) => {
             return Err(anchor_error(&e, mesh_path, &options.supports))
         }

@@ -167,8 +167,9 @@ class Mesh:
             weld_tolerance: vertices closer than this x the bounding-box diagonal are merged
                 (0: only equal positions); default ``voussoir.WELD_TOLERANCE``.
             repair_tolerance: faces whose plan area is below this x the median plan area are
-                mended by plan edge flips or the smallest plan move of a vertex (0: none,
-                such faces are rejected); default ``voussoir.REPAIR_TOLERANCE``.
+                mended by plan edge flips or the smallest plan move of a vertex (0: none, and
+                the faces the default would mend are rejected); default
+                ``voussoir.REPAIR_TOLERANCE``.
             up: "z", or "y" for a Y-up file (as most modellers export): the mesh is turned
                 Z-up, and `write` turns positions back.
             face_density, extra_loads, horizontal_forces, prescribed_tau: as for `Mesh`,

@@ -99,7 +99,7 @@ pub struct ReadOptions {
     pub weld_tolerance: Option<f64>,
     /// Faces whose plan area is below this × the median plan area are mended by
     /// [`repair_plan`] before validation (0: none, and the faces the default tolerance would
-    /// mend are rejected, [`Error::InvalidArgument`] naming them). Finite and >= 0. Default
+    /// mend are rejected, [`Error::DegenerateFaces`] naming them). Finite and >= 0. Default
     /// [`DEFAULT_REPAIR_TOLERANCE`].
     pub repair_tolerance: f64,
     /// The file's up axis. Default z.
@@ -223,32 +223,24 @@ impl Model {
     }
 }
 
-/// With no repair asked for (tolerance 0), the faces the default tolerance would mend are an
-/// error naming them: a plan sliver left as drawn carries force densities many orders of
-/// magnitude apart, which no step balances to the tolerance.
+/// With no repair asked for (tolerance 0), the faces the default tolerance would mend are
+/// degenerate: a plan sliver left as drawn carries force densities many orders of magnitude
+/// apart, which no step balances to the tolerance. (A flip names its sliver first.)
 fn reject_slivers(positions: &[[f64; 3]], faces: &[[u32; 3]], anchored: &[u32]) -> Result<()> {
     let (mut p, mut f) = (positions.to_vec(), faces.to_vec());
     let repairs = repair_plan(&mut p, &mut f, anchored, DEFAULT_REPAIR_TOLERANCE)?;
     let mut slivers: Vec<usize> = (repairs.iter())
-        .flat_map(|r| match r {
-            PlanRepair::Flip { faces, .. } => faces.to_vec(),
-            PlanRepair::Nudge { face, .. } => vec![*face],
+        .map(|r| match r {
+            PlanRepair::Flip { faces, .. } => faces[0],
+            PlanRepair::Nudge { face, .. } => *face,
         })
         .collect();
     slivers.sort_unstable();
     slivers.dedup();
-    if slivers.is_empty() {
-        return Ok(());
+    match slivers.is_empty() {
+        true => Ok(()),
+        false => Err(Error::DegenerateFaces { faces: slivers }),
     }
-    Err(Error::InvalidArgument {
-        name: "repair_tolerance",
-        reason: format!(
-            "no repair (tolerance 0) rejects plan slivers: faces {} have a plan area below \
-             {DEFAULT_REPAIR_TOLERANCE:e} of the median or are slightly inverted (the default \
-             tolerance mends them)",
-            crate::error::ids(&slivers)
-        ),
-    })
 }
 
 /// Reads a mesh file (OBJ, OFF, STL or PLY, by its extension; polygons split into fans) into a
