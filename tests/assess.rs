@@ -812,37 +812,33 @@ fn envelopes_scale_with_the_mesh_at_extreme_sizes() {
 }
 
 /// An intrados and an extrados that meet at the crown (zero thickness there, read apart by
-/// their interpolation's rounding) make an envelope, closed at that vertex; one truly above
-/// the other by a thousandth is still named.
+/// their interpolation's rounding) make an envelope, closed at that vertex, whether they meet
+/// at the crown's height or at z = 0; one truly above the other by a thousandth is still
+/// named.
 #[test]
 fn surfaces_that_meet_make_an_envelope() {
-    let mesh = generate::cap_dome(0.8, 60).unwrap();
-    let crown = (0..mesh.positions().len())
-        .max_by(|&a, &b| mesh.positions()[a][2].total_cmp(&mesh.positions()[b][2]))
+    let dome = generate::cap_dome(0.8, 60).unwrap();
+    let crown = (0..dome.positions().len())
+        .max_by(|&a, &b| dome.positions()[a][2].total_cmp(&dome.positions()[b][2]))
         .unwrap();
-    let c = mesh.positions()[crown];
-    let above = |gap: f64| -> Vec<[f64; 3]> {
-        (mesh.positions().iter())
-            .map(|p| {
-                let r2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-                [p[0], p[1], p[2] + 0.05 * r2 - gap]
-            })
-            .collect()
-    };
-    let extrados = above(0.0);
-    let envelope = Envelope::from_surfaces(
-        &mesh,
-        (mesh.positions(), mesh.faces()),
-        (&extrados, mesh.faces()),
-    )
-    .unwrap();
-    assert!((envelope.upper[crown] - envelope.lower[crown]).abs() <= 1e-12);
-    let below = above(1e-3);
-    let e = Envelope::from_surfaces(
-        &mesh,
-        (mesh.positions(), mesh.faces()),
-        (&below, mesh.faces()),
-    );
-    let text = message(e.unwrap_err());
-    assert!(text.contains(&format!("vertex {crown}")), "{text}");
+    for drop in [0.0, dome.positions()[crown][2]] {
+        let lowered: Vec<f64> = dome.positions().iter().map(|p| p[2] - drop).collect();
+        let mesh = dome.clone().with_heights(&lowered).unwrap();
+        let c = mesh.positions()[crown];
+        let above = |gap: f64| -> Vec<[f64; 3]> {
+            (mesh.positions().iter())
+                .map(|p| {
+                    let r2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+                    [p[0], p[1], p[2] + 0.05 * r2 - gap]
+                })
+                .collect()
+        };
+        let intrados = (mesh.positions(), mesh.faces());
+        let envelope = Envelope::from_surfaces(&mesh, intrados, (&above(0.0), mesh.faces()));
+        let envelope = envelope.unwrap();
+        assert!((envelope.upper[crown] - envelope.lower[crown]).abs() <= 1e-12);
+        let e = Envelope::from_surfaces(&mesh, intrados, (&above(1e-3), mesh.faces()));
+        let text = message(e.unwrap_err());
+        assert!(text.contains(&format!("vertex {crown}")), "{text}");
+    }
 }

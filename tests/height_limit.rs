@@ -109,3 +109,22 @@ fn no_answer_moves_beyond_the_height_limit() {
         "the limit bound the paper's loop {paper_bound} times only"
     );
 }
+
+/// ODT sweeps resample heights as they move the plan: the paper's loop brings those back
+/// within the limit too.
+#[test]
+fn odt_sweeps_stay_within_the_height_limit() {
+    let problem = Problem::new(walled_vault(0, 0.0));
+    for limit in [0.5, 0.2] {
+        let mut settings = FormFindSettings::default()
+            .with_method(FormMethod::Paper)
+            .with_max_height_change(limit);
+        settings.odt_iterations = 5;
+        let r = form_find(&problem, &settings, None).unwrap();
+        let moved = largest_change(&problem.mesh, &r.positions);
+        assert!(
+            moved <= limit * (1.0 + 1e-9),
+            "limit {limit}: moved {moved}"
+        );
+    }
+}

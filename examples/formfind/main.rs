@@ -362,6 +362,17 @@ fn print_model(m: &model::Model) {
     }
 }
 
+/// Why a state balanced vertically is not a converged answer (docs/method.md §13.1).
+fn uncertified(report: &Value, outcome: &run::Outcome) -> String {
+    match report["horizontal_imbalance"].as_f64() {
+        Some(h) if h < outcome.tolerance => "its forces fall outside their bounds, or its QP \
+            stopped short of the optimum"
+            .into(),
+        Some(h) => format!("its horizontal imbalance is {h:.2e} of the mean load"),
+        None => "its horizontal imbalance is not a number".into(),
+    }
+}
+
 fn print_summary(outcome: &run::Outcome, report: &Value) {
     print_model(&outcome.model);
     let s = &outcome.stress;
@@ -381,11 +392,11 @@ fn print_summary(outcome: &run::Outcome, report: &Value) {
                 outcome.tolerance,
                 outcome.before.eps_inf
             );
-            let horizontal = report["horizontal_imbalance"].as_f64().unwrap_or(0.0);
-            if report["termination"] != "converged" && s.eps_inf < outcome.tolerance {
+            let ended = report["termination"].as_str().unwrap_or("");
+            if !matches!(ended, "converged" | "cancelled") && s.eps_inf < outcome.tolerance {
                 say!(
-                    "  balanced vertically but not certified: horizontal imbalance {horizontal:.2e} \
-                     of the mean load, or forces outside their bounds"
+                    "  balanced vertically but not certified: {}",
+                    uncertified(report, outcome)
                 );
             }
             // A stall with no vertex to name has nothing to add to its own line.

@@ -117,7 +117,8 @@ class FormFindResult(StressResult):
 
     @property
     def converged(self) -> bool:
-        """True when eps_inf fell below the tolerance."""
+        """True for a certified state in equilibrium: eps_inf and the horizontal imbalance
+        below the tolerance, the forces within their bounds."""
         return self.termination == "converged"
 
 
@@ -131,9 +132,9 @@ class AssessmentResult:
     objective: str
     """The analysis: "fit", "min-thickness", "min-thrust", "max-thrust" or "max-load"."""
     feasible: bool
-    """True when the surface is certified: eps_inf below the tolerance, every force density
-    >= q_min (compression), every height within [lower, upper] to 1e-9 of the plan
-    diagonal."""
+    """True when the surface is certified: eps_inf and the horizontal imbalance below the
+    tolerance, every force density >= q_min (compression), every height within [lower, upper]
+    to 1e-9 of the plan diagonal, and the springing joints' check."""
     termination: str
     """How the search ended: "converged" (the objective's optimum), "max_iterations",
     "stalled", "numerical_error" or "cancelled"."""

@@ -105,9 +105,10 @@ impl Envelope {
         let mut upper = sample(mesh, extrados, "extrados", Pick::Lowest)?;
         let n = mesh.positions.len();
         let mut middle = vec![0.0; n];
+        let scale = crate::geometry::Frame::of(mesh, &mesh.positions).scale;
         for v in (0..n).filter(|&v| mesh.referenced[v]) {
             // Surfaces that meet at a vertex read apart by their interpolation's rounding.
-            let rounding = 1e-12 * lower[v].abs().max(upper[v].abs());
+            let rounding = 1e-12 * lower[v].abs().max(upper[v].abs()).max(scale);
             if lower[v] > upper[v] && lower[v] - upper[v] <= rounding {
                 let meet = 0.5 * (lower[v] + upper[v]);
                 (lower[v], upper[v]) = (meet, meet);

@@ -184,9 +184,10 @@ impl SpringingJoint {
 pub struct AssessResult {
     /// The analysis that was run.
     pub objective: Objective,
-    /// True when `positions` with `force_densities` is a certified thrust surface: ε∞ <
-    /// tolerance, every q within its bounds (q ≥ 0), and every height within
-    /// `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal.
+    /// True when `positions` with `force_densities` is a certified thrust surface: ε∞ and the
+    /// horizontal imbalance below the tolerance, every q within its bounds (q ≥ 0), every
+    /// height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal, and the
+    /// springing joints' check (docs/method.md §16.3).
     pub feasible: bool,
     /// Converged; or how the search ended (the best state reached is returned).
     pub termination: Termination,

@@ -59,7 +59,8 @@ pub unsafe extern "C" fn vsr_assessment_objective(
 }
 
 /// How the search ended: `feasible` 1 when the positions with the force densities are a
-/// certified thrust surface (ε∞ below the tolerance, every force density within its bounds,
+/// certified thrust surface (ε∞ and the horizontal imbalance below the tolerance, every force
+/// density within its bounds,
 /// every height within `[lower − 1e-9 d, upper + 1e-9 d]`, d the plan diagonal), else 0 (the
 /// least infeasible state reached is reported); `termination` `VSR_TERMINATION_CONVERGED`
 /// when the objective's optimum was reached (else why the search stopped: max iterations,

@@ -96,7 +96,8 @@ impl VsrStatus {
 #[repr(u32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VsrTermination {
-    /// ε∞ fell below the tolerance.
+    /// A certified state in equilibrium: ε∞ and the horizontal imbalance below the tolerance,
+    /// the forces within their bounds.
     Converged = 0,
     /// The iteration limit was reached first.
     MaxIterations = 1,

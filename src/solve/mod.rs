@@ -18,7 +18,8 @@ use std::time::Instant;
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum Termination {
-    /// ε∞ < tolerance.
+    /// A certified state in equilibrium: ε∞ and the horizontal imbalance below the
+    /// tolerance, the forces within their bounds (docs/method.md §13.1).
     Converged,
     /// The iteration limit was reached first.
     MaxIterations,
@@ -496,9 +497,6 @@ fn idle_floored_vertices(problem: &Problem, s: &StressSettings) -> Vec<u32> {
     })
 }
 
-/// The region a blocked loop names: `limited` (the vertices held at the height limit) with the
-/// non-anchored vertices furthest from balance in `s`, the state answered (residual above a
-/// tenth of the largest), sorted.
 /// Whether `s`, forces certified at `positions`, is a state in equilibrium that form finding
 /// may answer as converged: ε∞ and the largest horizontal imbalance over the same mean load
 /// below the tolerance, and its force densities within their bounds (`meets_bounds`; `fresh`:
@@ -589,6 +587,9 @@ const LIMIT_HINT: &str =
     "the shape cannot stand within the height limit: the vertices that reached \
     it, and those furthest from balance in the answer (raise max_height_change)";
 
+/// The region a blocked loop names: `limited` (the vertices held at the height limit) with the
+/// non-anchored vertices furthest from balance in `s`, the state answered (residual above a
+/// tenth of the largest), sorted.
 fn blocked_region(problem: &Problem, limited: &[u32], s: &StressResult) -> Vec<u32> {
     let mesh = &problem.mesh;
     let r_max = (0..mesh.positions.len())

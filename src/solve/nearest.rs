@@ -532,7 +532,19 @@ impl<'a, 'p> Nearest<'a, 'p> {
         self.history.extend(&r.history);
         self.stress_seconds += r.stress_seconds;
         self.shape_seconds += r.shape_seconds;
-        if r.stress.eps_inf < self.best.eps {
+        // A converged answer passed the certificate; another replaces the best state only if
+        // it balances better with its forces within their bounds.
+        let converged = r.termination == Termination::Converged;
+        let within = || {
+            meets_bounds(
+                self.problem,
+                &settings.stress,
+                &r.positions,
+                &r.stress,
+                false,
+            )
+        };
+        if converged || (r.stress.eps_inf < self.best.eps && within()) {
             self.best = Best {
                 eps: r.stress.eps_inf,
                 energy: self.energy(&r.positions),
@@ -572,6 +584,12 @@ impl<'a, 'p> Nearest<'a, 'p> {
         certified(self.problem, self.settings, &self.positions, s, fresh)
     }
 
+    /// Whether the held forces are the last stress step's own answer, solved (see
+    /// `meets_bounds`); `record_height_state` checks forces kept at new heights first.
+    fn fresh(&self) -> bool {
+        self.held_answers && self.held.status == StressStatus::Solved
+    }
+
     /// Whether the force densities of `s` meet their bounds at the current heights.
     fn meets_bounds(&self, s: &StressResult, fresh: bool) -> bool {
         meets_bounds(
@@ -600,7 +618,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         // Forces outside their bounds are no answer, however well they balance.
         let first = self.best.stress.force_densities.is_empty();
         let better = usable && self.held.eps_inf < self.best.eps;
-        if first || (better && self.meets_bounds(&self.held, self.held_answers)) {
+        if first || (better && self.meets_bounds(&self.held, self.fresh())) {
             self.best = current.clone();
         }
         // An answer in equilibrium counts once its QP met the full tolerances, so that the
@@ -609,7 +627,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         // the recomputed certificate holds (bounds and horizontal balance included: force
         // densities many orders of magnitude apart can leave a solved QP's rows loose).
         let solved = self.held.status == StressStatus::Solved && self.exact;
-        if !(solved && self.balances(&self.held, self.held_answers)) {
+        if !(solved && self.balances(&self.held, self.fresh())) {
             return false;
         }
         let settled = match &self.feasible {

@@ -45,6 +45,20 @@ fn set_heights(positions: &mut [[f64; 3]], z: Vec<f64>, mut limit: Option<&mut H
     }
 }
 
+/// One ODT sweep (docs/method.md §12), its resampled heights brought back within `limit`;
+/// true when the plan has settled (the sweep no longer raises its quality).
+fn sweep_within(
+    odt: &mut Odt,
+    mesh: &crate::mesh::Mesh,
+    positions: &mut [[f64; 3]],
+    limit: Option<&mut HeightLimit>,
+) -> bool {
+    let settled = !odt.sweep(mesh, positions);
+    let z: Vec<f64> = positions.iter().map(|p| p[2]).collect();
+    set_heights(positions, z, limit);
+    settled
+}
+
 /// The paper's loop: stress step, then a height step pulled towards the current heights with
 /// inverse-residual weights and a geometric schedule, repeated until ε∞ < tolerance; every
 /// height held within `max_height_change` of the input, and a loop that did not converge
@@ -102,13 +116,10 @@ pub(super) fn paper_within(
     let (mut solvers, mut qp_iterations) = (Vec::new(), Vec::new());
     let mut lowest = Lowest::default();
     for k in 0..settings.max_iterations.max(1) {
-        // The plan moves only while sweeps raise its quality (docs/method.md §12).
-        let mut plan_settled = true;
-        if k < settings.odt_iterations {
-            let t = Instant::now();
-            plan_settled = !odt.sweep(mesh, &mut positions);
-            shape_s += t.elapsed().as_secs_f64();
-        }
+        let t = Instant::now();
+        let plan_settled = k >= settings.odt_iterations
+            || sweep_within(&mut odt, mesh, &mut positions, limit.as_deref_mut());
+        shape_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let prior = prior(last.as_ref(), settings);
         let stress_settings = &faded(settings, k);
@@ -122,6 +133,7 @@ pub(super) fn paper_within(
         history.push(stress.eps_inf);
         let status = stress.status;
         let eps = stress.eps_inf;
+        let fresh = fresh && stress.status == StressStatus::Solved;
         let balanced = super::certified(problem, settings, &positions, &stress, fresh);
         let within = meets_bounds(problem, stress_settings, &positions, &stress, fresh);
         lowest.offer(&positions, &stress, within);
@@ -199,29 +211,32 @@ pub(super) fn paper_within(
 }
 
 /// The lowest-ε∞ state of the stress steps (heights with the forces certified there, the
-/// states the history lists), the answer of a loop that ends without converging: later steps
-/// of a stalled loop may have moved further from balance.
+/// states the history lists) among those whose forces pass their bound check, else among all
+/// usable ones: the answer of a loop that ends without converging (later steps of a stalled
+/// loop may have moved further from balance).
 #[derive(Default)]
 struct Lowest {
-    state: Option<(Vec<[f64; 3]>, StressResult)>,
+    within: Option<(Vec<[f64; 3]>, StressResult)>,
+    any: Option<(Vec<[f64; 3]>, StressResult)>,
 }
 
 impl Lowest {
-    /// Offers a state; `within`: whether its forces meet their bounds, without which it is
-    /// no answer however well it balances.
+    /// Offers a state; `within`: whether its forces pass their bound check.
     fn offer(&mut self, positions: &[[f64; 3]], stress: &StressResult, within: bool) {
         let usable = !matches!(
             stress.status,
             StressStatus::Infeasible | StressStatus::NumericalError
         );
-        if usable
-            && within
-            && self
-                .state
-                .as_ref()
-                .is_none_or(|(_, s)| stress.eps_inf < s.eps_inf)
-        {
-            self.state = Some((positions.to_vec(), stress.clone()));
+        let slots = [(within, &mut self.within), (true, &mut self.any)];
+        for (take, slot) in slots {
+            if usable
+                && take
+                && slot
+                    .as_ref()
+                    .is_none_or(|(_, s)| stress.eps_inf < s.eps_inf)
+            {
+                *slot = Some((positions.to_vec(), stress.clone()));
+            }
         }
     }
 
@@ -232,7 +247,7 @@ impl Lowest {
         positions: Vec<[f64; 3]>,
         stress: StressResult,
     ) -> (Vec<[f64; 3]>, StressResult) {
-        match self.state {
+        match self.within.or(self.any) {
             Some(lowest) if *termination != Termination::Converged => lowest,
             _ => (positions, stress),
         }
