@@ -525,17 +525,7 @@ pub(crate) fn horizontal_eps(problem: &Problem, s: &StressResult) -> f64 {
     let largest = (free.iter())
         .map(|&v| s.horizontal_imbalance[v][0].hypot(s.horizontal_imbalance[v][1]))
         .fold(0.0, f64::max);
-    largest / free_mean_load(s, &free)
-}
-
-/// The mean load over the vertices `free` (1 when not positive, as the stress step's scale).
-fn free_mean_load(s: &StressResult, free: &[usize]) -> f64 {
-    let mean = free.iter().map(|&v| s.loads[v]).sum::<f64>() / free.len().max(1) as f64;
-    if mean > 0.0 {
-        mean
-    } else {
-        1.0
-    }
+    largest / problem.mean_load(&s.loads)
 }
 
 /// Whether the force densities of `s` meet their bounds at `positions`. `fresh`: the QP's
@@ -552,10 +542,7 @@ fn meets_bounds(
     fresh: bool,
 ) -> bool {
     let mesh = &problem.mesh;
-    let free: Vec<usize> = (0..mesh.positions.len())
-        .filter(|&v| mesh.is_non_anchored(v))
-        .collect();
-    let p_bar = free_mean_load(s, &free);
+    let p_bar = problem.mean_load(&s.loads);
     let unit = p_bar / crate::geometry::Frame::of(mesh, positions).scale;
     let q_min = st.q_min.physical(unit);
     let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
