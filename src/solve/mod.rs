@@ -9,9 +9,7 @@ mod warm;
 use crate::error::{ids, Result};
 use crate::problem::Problem;
 use crate::shape::Schedule;
-use crate::stress::{
-    EdgeScope, QBound, QpSolver, StressResult, StressSettings, StressStatus, TauMode,
-};
+use crate::stress::{QBound, QpSolver, StressResult, StressSettings, StressStatus, TauMode};
 use std::time::Instant;
 
 /// Why the loop stopped.
@@ -547,17 +545,15 @@ fn meets_bounds(
     let q_min = st.q_min.physical(unit);
     let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
     let slack = |bound: f64| 1e-6 * if bound != 0.0 { bound.abs() } else { unit };
-    let diagonal = &problem.polygon_diagonal;
-    (mesh.edges.iter().zip(&s.force_densities).zip(diagonal)).all(|((edge, &q), &diagonal)| {
-        let active = !edge.is_boundary() || edge.v.iter().any(|&v| !mesh.anchored[v as usize]);
-        if !active {
+    (mesh.edges.iter().zip(&s.force_densities).enumerate()).all(|(e, (edge, &q))| {
+        if !crate::stress::carries_force(mesh, e) {
             return true;
         }
         if fresh {
             return q >= -slack(0.0);
         }
         let interior = !edge.is_boundary();
-        let scoped = (st.q_min_scope == EdgeScope::All || interior) && !diagonal;
+        let scoped = crate::stress::floored(problem, st, e);
         let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
         if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
             let [a, b] = edge.v.map(|v| positions[v as usize]);

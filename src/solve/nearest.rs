@@ -552,18 +552,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
                 stress: r.stress,
             };
         }
-        // A loop that did not converge with heights held back at the limit was blocked there.
-        let held = limit.held;
-        let termination = match r.termination {
-            Termination::MaxIterations | Termination::Stalled { .. } if !held.is_empty() => {
-                Termination::Blocked {
-                    vertices: blocked_region(self.problem, &held, &self.best.stress),
-                    hint: LIMIT_HINT.into(),
-                }
-            }
-            t => t,
-        };
-        Ok(termination)
+        Ok(limit.ending(self.problem, r.termination, &self.best.stress))
     }
 
     /// Records a height step's state (the held forces certified at new heights) as a state in

@@ -29,6 +29,27 @@ pub(super) struct HeightLimit<'a> {
     pub(super) held: Vec<u32>,
 }
 
+impl HeightLimit<'_> {
+    /// How a loop held by this limit ended: one that did not converge with heights held back
+    /// at the limit was blocked there (the region named from `answer`, the state answered).
+    pub(super) fn ending(
+        self,
+        problem: &Problem,
+        ended: Termination,
+        answer: &StressResult,
+    ) -> Termination {
+        match ended {
+            Termination::MaxIterations | Termination::Stalled { .. } if !self.held.is_empty() => {
+                Termination::Blocked {
+                    vertices: blocked_region(problem, &self.held, answer),
+                    hint: LIMIT_HINT.into(),
+                }
+            }
+            t => t,
+        }
+    }
+}
+
 /// Sets the heights of `positions` to `z`, each brought back within `limit` of its reference
 /// where one is given (and recorded there).
 fn set_heights(positions: &mut [[f64; 3]], z: Vec<f64>, mut limit: Option<&mut HeightLimit>) {
@@ -60,7 +81,8 @@ fn sweep_within(
 }
 
 /// The paper's loop: stress step, then a height step pulled towards the current heights with
-/// inverse-residual weights and a geometric schedule, repeated until ε∞ < tolerance; every
+/// inverse-residual weights and a geometric schedule, repeated until a state is certified
+/// (docs/method.md §13.1); every
 /// height held within `max_height_change` of the input, and a loop that did not converge
 /// with heights held back is `Blocked` there.
 pub(super) fn paper(
@@ -77,16 +99,8 @@ pub(super) fn paper(
         held: Vec::new(),
     };
     let mut result = paper_within(problem, settings, progress, Some(&mut limit))?;
-    let unfinished = matches!(
-        result.termination,
-        Termination::MaxIterations | Termination::Stalled { .. }
-    );
-    if unfinished && !limit.held.is_empty() {
-        result.termination = Termination::Blocked {
-            vertices: blocked_region(problem, &limit.held, &result.stress),
-            hint: LIMIT_HINT.into(),
-        };
-    }
+    let ended = std::mem::replace(&mut result.termination, Termination::MaxIterations);
+    result.termination = limit.ending(problem, ended, &result.stress);
     Ok(result)
 }
 
