@@ -129,7 +129,8 @@ pub struct FormFindSettings {
     /// Optimal Delaunay Triangulation sweeps of the plan (0: the plan never moves). The paper
     /// method runs one before each of its first `odt_iterations` stress steps; the nearest
     /// method runs them all on the input, resampling its heights, and takes the result as
-    /// the shape to stay near. An upper bound: the first sweep that does not raise the plan's
+    /// the shape to stay near. Either way `max_height_change` holds from the input's own
+    /// heights, resampled ones included. An upper bound: the first sweep that does not raise the plan's
     /// quality (docs/method.md §12) is undone and ends the smoothing. Default 0.
     pub odt_iterations: usize,
     /// Let ODT move free boundary vertices too (it favours concave free edges, which is what a

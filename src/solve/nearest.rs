@@ -14,7 +14,7 @@
 //! the nearest stress step's state in equilibrium (ε∞ < tolerance, certified by recomputed
 //! residuals), taken once a further one is no nearer.
 
-use super::paper::{paper_within, HeightLimit};
+use super::paper::{paper_within, sweep_within, HeightLimit};
 use super::warm::{faces_fingerprint, Continuation};
 use super::{
     area_shares, blocked_region, blocking_vertices, certified, finish, infeasibility_hint,
@@ -117,7 +117,7 @@ struct Nearest<'a, 'p> {
     /// Input heights (after ODT, when asked for), the shape to stay near: their mirror image
     /// where the input hangs (see [`Nearest::hanging_mirror`]).
     z0: Vec<f64>,
-    /// Input heights (after ODT, when asked for), from which the height limit is measured.
+    /// The input's own heights (before ODT), from which the height limit is measured.
     z_limit: Vec<f64>,
     /// Whether `z0` is the input's mirror image.
     mirrored: bool,
@@ -169,10 +169,15 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let mesh = &problem.mesh;
         let mut positions = mesh.positions.clone();
         let t = Instant::now();
+        // The limit holds from the input's own heights, as the paper's loop and `max_change`
+        // measure it: ODT's resampled heights too.
+        let z_limit: Vec<f64> = positions.iter().map(|p| p[2]).collect();
+        let limit = settings.max_height_change * 2.0 * Frame::of(mesh, &positions).scale;
         if settings.odt_iterations > 0 {
             let mut odt = Odt::new(mesh, &positions, settings.odt_free_boundary);
+            let mut held = HeightLimit::new(&z_limit, limit);
             for _ in 0..settings.odt_iterations {
-                if !odt.sweep(mesh, &mut positions) {
+                if sweep_within(&mut odt, mesh, &mut positions, Some(&mut held)) {
                     break;
                 }
             }
@@ -195,12 +200,12 @@ impl<'a, 'p> Nearest<'a, 'p> {
             progress,
             shape,
             z0: positions.iter().map(|p| p[2]).collect(),
-            z_limit: positions.iter().map(|p| p[2]).collect(),
+            z_limit,
             mirrored: false,
             area,
             fair,
             l0: frame.scale,
-            limit: settings.max_height_change * 2.0 * frame.scale,
+            limit,
             cache: StressCache::for_form_finding(),
             held: placeholder(),
             w: 0.0,
@@ -514,11 +519,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             ..self.settings.clone()
         };
         let offset = self.iterations;
-        let mut limit = HeightLimit {
-            z0: &self.z_limit,
-            limit: self.limit,
-            held: Vec::new(),
-        };
+        let mut limit = HeightLimit::new(&self.z_limit, self.limit);
         let r = match self.progress.as_mut() {
             Some(cb) => {
                 let mut shifted = |k: usize, eps: f64| cb(k + offset, eps);

@@ -25,11 +25,35 @@ pub(super) struct HeightLimit<'a> {
     pub(super) z0: &'a [f64],
     /// The largest change allowed, physical.
     pub(super) limit: f64,
-    /// The vertices a height step was brought back at so far.
+    /// The vertices a height step was brought back at so far, and a mask of them.
     pub(super) held: Vec<u32>,
+    is_held: Vec<bool>,
 }
 
-impl HeightLimit<'_> {
+impl<'a> HeightLimit<'a> {
+    /// Changes from `z0` of at most `limit` (physical), none held back yet.
+    pub(super) fn new(z0: &'a [f64], limit: f64) -> Self {
+        HeightLimit {
+            z0,
+            limit,
+            held: Vec::new(),
+            is_held: vec![false; z0.len()],
+        }
+    }
+
+    /// `z` for vertex `v`, brought back within the limit (and recorded) where it is beyond.
+    fn hold(&mut self, v: usize, z: f64) -> f64 {
+        let reference = self.z0[v];
+        if (z - reference).abs() <= self.limit {
+            return z;
+        }
+        if !self.is_held[v] {
+            self.is_held[v] = true;
+            self.held.push(v as u32);
+        }
+        reference + self.limit.copysign(z - reference)
+    }
+
     /// How a loop held by this limit ended: one that did not converge with heights held back
     /// at the limit was blocked there (the region named from `answer`, the state answered).
     pub(super) fn ending(
@@ -55,20 +79,15 @@ impl HeightLimit<'_> {
 fn set_heights(positions: &mut [[f64; 3]], z: Vec<f64>, mut limit: Option<&mut HeightLimit>) {
     for (v, (p, z)) in positions.iter_mut().zip(z).enumerate() {
         p[2] = match limit.as_deref_mut() {
-            Some(l) if (z - l.z0[v]).abs() > l.limit => {
-                if !l.held.contains(&(v as u32)) {
-                    l.held.push(v as u32);
-                }
-                l.z0[v] + l.limit.copysign(z - l.z0[v])
-            }
-            _ => z,
+            Some(l) => l.hold(v, z),
+            None => z,
         };
     }
 }
 
 /// One ODT sweep (docs/method.md §12), its resampled heights brought back within `limit`;
 /// true when the plan has settled (the sweep no longer raises its quality).
-fn sweep_within(
+pub(super) fn sweep_within(
     odt: &mut Odt,
     mesh: &crate::mesh::Mesh,
     positions: &mut [[f64; 3]],
@@ -93,11 +112,7 @@ pub(super) fn paper(
     let mesh = &problem.mesh;
     let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
     let frame = Frame::of(mesh, &mesh.positions);
-    let mut limit = HeightLimit {
-        z0: &z0,
-        limit: settings.max_height_change * 2.0 * frame.scale,
-        held: Vec::new(),
-    };
+    let mut limit = HeightLimit::new(&z0, settings.max_height_change * 2.0 * frame.scale);
     let mut result = paper_within(problem, settings, progress, Some(&mut limit))?;
     let ended = std::mem::replace(&mut result.termination, Termination::MaxIterations);
     result.termination = limit.ending(problem, ended, &result.stress);
