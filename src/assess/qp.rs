@@ -7,6 +7,7 @@
 
 use super::model::{other_end, Model, State};
 use super::Objective;
+use crate::stress::sparse::Triplets;
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
@@ -115,23 +116,6 @@ pub(super) struct Step {
     pub joint_multiplier: f64,
     /// ½ dᵀ B d of the convexified Hessian of the Lagrangian (0 without multipliers).
     pub curvature: f64,
-}
-
-#[derive(Default)]
-struct Triplets {
-    i: Vec<usize>,
-    j: Vec<usize>,
-    v: Vec<f64>,
-}
-
-impl Triplets {
-    fn push(&mut self, i: usize, j: usize, v: f64) {
-        if v != 0.0 {
-            self.i.push(i);
-            self.j.push(j);
-            self.v.push(v);
-        }
-    }
 }
 
 /// Rows A x + s = b in cone order: zero, non-negative, then second-order cones of size 3.

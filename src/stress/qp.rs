@@ -8,7 +8,7 @@
 //!               lower ≤ S y ≤ upper on active edges,  τ ≥ 0
 
 use super::ipm;
-use super::sparse::Csr;
+use super::sparse::{Csr, Triplets};
 use super::StressStatus;
 
 use clarabel::algebra::CscMatrix;
@@ -58,22 +58,6 @@ pub struct QpOutput {
     pub coarse: bool,
     /// Solved to a looser relative gap than the tolerances' (`solve_native`'s `inexact`).
     pub inexact: bool,
-}
-
-struct Triplets {
-    i: Vec<usize>,
-    j: Vec<usize>,
-    v: Vec<f64>,
-}
-
-impl Triplets {
-    fn push(&mut self, i: usize, j: usize, v: f64) {
-        if v != 0.0 {
-            self.i.push(i);
-            self.j.push(j);
-            self.v.push(v);
-        }
-    }
 }
 
 /// One row l_a force_a − l_b force_b per smoothing pair (columns may repeat; they add up).
@@ -156,11 +140,7 @@ struct ClarabelColumns<'a> {
 /// triangle (a: the smoothing row l_a S_a − l_b S_b).
 fn clarabel_objective(inp: &QpInput, cols: &ClarabelColumns) -> Triplets {
     let force = cols.force;
-    let mut p = Triplets {
-        i: vec![],
-        j: vec![],
-        v: vec![],
-    };
+    let mut p = Triplets::default();
     for e in 0..force.nrows() {
         let w = 2.0 * inp.regularisation * inp.length[e] * inp.length[e];
         for (c1, v1) in force.row(e) {
@@ -207,11 +187,7 @@ impl ClarabelRows {
 fn clarabel_equalities(inp: &QpInput, cols: &ClarabelColumns) -> ClarabelRows {
     let (force, tau_col, r_start) = (cols.force, &cols.tau_col, cols.r_start);
     let incident = incident_edges(inp);
-    let mut a = Triplets {
-        i: vec![],
-        j: vec![],
-        v: vec![],
-    };
+    let mut a = Triplets::default();
     let mut b = Vec::new();
     let mut row = 0;
     // Vertical residuals: Σ_e (z_i − z_j) q_e − r_i = p_i.

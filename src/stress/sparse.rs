@@ -1,6 +1,26 @@
 //! A minimal compressed-row matrix: the force map q = S y is built row by row (one row per
-//! edge) and consumed row by row when the QP is assembled; and compressed patterns built from
-//! their entries (`bucketed`).
+//! edge) and consumed row by row when the QP is assembled; compressed patterns built from
+//! their entries (`bucketed`); and the (row, column, value) lists clarabel's matrices are
+//! built from (`Triplets`).
+
+/// Entries of a sparse matrix as (row, column, value) lists, zeros left out; repeated
+/// positions add up when clarabel compresses them.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Triplets {
+    pub i: Vec<usize>,
+    pub j: Vec<usize>,
+    pub v: Vec<f64>,
+}
+
+impl Triplets {
+    pub fn push(&mut self, i: usize, j: usize, v: f64) {
+        if v != 0.0 {
+            self.i.push(i);
+            self.j.push(j);
+            self.v.push(v);
+        }
+    }
+}
 
 /// Compressed sparse rows; duplicate entries within a row are summed on construction.
 #[derive(Debug, Clone, Default)]
