@@ -57,9 +57,10 @@ pub(super) fn solve(
     let start = Instant::now();
     let layout = Layout::new(model);
     let mut search = Search::new(model, settings);
-    // The other analyses' start (`fit` until certified) keeps the QP's correction: its
-    // answer is their starting point, not the nearest surface.
-    if model.objective == Objective::Fit && until == Until::Optimal {
+    // `fit`'s searches, the other analyses' start included, correct a step along the heights
+    // first (`projected`), so that the start reaches a certified surface instead of creeping
+    // with residuals just above the certificate's.
+    if model.objective == Objective::Fit {
         search.heights = ShapeStep::new(&model.problem.mesh).ok();
     }
     match from {
@@ -167,8 +168,8 @@ struct Search<'m, 'a> {
     /// The best certified state lies on a ray of certified surfaces along which the
     /// objective has no bound (the greatest thrust and the largest load only; ray.rs).
     unbounded: bool,
-    /// The height solve of `fit`'s projected correction (none for the other analyses and
-    /// their start, or where its analysis failed).
+    /// The height solve of `fit`'s projected correction (none for the other analyses' own
+    /// searches, or where its analysis failed).
     heights: Option<ShapeStep>,
 }
 
