@@ -283,7 +283,9 @@ pub fn form_find(
 /// equilibrium starts over for the edited input; a `previous` of the paper's loop starts it
 /// as a cold run does. A `previous` whose forces are not a solved stress step's gives no
 /// proximal centre. A `previous` whose input hung (`mirrored`), or an edited input that
-/// hangs, is re-solved cold (the mirror image depends on the input's forces).
+/// hangs, is re-solved cold (the mirror image depends on the input's forces), and so is an edit
+/// that is not small: `previous` farther from the edited input (area-weighted RMS height
+/// change over the plan diagonal) than twice its own RMS change plus 0.01.
 ///
 /// The nearest shape is a local optimum: a cold run and a warm one of the same edited
 /// problem may end at different ones (measured on the shared models: the warm answer within
