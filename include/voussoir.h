@@ -286,9 +286,10 @@ enum VsrTermination
    */
   VSR_TERMINATION_CANCELLED = 5,
   /**
-   * The shape cannot be balanced under the stress constraints within the height limit
-   * (`vsr_settings_set_max_height_change`): `vsr_result_termination_message` names what
-   * blocks (q_max or the limit) and `vsr_result_stalled_vertices` lists where.
+   * No state in equilibrium under the stress constraints was reached within the height
+   * limit (`vsr_settings_set_max_height_change`) or below q_max (a local search: no proof
+   * that none exists): `vsr_result_termination_message` names what held it (q_max or the
+   * limit) and `vsr_result_stalled_vertices` lists where.
    */
   VSR_TERMINATION_BLOCKED = 6,
 };
@@ -1322,8 +1323,8 @@ VsrStatus vsr_settings_set_fairness(struct VsrSettings *settings, double gamma);
 
 /**
  * Sets the largest height change form finding may make at any vertex (either method), in
- * plan bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within
- * it ends `VSR_TERMINATION_BLOCKED`.
+ * plan bounding-box diagonals. Finite and > 0. Default 1. A run that reaches no state in
+ * equilibrium within it ends `VSR_TERMINATION_BLOCKED`.
  *
  * # Safety
  * `settings`: a valid handle with exclusive access.

@@ -400,8 +400,8 @@ pub unsafe extern "C" fn vsr_settings_set_fairness(
 }
 
 /// Sets the largest height change form finding may make at any vertex (either method), in
-/// plan bounding-box diagonals. Finite and > 0. Default 1. A shape that cannot stand within
-/// it ends `VSR_TERMINATION_BLOCKED`.
+/// plan bounding-box diagonals. Finite and > 0. Default 1. A run that reaches no state in
+/// equilibrium within it ends `VSR_TERMINATION_BLOCKED`.
 ///
 /// # Safety
 /// `settings`: a valid handle with exclusive access.

@@ -111,9 +111,10 @@ pub enum VsrTermination {
     NumericalError = 4,
     /// The progress callback returned non-zero.
     Cancelled = 5,
-    /// The shape cannot be balanced under the stress constraints within the height limit
-    /// (`vsr_settings_set_max_height_change`): `vsr_result_termination_message` names what
-    /// blocks (q_max or the limit) and `vsr_result_stalled_vertices` lists where.
+    /// No state in equilibrium under the stress constraints was reached within the height
+    /// limit (`vsr_settings_set_max_height_change`) or below q_max (a local search: no proof
+    /// that none exists): `vsr_result_termination_message` names what held it (q_max or the
+    /// limit) and `vsr_result_stalled_vertices` lists where.
     Blocked = 6,
 }
 

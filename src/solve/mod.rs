@@ -40,12 +40,14 @@ pub enum Termination {
     },
     /// The progress callback asked to stop.
     Cancelled,
-    /// The shape cannot be balanced under the stress constraints within the height limit
-    /// ([`FormFindSettings::max_height_change`]): `hint` names what blocks (q_max holding the
-    /// force densities down, or the height limit) and `vertices` lists where: at the height
-    /// limit, the region that cannot stand within it (the vertices that reached the limit, with
-    /// those furthest from balance in the answer); where q_max blocks, the vertices beside
-    /// edges at q_max with the largest residuals.
+    /// No state in equilibrium under the stress constraints was reached within the height
+    /// limit ([`FormFindSettings::max_height_change`]) or below q_max: `hint` names what held
+    /// the search (q_max holding the force densities down, or the height limit) and `vertices`
+    /// lists where: at the height limit, the vertices that reached it with those furthest from
+    /// balance in the answer; where q_max holds, the vertices beside edges at q_max with the
+    /// largest residuals. The search is local: it is no proof that no such state exists (a
+    /// flat 9 × 9 grid under a limit of 0.25 diagonals ends here, while its nearest shape
+    /// without the limit moves 0.15).
     Blocked {
         /// Where it is blocked.
         vertices: Vec<u32>,
@@ -116,7 +118,7 @@ pub struct FormFindSettings {
     /// shape; larger values spread a change over a wider, smoother patch. Default 0.03.
     pub fairness: f64,
     /// Largest height change allowed at any vertex, in plan bounding-box diagonals (both
-    /// methods). A shape that cannot stand within it ends `Blocked`. Default 1.
+    /// methods). A run that reaches no state in equilibrium within it ends `Blocked`. Default 1.
     pub max_height_change: f64,
     /// Stop when ε∞ = max|r_i| / mean p_i < tolerance. Default 1e-6.
     pub tolerance: f64,
@@ -570,7 +572,7 @@ fn meets_bounds(
 
 /// What blocks a loop whose heights reached the limit, where q_max does not.
 const LIMIT_HINT: &str =
-    "the shape cannot stand within the height limit: the vertices that reached \
+    "no state in equilibrium was reached within the height limit: the vertices that reached \
     it, and those furthest from balance in the answer (raise max_height_change)";
 
 /// The region a blocked loop names: `limited` (the vertices held at the height limit) with the
