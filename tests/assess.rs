@@ -171,6 +171,41 @@ fn unit_weight_scales_forces_not_the_surface() {
     assert!((ratio - 25.0).abs() < 25.0 * 1e-4, "thrust ratio {ratio}");
 }
 
+/// The largest load does not depend on the pattern's scale: λ × pattern is the same load
+/// whether the pattern is given in newtons or in kilonewtons (it ranged from 0 to 18 000
+/// with the pattern scaled by 0.1 and by 1 when the search ran in the pattern's own units).
+#[test]
+fn max_load_does_not_depend_on_the_patterns_scale() {
+    let mesh = generate::cap_dome(0.9, 120).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.15)).unwrap();
+    let n = mesh.positions().len();
+    let target = (0..n).find(|&v| !mesh.anchored()[v]).unwrap();
+    let loads: Vec<(f64, AssessResult)> = [1.0, 10.0, 0.1, 1e-3]
+        .into_iter()
+        .map(|scale| {
+            let mut pattern = vec![0.0; n];
+            pattern[target] = 0.05 * scale;
+            // The same path whatever the scale, to any step.
+            let settings = AssessSettings::default()
+                .with_objective(Objective::MaxLoad)
+                .with_load_pattern(pattern)
+                .with_max_iterations(20);
+            let result = run(mesh.clone(), &envelope, settings);
+            (result.load_factor * 0.05 * scale, result)
+        })
+        .collect();
+    let (first, base) = &loads[0];
+    assert!(*first > 0.0, "{first}");
+    for (load, result) in &loads[1..] {
+        assert!(
+            (load - first).abs() <= 1e-9 * first,
+            "{load} against {first}"
+        );
+        assert_eq!(result.iterations, base.iterations);
+        assert_eq!(result.termination, base.termination);
+    }
+}
+
 /// The largest load factor: a certified surface under self-weight plus λ × the pattern.
 #[test]
 fn max_load_is_certified_with_its_factor() {

@@ -33,9 +33,13 @@ pub(super) struct Model<'a> {
     /// Physical self-weight plus extra loads, and the live pattern, per vertex.
     pub dead_physical: Vec<f64>,
     pub live_physical: Vec<f64>,
-    /// Frame loads per vertex.
+    /// Frame loads per vertex: the dead loads over p̄, the live pattern over its own mean on
+    /// the non-anchored vertices (so that the search's scalar is the same whatever the
+    /// pattern's scale).
     pub dead: Vec<f64>,
     pub live: Vec<f64>,
+    /// λ per unit of the search's scalar: p̄ over the live pattern's mean (1 without one).
+    pub live_unit: f64,
     /// Frame middle heights and half extents per vertex.
     pub middle: Vec<f64>,
     pub half: Vec<f64>,
@@ -120,6 +124,11 @@ impl<'a> Model<'a> {
         let live_physical = live_pattern(problem, settings)?;
         let residual = crate::stress::non_anchored(mesh);
         let p_bar = mean_load(&dead_physical, &residual)?;
+        let live_mean = (residual.iter())
+            .map(|&v| live_physical[v as usize])
+            .sum::<f64>()
+            / residual.len().max(1) as f64;
+        let live_scale = if live_mean > 0.0 { live_mean } else { p_bar };
         let stress_settings = StressSettings {
             q_min: settings.q_min,
             tau: TauMode::Zero,
@@ -155,7 +164,8 @@ impl<'a> Model<'a> {
             p_bar,
             l0,
             dead: dead_physical.iter().map(|p| p / p_bar).collect(),
-            live: live_physical.iter().map(|p| p / p_bar).collect(),
+            live: live_physical.iter().map(|p| p / live_scale).collect(),
+            live_unit: p_bar / live_scale,
             dead_physical,
             live_physical,
             middle: envelope.middle.iter().map(|m| m / l0).collect(),
@@ -367,7 +377,7 @@ impl<'a> Model<'a> {
         let unit = self.p_bar / self.l0;
         let force_densities: Vec<f64> = state.q.iter().map(|q| q * unit).collect();
         let lambda = if self.objective == Objective::MaxLoad {
-            state.t
+            state.t * self.live_unit
         } else {
             0.0
         };
