@@ -25,8 +25,8 @@ pub(crate) fn read_obj_split(path: &Path) -> Result<(RawMesh, Vec<[u32; 2]>)> {
 /// comments and blank lines).
 pub const IGNORED_KEYWORDS: [&str; 9] = ["vn", "vt", "vp", "g", "o", "s", "usemtl", "mtllib", "l"];
 
-/// Parses OBJ text: `v x y z` lines give vertices (extra values such as `w` or colours are
-/// ignored), `f` lines give faces with 1-based indices, in any of the forms `i`, `i/t`,
+/// Parses OBJ text (lines ending in LF, CR LF or CR): `v x y z` lines give vertices (up to
+/// four numbers after them, `w` or colours `r g b`, are ignored), `f` lines give faces with 1-based indices, in any of the forms `i`, `i/t`,
 /// `i//n`, `i/t/n`; negative indices count back from the last vertex read so far. Polygons
 /// are split into a fan of triangles `(p0, p[i], p[i+1])`. Blank lines, comments (`#`) and
 /// the statements in [`IGNORED_KEYWORDS`] (normals, texture coordinates, groups, materials,
@@ -34,7 +34,8 @@ pub const IGNORED_KEYWORDS: [&str; 9] = ["vn", "vt", "vp", "g", "o", "s", "usemt
 ///
 /// Errors are [`Error::Parse`] with `path_label` and the 1-based line: any other statement
 /// (a misspelt `F`, `f,`, a keyword behind an invisible character: skipping it would drop a
-/// face or a vertex unseen), a vertex with fewer than 3 coordinates or a bad number, a face
+/// face or a vertex unseen), a vertex with fewer than 3 coordinates, a bad number, or anything but up to four numbers
+/// after its coordinates (`v 0 0 0 v 1 0 0`: statements run together), a face
 /// with fewer than 3 vertices or with a vertex listed twice (`f 1 2 2`: a face without area,
 /// which a mesh cannot hold; the message says to remove the repeated vertex), an index that is
 /// not an integer, is 0, or refers past the last vertex of the file (or, when negative, before
@@ -58,6 +59,12 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
     let mut diagonals: Vec<[u32; 2]> = Vec::new();
 
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Classic Mac OS ends lines with CR alone: read as one line, its vertices would be lost.
+    let text: std::borrow::Cow<str> = if text.contains('\r') {
+        text.replace("\r\n", "\n").replace('\r', "\n").into()
+    } else {
+        text.into()
+    };
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let content = raw.split('#').next().unwrap_or("");
@@ -76,6 +83,7 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
                         err(line, format!("bad number `{}` in vertex", excerpt(tok)))
                     })?;
                 }
+                check_vertex_extras(tokens).map_err(|r| err(line, r))?;
                 positions.push(p);
             }
             Some("f") => {
@@ -129,6 +137,23 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
 }
 
 /// The 0-based vertex index of one face token (`i`, `i/t`, `i//n`, `i/t/n`), given the
+
+/// The tokens after a vertex's x y z: at most four numbers (`w`, colours `r g b`), ignored;
+/// anything else is statements run together on one line, whose vertices would be lost.
+fn check_vertex_extras<'a>(
+    tokens: impl Iterator<Item = &'a str>,
+) -> std::result::Result<(), String> {
+    for (k, tok) in tokens.enumerate() {
+        if k >= 4 || tok.parse::<f64>().is_err() {
+            return Err(format!(
+                "`{}` after the vertex's coordinates: only up to four numbers (w, or colours \
+                 r g b) may follow x y z, one statement per line",
+                excerpt(tok)
+            ));
+        }
+    }
+    Ok(())
+}
 /// number of vertices read so far (for negative, relative indices).
 fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, String> {
     let text = token.split('/').next().unwrap_or("");

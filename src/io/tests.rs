@@ -95,6 +95,39 @@ fn a_byte_order_mark_at_the_start_is_skipped() {
 }
 
 #[test]
+fn lines_may_end_in_cr_alone_or_cr_lf() {
+    for text in [
+        "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r",
+        "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3",
+    ] {
+        let (positions, faces) = parse_obj(text, "x").unwrap();
+        assert_eq!(positions, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(faces, vec![[0, 1, 2]]);
+    }
+    // Line numbers count CR LF as one ending.
+    assert_eq!(parse_line_error("v 0 0 0\r\nv 1 0\r\n").0, 2);
+    assert_eq!(parse_line_error("v 0 0 0\rv 1 0\r").0, 2);
+}
+
+#[test]
+fn a_vertex_may_carry_w_or_colours_but_not_another_statement() {
+    let (positions, _) = parse_obj("v 0 0 1 0.5 0.2 0.1\nv 1 0 0 1\nv 0 1 0\n", "x").unwrap();
+    assert_eq!(positions[0], [0.0, 0.0, 1.0]);
+    for text in [
+        "v 0 0 0 1 2 3 v 4 5 6 f 1 2 3\n",
+        "v 0 0 0 1 2 3 4 5\n",
+        "v 0 0 0 x\n",
+    ] {
+        let (line, reason) = parse_line_error(text);
+        assert_eq!(line, 1, "{text:?}");
+        assert!(
+            reason.contains("after the vertex's coordinates"),
+            "{reason}"
+        );
+    }
+}
+
+#[test]
 fn faces_may_refer_to_later_vertices() {
     let (positions, faces) = parse_obj("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", "x").unwrap();
     assert_eq!(positions.len(), 3);
