@@ -41,14 +41,20 @@ fn rows<T: numpy::Element + Copy>(
 }
 
 /// Vertex or face ids: non-negative and within u32.
-fn ids(name: &str, values: Vec<i64>) -> PyResult<Vec<u32>> {
+fn ids(name: &str, values: Vec<i64>, width: usize) -> PyResult<Vec<u32>> {
     values
         .iter()
         .enumerate()
         .map(|(i, &v)| {
             u32::try_from(v).map_err(|_| {
+                // Rows name the face (or pair) and its place, not the flattened entry.
+                let at = match width {
+                    1 => format!("entry {i}"),
+                    3 => format!("face {}, corner {}", i / 3, i % 3),
+                    _ => format!("row {}, entry {}", i / width, i % width),
+                };
                 VoussoirError::new_err(format!(
-                    "argument `{name}`: entry {i} is {v}, not a vertex id (0 to {})",
+                    "argument `{name}`: {at} is {v}, not a vertex id (0 to {})",
                     u32::MAX
                 ))
             })
@@ -162,7 +168,7 @@ fn with_diagonals(problem: Problem, pairs: &PyReadonlyArrayDyn<'_, i64>) -> PyRe
     let name = "polygon_diagonals";
     let flat = match pairs.shape() {
         [0] => Vec::new(),
-        _ => ids(name, rows(name, pairs, 2)?)?,
+        _ => ids(name, rows(name, pairs, 2)?, 2)?,
     };
     let pairs: Vec<[u32; 2]> = flat.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
     problem.with_polygon_diagonals(&pairs).map_err(|e| match e {
@@ -224,8 +230,8 @@ impl Mesh {
         polygon_diagonals: Option<PyReadonlyArrayDyn<'_, i64>>,
     ) -> PyResult<Mesh> {
         let positions = triples(&rows("vertices", &vertices, 3)?);
-        let faces = triples(&ids("faces", rows("faces", &faces, 3)?)?);
-        let anchored = ids("anchored", rows("anchored", &anchored, 1)?)?;
+        let faces = triples(&ids("faces", rows("faces", &faces, 3)?, 3)?);
+        let anchored = ids("anchored", rows("anchored", &anchored, 1)?, 1)?;
         let mesh =
             RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("faces", e))?;
         let problem = with_loads(
@@ -265,7 +271,7 @@ impl Mesh {
         prescribed_tau: Array<'_>,
     ) -> PyResult<Mesh> {
         let given = match &anchored {
-            Some(a) => Some(ids("anchored", rows("anchored", a, 1)?)?),
+            Some(a) => Some(ids("anchored", rows("anchored", a, 1)?, 1)?),
             None => None,
         };
         let supports = supports_of(supports, given, anchor_boundary, anchor_lowest)?;

@@ -87,6 +87,15 @@ def test_python_only_shapes_and_id_types():
         F,
         [-1],
     )
+    negative = [list(f) for f in F]
+    negative[1][2] = -1
+    raises(
+        "argument `faces`: face 1, corner 2 is -1, not a vertex id (0 to 4294967295)",
+        voussoir.Mesh,
+        V,
+        negative,
+        A,
+    )
 
 
 def test_stacked_plan_overlaps():
