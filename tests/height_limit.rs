@@ -42,6 +42,11 @@ fn walled_vault(seed: u64, noise: f64) -> Mesh {
             }
         }
     }
+    Mesh::new(positions, grid_faces(k), &anchored).expect("walled vault")
+}
+
+/// The two triangles of every cell of a k × k grid of vertices numbered row by row.
+fn grid_faces(k: usize) -> Vec<[u32; 3]> {
     let at = |i: usize, j: usize| (i * k + j) as u32;
     let mut faces = Vec::new();
     for i in 0..k - 1 {
@@ -50,7 +55,7 @@ fn walled_vault(seed: u64, noise: f64) -> Mesh {
             faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
         }
     }
-    Mesh::new(positions, faces, &anchored).expect("walled vault")
+    faces
 }
 
 /// The largest height change over the plan bounding-box diagonal, measured here.
@@ -134,15 +139,7 @@ fn jittered_bump() -> Mesh {
             positions.push([x, y, (pi * x).sin() * (pi * y).sin()]);
         }
     }
-    let at = |i: usize, j: usize| (i * k + j) as u32;
-    let mut faces = Vec::new();
-    for i in 0..k - 1 {
-        for j in 0..k - 1 {
-            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-        }
-    }
-    Mesh::new(positions, faces, &anchored).expect("jittered bump")
+    Mesh::new(positions, grid_faces(k), &anchored).expect("jittered bump")
 }
 
 /// ODT sweeps resample heights as they move the plan: both methods bring those back within
