@@ -136,8 +136,6 @@ pub(crate) fn parse_obj_split(text: &str, path_label: &str) -> Result<(RawMesh, 
     Ok(((positions, faces), diagonals))
 }
 
-/// The 0-based vertex index of one face token (`i`, `i/t`, `i//n`, `i/t/n`), given the
-
 /// The tokens after a vertex's x y z: at most four numbers (`w`, colours `r g b`), ignored;
 /// anything else is statements run together on one line, whose vertices would be lost.
 fn check_vertex_extras<'a>(
@@ -154,6 +152,8 @@ fn check_vertex_extras<'a>(
     }
     Ok(())
 }
+
+/// The 0-based vertex index of one face token (`i`, `i/t`, `i//n`, `i/t/n`), given the
 /// number of vertices read so far (for negative, relative indices).
 fn resolve_index(token: &str, n_so_far: usize) -> std::result::Result<u32, String> {
     let text = token.split('/').next().unwrap_or("");
