@@ -103,7 +103,7 @@ pub fn from_files(mesh_path: &Path, o: &Options) -> Result<Model, String> {
             });
         }
         Err(voussoir::Error::InvalidArgument {
-            name: "weld tolerance",
+            name: "weld_tolerance",
             reason,
         }) => return Err(format!("--weld: {reason} (or --no-weld)")),
         Err(e @ voussoir::Error::InvalidAnchor { .. }) => {

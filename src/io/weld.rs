@@ -70,7 +70,7 @@ impl Welded {
 pub fn weld(positions: &[[f64; 3]], faces: &[[u32; 3]], relative_tolerance: f64) -> Result<Welded> {
     if !(relative_tolerance.is_finite() && relative_tolerance >= 0.0) {
         return Err(Error::InvalidArgument {
-            name: "weld tolerance",
+            name: "weld_tolerance",
             reason: format!("{relative_tolerance} is not a finite number >= 0"),
         });
     }
@@ -100,7 +100,7 @@ pub fn weld(positions: &[[f64; 3]], faces: &[[u32; 3]], relative_tolerance: f64)
     }
     if new_faces.is_empty() && !faces.is_empty() {
         return Err(Error::InvalidArgument {
-            name: "weld tolerance",
+            name: "weld_tolerance",
             reason: format!(
                 "welding within {tolerance:.4e} ({relative_tolerance:e} x the bounding-box \
                  diagonal) merges two corners of every face ({} in all), so no face is left: \

@@ -140,7 +140,7 @@ fn tolerance_is_relative_to_the_bounding_box() {
         assert!(matches!(
             weld(&soup, &soup_faces, bad),
             Err(Error::InvalidArgument {
-                name: "weld tolerance",
+                name: "weld_tolerance",
                 ..
             })
         ));
@@ -174,7 +174,7 @@ fn welding_every_face_away_names_the_tolerance() {
     ];
     let err = weld(&positions, &[[0, 1, 2]], 1e-9).unwrap_err();
     assert!(
-        matches!(&err, Error::InvalidArgument { name: "weld tolerance", reason }
+        matches!(&err, Error::InvalidArgument { name: "weld_tolerance", reason }
             if reason.contains("every face (1 in all)")),
         "{err}"
     );
