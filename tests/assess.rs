@@ -206,6 +206,53 @@ fn max_load_does_not_depend_on_the_patterns_scale() {
     }
 }
 
+/// A longer search never answers a smaller load: on an 8 × 8 grid dome with a point load
+/// (whose load has no visible bound) the search ran uncertified while λ grew, its last polish
+/// failed, and 200 steps answered the start's λ = 0 where 30 steps certified 0.98.
+#[test]
+fn a_longer_max_load_search_answers_at_least_the_shorter_ones_load() {
+    let k = 8;
+    let mut positions = Vec::new();
+    let mut anchored = Vec::new();
+    for j in 0..k {
+        for i in 0..k {
+            let (x, y) = (i as f64 / (k - 1) as f64, j as f64 / (k - 1) as f64);
+            let pi = std::f64::consts::PI;
+            if i == 0 || j == 0 || i == k - 1 || j == k - 1 {
+                anchored.push(positions.len() as u32);
+            }
+            positions.push([x, y, 0.4 * (pi * x).sin() * (pi * y).sin()]);
+        }
+    }
+    let mut faces = Vec::new();
+    for j in 0..k - 1 {
+        for i in 0..k - 1 {
+            let a = (j * k + i) as u32;
+            let (b, c, d) = (a + 1, a + k as u32, a + k as u32 + 1);
+            faces.extend([[a, b, d], [a, d, c]]);
+        }
+    }
+    let mesh = Mesh::new(positions, faces, &anchored).unwrap();
+    let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.1)).unwrap();
+    let mut pattern = vec![0.0; k * k];
+    pattern[35] = 1.0;
+    let loads: Vec<f64> = [30, 200]
+        .into_iter()
+        .map(|steps| {
+            let settings = AssessSettings::default()
+                .with_objective(Objective::MaxLoad)
+                .with_fixed_supports(true)
+                .with_load_pattern(pattern.clone())
+                .with_max_iterations(steps);
+            let r = run(mesh.clone(), &envelope, settings);
+            check_certificate(&mesh, &envelope, &r, 1e-6);
+            r.load_factor
+        })
+        .collect();
+    assert!(loads[0] > 0.0, "{loads:?}");
+    assert!(loads[1] >= loads[0], "{loads:?}");
+}
+
 /// The largest load factor: a certified surface under self-weight plus λ × the pattern.
 #[test]
 fn max_load_is_certified_with_its_factor() {

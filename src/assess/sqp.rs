@@ -32,6 +32,9 @@ const RHO_MAX: f64 = 1e8;
 const NU_RANGE: f64 = 1e8;
 /// Steps at most that bring the last state into equilibrium after the search.
 const POLISH_STEPS: usize = 30;
+/// A checkpoint (`Search::checkpoint`) once the load has grown this many times past the last
+/// certified one.
+const CHECKPOINT_GROWTH: f64 = 10.0;
 /// The search holds the residuals to this fraction of the tolerance.
 const FEASIBILITY_MARGIN: f64 = 0.1;
 
@@ -77,7 +80,10 @@ pub(super) fn solve(
         }
         iterations += 1;
         match search.iterate(&layout) {
-            Outcome::Continue => {}
+            Outcome::Continue => {
+                let left = settings.max_iterations.saturating_sub(iterations);
+                iterations += search.checkpoint(&layout, left);
+            }
             Outcome::Stationary => {
                 termination = search.stationary_termination();
                 break;
@@ -171,6 +177,8 @@ struct Search<'m, 'a> {
     /// The height solve of `fit`'s projected correction (none for the other analyses' own
     /// searches, or where its analysis failed).
     heights: Option<ShapeStep>,
+    /// −f where the last checkpoint was tried (see `checkpoint`).
+    checkpoint_at: f64,
 }
 
 impl<'m, 'a> Search<'m, 'a> {
@@ -198,6 +206,7 @@ impl<'m, 'a> Search<'m, 'a> {
             unbounded: false,
             settings: settings.clone(),
             heights: None,
+            checkpoint_at: 0.0,
         }
     }
 
@@ -235,16 +244,48 @@ impl<'m, 'a> Search<'m, 'a> {
     /// steps: the best certified state then lies near where the search ended, not only
     /// where it last happened to be feasible. Returns the steps taken.
     fn polish(&mut self, layout: &Layout) -> usize {
+        self.polish_within(layout, POLISH_STEPS)
+    }
+
+    /// `polish` with at most `most` steps.
+    fn polish_within(&mut self, layout: &Layout, most: usize) -> usize {
         self.polishing = true;
         self.rho = RHO_START;
         let mut steps = 0;
-        while self.residual > self.feasible_below && steps < POLISH_STEPS {
+        while self.residual > self.feasible_below && steps < most {
             steps += 1;
             self.nu = (self.nu * 1e3).min(self.nu_max);
             if let Outcome::Stationary | Outcome::Infeasible = self.iterate(layout) {
                 break;
             }
         }
+        steps
+    }
+
+    /// The largest load only: where the load has grown tenfold past the best certified one
+    /// (and the last checkpoint) while the residuals stay above target, the current state is
+    /// brought into equilibrium at a dear penalty (at most `left` steps, `polish`'s), so that
+    /// the answer, the best certified state, follows the search: a search that runs
+    /// uncertified while λ grows without visible bound ended where its last polish failed,
+    /// with the start's λ = 0 after 200 steps where 30 steps certified a load. The search
+    /// then goes on from the polished state with its own ρ and ν. Returns the steps taken.
+    fn checkpoint(&mut self, layout: &Layout, left: usize) -> usize {
+        let grown = -self.model.objective_value(&self.state);
+        let certified = self.best_feasible.as_ref().map_or(0.0, |(f, _)| -f);
+        let reference = certified
+            .max(self.checkpoint_at)
+            .max(self.objective_floor());
+        if self.model.objective != Objective::MaxLoad
+            || self.polishing
+            || self.residual <= self.feasible_below
+            || grown <= CHECKPOINT_GROWTH * reference
+        {
+            return 0;
+        }
+        self.checkpoint_at = grown;
+        let (nu, rho, grow) = (self.nu, self.rho, self.grow);
+        let steps = self.polish_within(layout, left.min(POLISH_STEPS));
+        (self.nu, self.rho, self.grow, self.polishing) = (nu, rho, grow, false);
         steps
     }
 
