@@ -265,10 +265,9 @@ impl<'m, 'a> Search<'m, 'a> {
     /// The largest load only: where the load has grown tenfold past the best certified one
     /// (and the last checkpoint) while the residuals stay above target, the current state is
     /// brought into equilibrium at a dear penalty (at most `left` steps, `polish`'s), so that
-    /// the answer, the best certified state, follows the search: a search that runs
-    /// uncertified while λ grows without visible bound ended where its last polish failed,
-    /// with the start's λ = 0 after 200 steps where 30 steps certified a load. The search
-    /// then goes on from the polished state with its own ρ and ν. Returns the steps taken.
+    /// the answer, the best certified state, keeps up with a search whose load grows without
+    /// visible bound. The search then goes on from the polished state with its own ρ and ν.
+    /// Returns the steps taken.
     fn checkpoint(&mut self, layout: &Layout, left: usize) -> usize {
         let grown = -self.model.objective_value(&self.state);
         let certified = self.best_feasible.as_ref().map_or(0.0, |(f, _)| -f);

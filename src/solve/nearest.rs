@@ -102,8 +102,7 @@ pub(super) fn nearest_from(
 /// Whether `previous` lies farther from the edited input (area-weighted RMS height change
 /// over the plan diagonal) than twice its own change from its input plus a hundredth of the
 /// diagonal: no small edit (a model rescaled, a region redrawn), whose continuation from there
-/// would settle far from the cold answer (three_pillar rescaled by 1000: RMS change 0.21
-/// against the cold run's 0.014).
+/// would settle near the previous answer, far from the cold one (method.md §13.4).
 fn far_from_edited(problem: &Problem, previous: &FormFindResult) -> bool {
     let (rms, _) = super::height_change(problem, &previous.positions);
     rms > 2.0 * previous.rms_change + 0.01

@@ -122,11 +122,12 @@ pub(super) fn polish(
         let z_new: Vec<f64> = step.multiplier.iter().map(|v| v.max(0.0)).collect();
         Kkt::new(qp, normal, &step.x, &step.lambda, &s_new, &z_new)
     };
+    // An inactive row is violated beyond its own bound's tolerance, not the residuals'
+    // global scale, which large Airy values inflate far beside the bounds.
+    let violated =
+        |step: &PolishStep, i: usize| step.slack[i] < -row_tolerance(qp, &step.x, i, tol);
     // Rows where the step contradicts the guess: inactive rows it violates, active rows
     // whose multiplier comes out negative.
-    // An inactive row is violated beyond its own bound's tolerance and the rounding of its
-    // terms, not the residuals' global scale: where Airy values are large beside the bounds
-    // that scale let answers 3 % below q_min pass as solved.
     let wrong_rows = |step: &PolishStep, kkt: &Kkt, active: &[bool]| -> Vec<usize> {
         let negative = tol.dual_feas * kkt.dual_scale;
         (0..m)
@@ -134,14 +135,13 @@ pub(super) fn polish(
                 if active[i] {
                     step.multiplier[i] < -negative
                 } else {
-                    step.slack[i] < -row_tolerance(qp, &step.x, i, tol)
+                    violated(step, i)
                 }
             })
             .collect()
     };
-    let feasible = |step: &PolishStep, active: &[bool]| {
-        (0..m).all(|i| active[i] || step.slack[i] >= -row_tolerance(qp, &step.x, i, tol))
-    };
+    let feasible =
+        |step: &PolishStep, active: &[bool]| (0..m).all(|i| active[i] || !violated(step, i));
     for _ in 0..rounds {
         let correctable = match corrections {
             Corrections::Few => {
