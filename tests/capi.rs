@@ -104,7 +104,7 @@ fn mesh_create_rejects_empty_input() {
             &mut out,
         )
     };
-    assert_failed(s, S::EmptyMesh, "positions");
+    assert_failed(s, S::EmptyMesh, "triangles");
     assert_eq!(out, sentinel());
 }
 

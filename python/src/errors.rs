@@ -23,7 +23,7 @@ pub fn from_error(arg: &str, e: Error) -> PyErr {
     use Error::*;
     let arg = match &e {
         InvalidArgument { name, .. } => python_name(name),
-        EmptyMesh | NonFiniteCoordinate { .. } => "vertices",
+        NonFiniteCoordinate { .. } => "vertices",
         DegenerateFaces { .. }
         | FlippedFaces { .. }
         | OverlappingPlan { .. }

@@ -232,8 +232,13 @@ impl Mesh {
         let positions = triples(&rows("vertices", &vertices, 3)?);
         let faces = triples(&ids("faces", rows("faces", &faces, 3)?, 3)?);
         let anchored = ids("anchored", rows("anchored", &anchored, 1)?, 1)?;
-        let mesh =
-            RustMesh::new(positions, faces, &anchored).map_err(|e| from_error("faces", e))?;
+        // An empty mesh is the fault of whichever array is empty.
+        let arg = if positions.is_empty() {
+            "vertices"
+        } else {
+            "faces"
+        };
+        let mesh = RustMesh::new(positions, faces, &anchored).map_err(|e| from_error(arg, e))?;
         let problem = with_loads(
             Problem::new(mesh),
             face_density,

@@ -50,6 +50,27 @@ def test_empty_mesh():
         F,
         A,
     )
+    raises(
+        "argument `faces`: empty mesh: it needs at least one vertex and one face",
+        voussoir.Mesh,
+        V,
+        np.zeros((0, 3), dtype=np.int64),
+        A,
+    )
+
+
+def test_ragged_faces_and_wrong_types_name_the_argument():
+    ragged = [list(f) for f in F]
+    ragged[1] = ragged[1][:2]
+    with pytest.raises(voussoir.VoussoirError, match=r"^argument `faces`: is not an array of integer ids"):
+        voussoir.Mesh(V, ragged, A)
+    raises("argument `up`: None is not a string", voussoir.Mesh.from_file, "any.obj", up=None)
+    raises(
+        "argument `weld_tolerance`: 'fine' is not a number",
+        voussoir.Mesh.from_file,
+        "any.obj",
+        weld_tolerance="fine",
+    )
 
 
 def test_out_of_range_ids_and_nan_coordinates():

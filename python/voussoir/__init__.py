@@ -63,7 +63,10 @@ def _floats(name: str, value: Any) -> Optional[np.ndarray]:
 
 
 def _ids(name: str, value: Any) -> np.ndarray:
-    array = np.asarray(value)
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError) as e:
+        raise VoussoirError(f"argument `{name}`: is not an array of integer ids ({e})") from None
     if array.size == 0:
         return np.zeros(array.shape, dtype=np.int64)
     if array.dtype.kind not in "iu":
@@ -73,6 +76,19 @@ def _ids(name: str, value: Any) -> np.ndarray:
     if array.dtype.kind == "u" and array.size and array.max() > np.iinfo(np.int64).max:
         raise VoussoirError(f"argument `{name}`: holds an id beyond 2^63")
     return np.ascontiguousarray(array, dtype=np.int64)
+
+
+def _number(name: str, value: Any) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise VoussoirError(f"argument `{name}`: {value!r} is not a number") from None
+
+
+def _text(name: str, value: Any) -> str:
+    if not isinstance(value, str):
+        raise VoussoirError(f"argument `{name}`: {value!r} is not a string")
+    return value
 
 
 def _required(name: str, value: Any) -> Any:
@@ -182,17 +198,21 @@ class Mesh:
         elif weld_tolerance is None:
             tolerance = _native.WELD_TOLERANCE
         else:
-            tolerance = float(weld_tolerance)
+            tolerance = _number("weld_tolerance", weld_tolerance)
         mesh._native = _native.Mesh.read(
             os.fspath(_required("path", path)),
             None if supports is None else os.fspath(supports),
             None if anchored is None else _ids("anchored", anchored),
             tolerance,
-            _native.REPAIR_TOLERANCE if repair_tolerance is None else float(repair_tolerance),
+            (
+                _native.REPAIR_TOLERANCE
+                if repair_tolerance is None
+                else _number("repair_tolerance", repair_tolerance)
+            ),
             bool(anchor_boundary),
-            None if anchor_lowest is None else float(anchor_lowest),
+            None if anchor_lowest is None else _number("anchor_lowest", anchor_lowest),
             bool(anchor_lowest_absolute),
-            up,
+            _text("up", up),
             _floats("face_density", face_density),
             _floats("extra_loads", extra_loads),
             _floats("horizontal_forces", horizontal_forces),
@@ -509,7 +529,11 @@ def min_thickness_of_family(
     kwargs: Dict[str, Any] = dict(settings)
     kwargs.update(fixed_supports=fixed_supports, unit_weight=unit_weight)
     fields = _native.min_thickness_of_family(
-        native, member, float(thickness), float(scale_tolerance), kwargs
+        native,
+        member,
+        _number("thickness", thickness),
+        _number("scale_tolerance", scale_tolerance),
+        kwargs,
     )
     return AssessmentResult._from_native(fields, fields["thickness"])
 

@@ -327,7 +327,8 @@ pub(crate) fn from_error(arg: &str, e: Error) -> Failure {
                 format!("argument `{name}`: {reason}"),
             )
         }
-        EmptyMesh => (VsrStatus::EmptyMesh, "positions"),
+        // The caller names the empty input: an array, or the file read.
+        EmptyMesh => (VsrStatus::EmptyMesh, arg),
         IndexOutOfRange { .. } => (VsrStatus::IndexOutOfRange, "triangles"),
         InvalidAnchor { reason, .. } => (
             if *reason == "out of range" {

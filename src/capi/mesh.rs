@@ -109,7 +109,12 @@ pub unsafe extern "C" fn vsr_mesh_create(
         };
         let pos: Vec<[f64; 3]> = pos.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let tri: Vec<[u32; 3]> = tri.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let mesh = Mesh::new(pos, tri, anc).map_err(|e| from_error("triangles", e))?;
+        let arg = if pos.is_empty() {
+            "positions"
+        } else {
+            "triangles"
+        };
+        let mesh = Mesh::new(pos, tri, anc).map_err(|e| from_error(arg, e))?;
         let handle = Box::new(VsrMesh {
             problem: Problem::new(mesh),
             welded_ids: None,
