@@ -82,13 +82,13 @@ impl Layout {
 }
 
 /// A step's inputs: the proximal weight ρ, the penalty ν and, for a second-order correction,
-/// the bilinear term of the rejected trial step per residual row.
+/// the second-order terms of a trial step.
 pub(super) struct StepInput<'a> {
     /// ρ on the force densities and on the heights (and the scalar).
     pub rho: f64,
     pub rho_z: f64,
     pub nu: f64,
-    pub correction: Option<&'a [f64]>,
+    pub correction: Option<&'a Correction>,
     /// Multipliers μ of the residual rows for the Hessian of the Lagrangian (none: no
     /// curvature but the proximal term).
     pub multipliers: Option<&'a [f64]>,
@@ -116,6 +116,69 @@ pub(super) struct Step {
     pub joint_multiplier: f64,
     /// ½ dᵀ B d of the convexified Hessian of the Lagrangian (0 without multipliers).
     pub curvature: f64,
+}
+
+/// The terms a step's linearisation leaves out of the constraints, all of second order (the
+/// constraints are bilinear), evaluated on a trial step: Fletcher's second-order correction
+/// solves the step again with them on the right-hand side.
+pub(super) struct Correction {
+    /// Per residual row: Σ dq_e (dz_i − dz_j).
+    rows: Vec<f64>,
+    /// Per springing joint, in the cone's units: the bound's term and the vector's two.
+    joints: Vec<[f64; 3]>,
+}
+
+impl Correction {
+    pub fn of(model: &Model, state: &State, step: &Step) -> Self {
+        let edges = &model.problem.mesh.edges;
+        let rows = (model.residual.iter())
+            .map(|&i| {
+                let i = i as usize;
+                (model.incident[i].iter())
+                    .map(|&e| {
+                        let j = other_end(edges[e as usize].v, i);
+                        step.dq[e as usize] * (step.dz[i] - step.dz[j])
+                    })
+                    .sum()
+            })
+            .collect();
+        let joints = (0..model.joints.len())
+            .map(|k| joint_terms(model, state, step, k))
+            .collect();
+        Correction { rows, joints }
+    }
+}
+
+/// Joint k's second-order terms along `step` (`joint_cones`' products): σ b V gains
+/// b (σ dV₂ + dσ (dV₁ + dV₂)) and w H gains dw dH, over the joint's unit, where dV₁ is V's
+/// first-order change and dV₂ = Σ dq_e (dz_j − dz_a).
+fn joint_terms(model: &Model, state: &State, step: &Step, k: usize) -> [f64; 3] {
+    let joint = &model.joints[k];
+    let (a, u) = (joint.support as usize, &model.stress.plan.u);
+    let js = model.joint_state(state, k);
+    let (mut dh, mut dv1, mut dv2) = ([0.0; 2], 0.0, 0.0);
+    for &(e, j) in &joint.edges {
+        let j = j as usize;
+        for d in 0..2 {
+            dh[d] += step.dq[e] * (u[a][d] - u[j][d]);
+        }
+        let rise = step.dz[j] - step.dz[a];
+        dv1 += step.dq[e] * (state.z[j] - state.z[a]) + state.q[e] * rise;
+        dv2 += step.dq[e] * rise;
+    }
+    let (dsigma, dw) = match model.objective {
+        Objective::MinThickness => (
+            step.dt,
+            step.dz[a] + step.dt * (model.middle[a] - joint.springing),
+        ),
+        _ => (0.0, step.dz[a]),
+    };
+    let unit = joint.unit();
+    [
+        joint.reach * (js.scale * dv2 + dsigma * (dv1 + dv2)) / unit,
+        dw * dh[0] / unit,
+        dw * dh[1] / unit,
+    ]
 }
 
 /// Rows A x + s = b in cone order: zero, non-negative, then second-order cones of size 3.
@@ -167,7 +230,7 @@ pub(super) fn solve_step(
     rows.n_nonneg = rows.next() - rows.n_zero;
     thrust_cones(model, layout, state, &mut rows);
     let first_joint_row = rows.next();
-    joint_cones(model, layout, state, &mut rows);
+    joint_cones(model, layout, state, input.correction, &mut rows);
     rows.n_soc = (rows.next() - rows.n_zero - rows.n_nonneg) / 3;
     let first_residual_row = layout.q_col.iter().flatten().count();
     p.v.iter_mut().for_each(|v| *v /= unit);
@@ -401,7 +464,7 @@ fn vertical_rows(
     model: &Model,
     layout: &Layout,
     state: &State,
-    correction: Option<&[f64]>,
+    correction: Option<&Correction>,
     rows: &mut Rows,
 ) {
     let c = model.residuals(state);
@@ -426,7 +489,7 @@ fn vertical_rows(
         }
         rows.a.push(row, layout.e_plus + k, -1.0);
         rows.a.push(row, layout.e_minus + k, 1.0);
-        rows.b.push(-c[k] - correction.map_or(0.0, |x| x[k]));
+        rows.b.push(-c[k] - correction.map_or(0.0, |x| x.rows[k]));
     }
 }
 
@@ -566,18 +629,26 @@ fn springing_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows
 
 /// The springing joints, linearised: (w + dw)·(H + dH)/u as the cone's vector and
 /// ((σ + dσ)(V + dV) b + e)/u as its bound, u the joint's unit (the bilinear products to
-/// first order): ‖w H + w dH + dw H‖ ≤ σ b V + σ b dV + b V dσ + u e, e ≥ 0 priced at ν.
-fn joint_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
+/// first order): ‖w H + w dH + dw H‖ ≤ σ b V + σ b dV + b V dσ + u e, e ≥ 0 priced at ν;
+/// with a correction, its second-order terms added.
+fn joint_cones(
+    model: &Model,
+    layout: &Layout,
+    state: &State,
+    correction: Option<&Correction>,
+    rows: &mut Rows,
+) {
     let u = &model.stress.plan.u;
     for (k, joint) in model.joints.iter().enumerate() {
         let a = joint.support as usize;
         let js = model.joint_state(state, k);
         let (unit, b) = (joint.unit(), joint.reach);
+        let second = correction.map_or([0.0; 3], |c| c.joints[k]);
         let first = rows.next();
         // Bound: s0 = σbV/u + σb dV/u + bV dσ/u + e; rows hold −coefficients.
-        rows.b.push(js.scale * b * js.v / unit);
-        rows.b.push(js.w * js.h[0] / unit);
-        rows.b.push(js.w * js.h[1] / unit);
+        rows.b.push(js.scale * b * js.v / unit + second[0]);
+        rows.b.push(js.w * js.h[0] / unit + second[1]);
+        rows.b.push(js.w * js.h[1] / unit + second[2]);
         rows.a.push(first, layout.j_start + k, -1.0);
         let vb = js.scale * b / unit;
         for &(e, j) in &joint.edges {
@@ -705,5 +776,100 @@ fn read_step(model: &Model, layout: &Layout, state: &State, x: &[f64]) -> Step {
         multipliers: None,
         joint_multiplier: 0.0,
         curvature: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assess::{AssessSettings, Envelope};
+    use crate::{Mesh, Problem, Thickness};
+
+    /// A free centre over six free supports on the unit circle: every support has a joint.
+    fn fan() -> (Problem, Envelope) {
+        let mut positions = vec![[0.0, 0.0, 0.5]];
+        for k in 0..6 {
+            let a = std::f64::consts::PI * k as f64 / 3.0;
+            positions.push([a.cos(), a.sin(), 0.1 * k as f64]);
+        }
+        let faces: Vec<[u32; 3]> = (0..6u32).map(|k| [0, k + 1, (k + 1) % 6 + 1]).collect();
+        let mesh = Mesh::new(positions, faces, &[1, 2, 3, 4, 5, 6]).unwrap();
+        let envelope = Envelope::from_thickness(&mesh, &Thickness::Uniform(0.2)).unwrap();
+        (Problem::new(mesh), envelope)
+    }
+
+    /// The constraints the correction completes: the residuals, then per joint its cone's
+    /// bound and vector (`joint_cones`' units).
+    fn constraints(model: &Model, state: &State) -> Vec<f64> {
+        let mut values = model.residuals(state);
+        for (k, joint) in model.joints.iter().enumerate() {
+            let js = model.joint_state(state, k);
+            let unit = joint.unit();
+            values.push(js.scale * joint.reach * js.v / unit);
+            values.extend(js.h.map(|h| js.w * h / unit));
+        }
+        values
+    }
+
+    fn along(state: &State, step: &Step, s: f64) -> State {
+        let moved = |x: &[f64], dx: &[f64]| x.iter().zip(dx).map(|(x, d)| x + s * d).collect();
+        State {
+            y: Vec::new(),
+            q: moved(&state.q, &step.dq),
+            z: moved(&state.z, &step.dz),
+            t: state.t + s * step.dt,
+        }
+    }
+
+    /// The correction is what the linearisation leaves out: c(x + d) − c(x) − c'(x) d, with
+    /// c'(x) d by central differences (exact but for rounding: c is a polynomial of degree
+    /// at most three along d, whose cubic term the differences see as ε² times it).
+    #[test]
+    fn the_correction_is_the_constraints_remainder_along_the_step() {
+        let (problem, envelope) = fan();
+        for objective in [Objective::Fit, Objective::MinThickness, Objective::MaxLoad] {
+            let settings = AssessSettings::default()
+                .with_objective(objective)
+                .with_load_pattern(vec![1.0; 7]);
+            let model = Model::new(&problem, &envelope, &settings).unwrap();
+            assert_eq!(model.joints.len(), 6, "{objective:?}");
+            let wave = |k: usize, a: f64| 1.0 + a * ((k as f64) * 1.7).sin();
+            let n_edges = model.problem.mesh.edges.len();
+            let state = State {
+                y: Vec::new(),
+                q: (0..n_edges).map(|e| wave(e, 0.5)).collect(),
+                z: (0..7)
+                    .map(|v| model.middle[v] + 0.01 * wave(v, 1.0))
+                    .collect(),
+                t: 0.8,
+            };
+            let step = Step {
+                dy: Vec::new(),
+                dq: (0..n_edges).map(|e| 0.3 * wave(e + 3, 1.0)).collect(),
+                dz: (0..7).map(|v| 0.05 * wave(v + 5, 1.0)).collect(),
+                dt: 0.1,
+                slack: 0.0,
+                model_objective: 0.0,
+                multipliers: None,
+                joint_multiplier: 0.0,
+                curvature: 0.0,
+            };
+            let correction = Correction::of(&model, &state, &step);
+            let mut expected = correction.rows.clone();
+            expected.extend(correction.joints.iter().flatten());
+            let eps = 1e-5;
+            let at = |s: f64| constraints(&model, &along(&state, &step, s));
+            let (start, end, ahead, behind) = (at(0.0), at(1.0), at(eps), at(-eps));
+            for (k, want) in expected.iter().enumerate() {
+                let linear = (ahead[k] - behind[k]) / (2.0 * eps);
+                let remainder = end[k] - start[k] - linear;
+                assert!(
+                    (remainder - want).abs() <= 1e-7 * (1.0 + want.abs()),
+                    "{objective:?}, value {k}: remainder {remainder}, correction {want}"
+                );
+            }
+            // The step is far from small: the terms are not negligible.
+            assert!(expected.iter().any(|c| c.abs() > 1e-3), "{expected:?}");
+        }
     }
 }

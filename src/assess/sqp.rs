@@ -9,8 +9,8 @@
 //! ν grows while the linearised residuals cannot be met at its price and otherwise follows
 //! the step's multipliers (ten times the largest).
 
-use super::model::{other_end, Model, Run, State};
-use super::qp::{solve_step, Layout, Step, StepInput};
+use super::model::{Model, Run, State};
+use super::qp::{solve_step, Correction, Layout, Step, StepInput};
 use super::ray;
 use super::{AssessSettings, Objective};
 use crate::error::Result;
@@ -347,8 +347,14 @@ impl<'m, 'a> Search<'m, 'a> {
         self.grow = 2.0;
         let after = self.model.objective_value(&self.state);
         if std::env::var_os("VSR_ASSESS_TRACE").is_some() {
+            let cmax = max_abs(&self.model.residuals(&self.state));
+            let gmax = self
+                .model
+                .joint_excess(&self.state)
+                .iter()
+                .fold(0.0f64, |m, g| m.max(*g));
             eprintln!(
-                "f {before:.6e} -> {after:.6e} res {:.2e} rho {:.1e} nu {:.1e} pred {predicted:.2e} t {:.5}",
+                "f {before:.6e} -> {after:.6e} res {:.2e} rho {:.1e} nu {:.1e} pred {predicted:.2e} t {:.5} c {cmax:.2e} g {gmax:.2e} ratio {ratio:.2}",
                 self.residual, self.rho, self.nu, self.state.t
             );
         }
@@ -393,8 +399,9 @@ impl<'m, 'a> Search<'m, 'a> {
 
     /// The step's second-order correction, where `better` takes it: for `fit`, first the
     /// trial's heights projected onto equilibrium with its forces (one height solve: the
-    /// least change in the fit's own measure), else the step solved again with the bilinear
-    /// term it leaves in the residuals on the right-hand side (one QP).
+    /// least change in the fit's own measure), else the step solved again with the
+    /// second-order terms it leaves in the residuals and the joints on the right-hand side
+    /// (one QP).
     fn corrected(
         &self,
         layout: &Layout,
@@ -405,7 +412,7 @@ impl<'m, 'a> Search<'m, 'a> {
         if let Some(projected) = self.projected(trial).filter(&better) {
             return Some(projected);
         }
-        let correction = bilinear_term(self.model, step);
+        let correction = Correction::of(self.model, &self.state, step);
         let input = self.input(Some(&correction));
         let second = solve_step(self.model, layout, &self.state, &input)?;
         Some(self.apply(&second)).filter(better)
@@ -520,7 +527,7 @@ impl<'m, 'a> Search<'m, 'a> {
     }
 
     /// The step's inputs at the current ρ and ν, with the last multipliers' curvature.
-    fn input<'s>(&'s self, correction: Option<&'s [f64]>) -> StepInput<'s> {
+    fn input<'s>(&'s self, correction: Option<&'s Correction>) -> StepInput<'s> {
         StepInput {
             rho: self.rho,
             rho_z: self.rho,
@@ -661,22 +668,6 @@ impl<'m, 'a> Search<'m, 'a> {
             None => self.least_infeasible.1,
         }
     }
-}
-
-/// The second-order term of the residuals along a step: Σ dq_e (dz_i − dz_j) per row.
-fn bilinear_term(model: &Model, step: &Step) -> Vec<f64> {
-    let edges = &model.problem.mesh.edges;
-    (model.residual.iter())
-        .map(|&i| {
-            let i = i as usize;
-            (model.incident[i].iter())
-                .map(|&e| {
-                    let j = other_end(edges[e as usize].v, i);
-                    step.dq[e as usize] * (step.dz[i] - step.dz[j])
-                })
-                .sum()
-        })
-        .collect()
 }
 
 fn max_abs(x: &[f64]) -> f64 {
