@@ -65,6 +65,8 @@ def test_ragged_faces_and_wrong_types_name_the_argument():
     with pytest.raises(voussoir.VoussoirError, match=r"^argument `faces`: is not an array of integer ids"):
         voussoir.Mesh(V, ragged, A)
     raises("argument `up`: None is not a string", voussoir.Mesh.from_file, "any.obj", up=None)
+    raises("argument `path`: 5 is not a path", voussoir.Mesh.from_file, 5)
+    raises("argument `supports`: 5 is not a path", voussoir.Mesh.from_file, "any.obj", 5)
     raises(
         "argument `weld_tolerance`: 'fine' is not a number",
         voussoir.Mesh.from_file,

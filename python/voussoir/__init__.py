@@ -91,6 +91,14 @@ def _text(name: str, value: Any) -> str:
     return value
 
 
+def _path(name: str, value: Any) -> str:
+    """A file path argument as text, or VoussoirError naming it."""
+    try:
+        return os.fspath(_required(name, value))
+    except TypeError:
+        raise VoussoirError(f"argument `{name}`: {value!r} is not a path") from None
+
+
 def _required(name: str, value: Any) -> Any:
     if value is None:
         raise VoussoirError(f"argument `{name}` is None")
@@ -200,8 +208,8 @@ class Mesh:
         else:
             tolerance = _number("weld_tolerance", weld_tolerance)
         mesh._native = _native.Mesh.read(
-            os.fspath(_required("path", path)),
-            None if supports is None else os.fspath(supports),
+            _path("path", path),
+            None if supports is None else _path("supports", supports),
             None if anchored is None else _ids("anchored", anchored),
             tolerance,
             (
@@ -286,7 +294,7 @@ class Mesh:
         .ply (every bit kept) or .stl (single precision), all or nothing, in the axes of the
         file the mesh was read from (Y-up for ``up="y"``)."""
         points = self.vertices if positions is None else _floats("positions", positions)
-        _native.write_mesh(self._native, points, os.fspath(_required("path", path)))
+        _native.write_mesh(self._native, points, _path("path", path))
 
     def __repr__(self) -> str:
         def count(n: int, one: str, many: str) -> str:

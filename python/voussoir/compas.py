@@ -35,7 +35,7 @@ from typing import Any, Dict, List
 
 import numpy as np
 
-from . import Mesh, VoussoirError
+from . import Mesh, VoussoirError, _path
 
 CONVENTIONS = {"tna": 1.0, "tno": -1.0}
 DTYPE = "compas_tna.diagrams/FormDiagram"
@@ -97,7 +97,7 @@ def write_formdiagram(path: Any, mesh: Mesh, result: Any = None, convention: str
         "name": "FormDiagram",
         "guid": str(uuid.uuid4()),
     }
-    path = os.fspath(path)
+    path = _path("path", path)
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".voussoir-", suffix=".json", dir=folder)
     try:
@@ -182,7 +182,7 @@ def mesh_from_data(
 def read_formdiagram(path: Any, convention: str = "tna", **kwargs: Any) -> Mesh:
     """A `Mesh` from a FormDiagram (or any COMPAS mesh) JSON file, COMPAS 1 or 2; keyword
     arguments as for `mesh_from_data`."""
-    path = os.fspath(path)
+    path = _path("path", path)
     try:
         with open(path) as f:
             document = json.load(f)

@@ -21,7 +21,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from . import Mesh, VoussoirError
+from . import Mesh, VoussoirError, _path
 
 ANCHORED_KEY = "voussoir.anchored"
 
@@ -52,7 +52,7 @@ def read_3dm(
     Supports: `anchored`, else the object's ``voussoir.anchored`` user text. Other keyword
     arguments (loads) go to `Mesh`."""
     rhino3dm = _rhino3dm()
-    path = os.fspath(path)
+    path = _path("path", path)
     model = rhino3dm.File3dm.Read(path)
     if model is None:
         raise VoussoirError(f"argument `path`: cannot read {path} as a .3dm file")
@@ -101,7 +101,7 @@ def write_3dm(path: Any, mesh: Mesh, positions: Any = None, name: str = "voussoi
     attributes.SetUserString(ANCHORED_KEY, json.dumps(mesh.anchored.tolist()))
     model = rhino3dm.File3dm()
     model.Objects.AddMesh(geometry, attributes)
-    path = os.fspath(path)
+    path = _path("path", path)
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".voussoir-", suffix=".3dm", dir=folder)
     os.close(fd)
