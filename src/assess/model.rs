@@ -316,9 +316,15 @@ impl<'a> Model<'a> {
             }
             v += state.q[e] * (state.z[j] - state.z[a]);
         }
-        let m = self.middle[a];
-        let w = state.z[a] - (m - scale * (m - joint.springing));
+        let w = state.z[a] - (self.middle[a] - scale * self.springing_rate(k));
         JointState { w, h, v, scale }
+    }
+
+    /// ∂w/∂s of joint k: the uniformly thinner envelope moves the springing plane towards the
+    /// middle surface, w = z_a − (m − s (m − springing)).
+    pub fn springing_rate(&self, k: usize) -> f64 {
+        let joint = &self.joints[k];
+        self.middle[joint.support as usize] - joint.springing
     }
 
     /// Per joint g = (w |H| − σ b V) / b, in load units: > 0 where the reaction's line

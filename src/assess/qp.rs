@@ -167,10 +167,7 @@ fn joint_terms(model: &Model, state: &State, step: &Step, k: usize) -> [f64; 3] 
         dv2 += step.dq[e] * rise;
     }
     let (dsigma, dw) = match model.objective {
-        Objective::MinThickness => (
-            step.dt,
-            step.dz[a] + step.dt * (model.middle[a] - joint.springing),
-        ),
+        Objective::MinThickness => (step.dt, step.dz[a] + step.dt * model.springing_rate(k)),
         _ => (0.0, step.dz[a]),
     };
     let unit = joint.unit();
@@ -615,13 +612,14 @@ fn thrust_cones(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) 
 fn springing_rows(model: &Model, layout: &Layout, state: &State, rows: &mut Rows) {
     let thickness = model.objective == Objective::MinThickness;
     for (k, joint) in model.joints.iter().enumerate() {
-        let a = joint.support as usize;
-        let Some(zc) = layout.z_col[a] else { continue };
+        let Some(zc) = layout.z_col[joint.support as usize] else {
+            continue;
+        };
         let w = model.joint_state(state, k).w;
         let row = rows.next();
         rows.a.push(row, zc, -1.0);
         if let (true, Some(t)) = (thickness, layout.t_col) {
-            rows.a.push(row, t, -(model.middle[a] - joint.springing));
+            rows.a.push(row, t, -model.springing_rate(k));
         }
         rows.b.push(w);
     }
@@ -673,7 +671,7 @@ fn joint_cones(
             (Objective::MaxLoad, Some(t)) => rows.a.push(first, t, -vb * model.live[a]),
             (Objective::MinThickness, Some(t)) => {
                 rows.a.push(first, t, -b * js.v / unit);
-                let dw = model.middle[a] - joint.springing;
+                let dw = model.springing_rate(k);
                 for d in 0..2 {
                     rows.a.push(first + 1 + d, t, -dw * js.h[d] / unit);
                 }

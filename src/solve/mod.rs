@@ -545,28 +545,17 @@ fn meets_bounds(
     fresh: bool,
 ) -> bool {
     let mesh = &problem.mesh;
-    let p_bar = problem.mean_load(&s.loads);
-    let unit = p_bar / crate::geometry::Frame::of(mesh, positions).scale;
-    let q_min = st.q_min.physical(unit);
-    let q_max = st.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
+    let scale = crate::geometry::Frame::of(mesh, positions).scale;
+    let unit = problem.mean_load(&s.loads) / scale;
     let slack = |bound: f64| 1e-6 * if bound != 0.0 { bound.abs() } else { unit };
     (mesh.edges.iter().zip(&s.force_densities).enumerate()).all(|(e, (edge, &q))| {
-        if !crate::stress::carries_force(mesh, e) {
-            return true;
+        let [a, b] = edge.v.map(|v| positions[v as usize]);
+        let length = (a[0] - b[0]).hypot(a[1] - b[1]) / scale;
+        match crate::stress::force_density_bounds(problem, st, e, unit, length) {
+            None => true,
+            Some(_) if fresh => q >= -slack(0.0),
+            Some((lo, hi)) => q >= lo - slack(lo) && q <= hi + slack(hi),
         }
-        if fresh {
-            return q >= -slack(0.0);
-        }
-        let interior = !edge.is_boundary();
-        let scoped = crate::stress::floored(problem, st, e);
-        let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
-        if let (Some((d_lo, d_hi)), true) = (st.dual_length_bounds, interior) {
-            let [a, b] = edge.v.map(|v| positions[v as usize]);
-            let length = (a[0] - b[0]).hypot(a[1] - b[1]);
-            lo = lo.max(d_lo * p_bar / length);
-            hi = hi.min(d_hi * p_bar / length);
-        }
-        q >= lo - slack(lo) && q <= hi + slack(hi)
     })
 }
 

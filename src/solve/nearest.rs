@@ -402,7 +402,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// settles or the loop stops.
     fn descend(&mut self) -> Result<Termination> {
         let w_start = self.w_start;
-        let mut last_norm = residual_term(&self.held, self.shape.vertices()).sqrt();
+        let mut last_norm = residual_term(self.problem, &self.held, self.shape.vertices()).sqrt();
         let (mut stage_rounds, mut stall_best, mut stall_at) = (0, self.best.eps, 0);
         loop {
             let before = self.merit(&self.positions, &self.held);
@@ -740,8 +740,8 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// holds in place; larger ones start the continuation where little of the input is kept.
     fn initial_weight(&self) -> Result<f64> {
         let kappa = self.mean_ktk_diagonal(&self.held.force_densities);
-        let p_bar = mean_load(&self.held, self.shape.vertices());
-        let r0 = residual_term(&self.held, self.shape.vertices());
+        let p_bar = self.problem.mean_load(&self.held.loads);
+        let r0 = residual_term(self.problem, &self.held, self.shape.vertices());
         let start = if kappa > 0.0 {
             p_bar * p_bar / (self.l0 * self.l0 * kappa)
         } else {
@@ -753,6 +753,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
             let target = self.height_target(w)?;
             let trial = self.with_heights(&target);
             let r = residual_term(
+                self.problem,
                 &self.held.at_heights(self.problem, &trial, &settings),
                 self.shape.vertices(),
             );
@@ -789,7 +790,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// heights `positions` with forces `s` certified there, r̂ = r / (p̄ √n).
     fn merit(&self, positions: &[[f64; 3]], s: &StressResult) -> f64 {
         let rows = self.shape.vertices();
-        let scale = mean_load(s, rows) * (rows.len() as f64).sqrt();
+        let scale = self.problem.mean_load(&s.loads) * (rows.len() as f64).sqrt();
         let shifted: f64 = (rows.iter().zip(&self.lambda))
             .map(|(&v, l)| (s.residuals[v as usize] / scale + l / (2.0 * self.w)).powi(2))
             .sum();
@@ -801,7 +802,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// shift λ/2w shrinks).
     fn update_multipliers(&mut self, last_norm: &mut f64) {
         let rows = self.shape.vertices();
-        let scale = mean_load(&self.held, rows) * (rows.len() as f64).sqrt();
+        let scale = self.problem.mean_load(&self.held.loads) * (rows.len() as f64).sqrt();
         let r: Vec<f64> = rows
             .iter()
             .map(|&v| self.held.residuals[v as usize] / scale)
@@ -822,7 +823,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// ‖r̂ + λ/2w‖²; handed to the stress steps through the cache.
     fn shift_loads(&mut self) {
         let rows = self.shape.vertices();
-        let scale = mean_load(&self.held, rows) * (rows.len() as f64).sqrt();
+        let scale = self.problem.mean_load(&self.held.loads) * (rows.len() as f64).sqrt();
         let mut offset = vec![0.0; self.positions.len()];
         for (l, &v) in self.lambda.iter().zip(rows) {
             offset[v as usize] = -scale * l / (2.0 * self.w);
@@ -883,7 +884,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
     /// The minimiser over z of L for the held forces, loads lagged.
     fn height_target(&self, w: f64) -> Result<Vec<f64>> {
         let rows = self.shape.vertices();
-        let p_bar = mean_load(&self.held, rows);
+        let p_bar = self.problem.mean_load(&self.held.loads);
         let rho = rows.len() as f64 * p_bar * p_bar / (w * self.l0 * self.l0);
         let z: Vec<f64> = self.positions.iter().map(|p| p[2]).collect();
         let fair = self.fair.as_deref().map(|c| (self.settings.fairness, c));
@@ -976,7 +977,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         };
         let mesh = &self.problem.mesh;
         let rows = self.shape.vertices();
-        let q_max = bound.physical(mean_load(&self.held, rows) / self.l0);
+        let q_max = bound.physical(self.problem.mean_load(&self.held.loads) / self.l0);
         let r = &self.held.residuals;
         let r_max = rows
             .iter()
@@ -1006,20 +1007,9 @@ fn inexact_gap(held: &StressResult) -> Option<f64> {
     gap.is_finite().then_some(gap)
 }
 
-/// Mean load over the rows (1 when zero, as the stress step's scale).
-fn mean_load(s: &StressResult, rows: &[u32]) -> f64 {
-    let sum: f64 = rows.iter().map(|&v| s.loads[v as usize]).sum();
-    let mean = sum / rows.len().max(1) as f64;
-    if mean > 0.0 {
-        mean
-    } else {
-        1.0
-    }
-}
-
 /// R: the mean over the rows of (r_i / p̄)².
-fn residual_term(s: &StressResult, rows: &[u32]) -> f64 {
-    let p_bar = mean_load(s, rows);
+fn residual_term(problem: &Problem, s: &StressResult, rows: &[u32]) -> f64 {
+    let p_bar = problem.mean_load(&s.loads);
     let sum: f64 = rows
         .iter()
         .map(|&v| (s.residuals[v as usize] / p_bar).powi(2))
@@ -1098,7 +1088,7 @@ mod tests {
         let mut s = Nearest::new(&problem, &settings, None).unwrap();
         s.held = s.stress_step(None).unwrap();
         s.w = s.initial_weight().unwrap();
-        let mut last_norm = residual_term(&s.held, s.shape.vertices()).sqrt();
+        let mut last_norm = residual_term(s.problem, &s.held, s.shape.vertices()).sqrt();
         let mut merit = s.merit(&s.positions, &s.held);
         let mut moves = 0;
         for round in 0..12 {

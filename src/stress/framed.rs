@@ -143,35 +143,53 @@ pub(crate) fn floored(problem: &Problem, settings: &StressSettings, e: usize) ->
     (settings.q_min_scope == EdgeScope::All || interior) && !problem.polygon_diagonal[e]
 }
 
-/// Per edge, None for an edge without force (boundary, both ends anchored), else its bounds
-/// (lower, upper) on q in frame units: q_min on the edges of its scope but polygon diagonals,
-/// q_max, and the dual length bounds of interior edges.
+/// Per edge, its bounds on q in frame units (see [`force_density_bounds`]).
 pub(super) fn edge_bounds(
     problem: &Problem,
     plan: &Plan,
     settings: &StressSettings,
     unit: f64,
 ) -> Vec<Option<(f64, f64)>> {
-    let mesh = &problem.mesh;
-    let q_min = settings.q_min.physical(unit) / unit;
-    let q_max = settings
-        .q_max
-        .map_or(f64::INFINITY, |b| b.physical(unit) / unit);
-    (0..mesh.edges.len())
+    (0..problem.mesh.edges.len())
         .map(|e| {
-            carries_force(mesh, e).then(|| {
-                let interior = !mesh.edges[e].is_boundary();
-                let scoped = floored(problem, settings, e);
-                let (mut lo, mut hi) = (if scoped { q_min } else { 0.0 }, q_max);
-                // Dual length d* = q l is p̄ q' l' in frame units: bounds on it are per-edge q bounds.
-                if let (Some((d_lo, d_hi)), true) = (settings.dual_length_bounds, interior) {
-                    lo = lo.max(d_lo / plan.length[e]);
-                    hi = hi.min(d_hi / plan.length[e]);
-                }
-                (lo, hi)
-            })
+            force_density_bounds(problem, settings, e, unit, plan.length[e])
+                .map(|(lo, hi)| (lo / unit, hi / unit))
         })
         .collect()
+}
+
+/// None for edge `e` without force (boundary, both ends anchored), else its bounds (lower,
+/// upper) on q, physical: q_min on the edges of its scope but polygon diagonals, q_max, and
+/// the dual length bounds of interior edges. `unit` is p̄/L₀ and `length` the edge's plan
+/// length over L₀.
+pub(crate) fn force_density_bounds(
+    problem: &Problem,
+    settings: &StressSettings,
+    e: usize,
+    unit: f64,
+    length: f64,
+) -> Option<(f64, f64)> {
+    let mesh = &problem.mesh;
+    carries_force(mesh, e).then(|| {
+        let q_min = settings.q_min.physical(unit);
+        let q_max = settings.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
+        let (mut lo, mut hi) = (
+            if floored(problem, settings, e) {
+                q_min
+            } else {
+                0.0
+            },
+            q_max,
+        );
+        // Dual length d* = q l is p̄ q' l' in frame units: bounds on it are per-edge q bounds.
+        if let (Some((d_lo, d_hi)), false) =
+            (settings.dual_length_bounds, mesh.edges[e].is_boundary())
+        {
+            lo = lo.max(d_lo * unit / length);
+            hi = hi.min(d_hi * unit / length);
+        }
+        (lo, hi)
+    })
 }
 
 /// Vertices whose equations count: referenced and not anchored.
@@ -283,9 +301,8 @@ pub(super) fn loads_at(
         &problem.face_density,
         &problem.extra_loads,
     );
-    let free = non_anchored(mesh);
-    let mean_load = mean_over(&load, &free);
-    (load, free, if mean_load > 0.0 { mean_load } else { 1.0 })
+    let p_bar = problem.mean_load(&load);
+    (load, non_anchored(mesh), p_bar)
 }
 
 pub(super) fn mean_over(x: &[f64], ids: &[u32]) -> f64 {

@@ -29,7 +29,7 @@ use cache::PlanKey;
 pub use cache::{Prior, StressCache};
 use clarabel::solver::SolverStatus;
 use framed::FramedStep;
-pub(crate) use framed::{carries_force, floored, non_anchored};
+pub(crate) use framed::{carries_force, floored, force_density_bounds, non_anchored};
 pub use framed::{MAX_MEAN_LOAD, MIN_MEAN_LOAD};
 pub(crate) use physical::equilibrium;
 use physical::{airy_and_centres, physical_hole_jumps, physical_tau, power_weights};
