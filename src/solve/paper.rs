@@ -113,19 +113,21 @@ pub(super) fn paper(
     let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
     let frame = Frame::of(mesh, &mesh.positions);
     let mut limit = HeightLimit::new(&z0, settings.max_height_change * 2.0 * frame.scale);
-    let mut result = paper_within(problem, settings, progress, Some(&mut limit))?;
+    let (mut result, _) = paper_within(problem, settings, progress, Some(&mut limit))?;
     let ended = std::mem::replace(&mut result.termination, Termination::MaxIterations);
     result.termination = limit.ending(problem, ended, &result.stress);
     Ok(result)
 }
 
-/// The paper's loop with every height step brought back within `limit` (None: unbounded).
+/// The paper's loop with every height step brought back within `limit` (None: unbounded),
+/// and whether the answer's forces pass their bound check (its own: a stress step's fresh
+/// answer is checked for compression, forces kept at new heights against every bound).
 pub(super) fn paper_within(
     problem: &Problem,
     settings: &FormFindSettings,
     progress: Option<&mut Progress>,
     mut limit: Option<&mut HeightLimit>,
-) -> Result<FormFindResult> {
+) -> Result<(FormFindResult, bool)> {
     let start = Instant::now();
     let mesh = &problem.mesh;
     let z0: Vec<f64> = mesh.positions.iter().map(|p| p[2]).collect();
@@ -219,8 +221,8 @@ pub(super) fn paper_within(
         }
     }
     let last = last.expect("at least one iteration");
-    let (positions, stress) = lowest.unless_converged(&termination, positions, last);
-    Ok(finish(
+    let (positions, stress, within) = lowest.unless_converged(&termination, positions, last);
+    let result = finish(
         problem,
         Run {
             termination,
@@ -236,7 +238,8 @@ pub(super) fn paper_within(
             warm: None,
         },
         start,
-    ))
+    );
+    Ok((result, within))
 }
 
 /// The lowest-ε∞ state of the stress steps (heights with the forces certified there, the
@@ -269,16 +272,21 @@ impl Lowest {
         }
     }
 
-    /// The state to answer: the lowest-ε∞ one unless the loop converged in its last state.
+    /// The state to answer: the lowest-ε∞ one unless the loop converged in its last state
+    /// (certified, so within its bounds); and whether its forces pass their bound check.
     fn unless_converged(
         self,
         termination: &Termination,
         positions: Vec<[f64; 3]>,
         stress: StressResult,
-    ) -> (Vec<[f64; 3]>, StressResult) {
-        match self.within.or(self.any) {
-            Some(lowest) if *termination != Termination::Converged => lowest,
-            _ => (positions, stress),
+    ) -> (Vec<[f64; 3]>, StressResult, bool) {
+        if *termination == Termination::Converged {
+            return (positions, stress, true);
+        }
+        match (self.within, self.any) {
+            (Some((p, s)), _) => (p, s, true),
+            (None, Some((p, s))) => (p, s, false),
+            (None, None) => (positions, stress, false),
         }
     }
 }
