@@ -1776,7 +1776,8 @@ VsrStatus vsr_assess_settings_set_load_rule(struct VsrAssessSettings *settings, 
 
 /**
  * Sets the live load of `VSR_OBJECTIVE_MAX_LOAD`: a downward load per mesh vertex, #V
- * doubles (copied), multiplied by λ and added to the self-weight. `n` 0 removes it (the
+ * doubles (copied; each finite, >= 0 and at most 1e150, one at least > 0), multiplied by λ
+ * and added to the self-weight. `n` 0 removes it (the
  * default: none). Other objectives ignore it; `vsr_assess` checks its length against the
  * mesh and, for max-load, that it loads a non-anchored vertex.
  *

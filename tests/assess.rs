@@ -335,6 +335,16 @@ fn bad_envelopes_and_settings_are_named() {
             "unit_weight",
         ),
         (
+            AssessSettings::default().with_unit_weight(0.0),
+            "unit_weight",
+        ),
+        (
+            AssessSettings::default()
+                .with_objective(Objective::MaxLoad)
+                .with_load_pattern(vec![1e300; mesh.positions().len()]),
+            "load_pattern",
+        ),
+        (
             AssessSettings::default().with_tolerance(f64::NAN),
             "tolerance",
         ),
@@ -347,6 +357,16 @@ fn bad_envelopes_and_settings_are_named() {
         let text = message(assess(&problem, &envelope, &settings, None).unwrap_err());
         assert!(text.contains(name), "{name}: {text}");
     }
+    // Intrados and extrados that coincide: no masonry, no weight.
+    let flat = Envelope::from_surfaces(
+        &mesh,
+        (mesh.positions(), mesh.faces()),
+        (mesh.positions(), mesh.faces()),
+    )
+    .unwrap();
+    let e = assess(&problem, &flat, &AssessSettings::default(), None).unwrap_err();
+    let text = message(e);
+    assert!(text.contains("`envelope`: has no thickness"), "{text}");
 }
 
 /// A fixed support outside the envelope is named; at the least thickness it only bounds the

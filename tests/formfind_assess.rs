@@ -543,7 +543,7 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
         25,
         "the messages name the first support"
     );
-    let cases: [(&[&str], &str); 20] = [
+    let cases: [(&[&str], &str); 21] = [
         (
             &["--thickness", "0"],
             "--thickness: expected a thickness > 0",
@@ -587,7 +587,11 @@ fn bad_assessment_input_exits_2_names_the_option_and_writes_nothing() {
         ),
         (
             &["--thickness", "0.1", "--unit-weight", "0"],
-            "loads: the self-weight and extra loads on the non-anchored vertices average 0e0",
+            "--unit-weight: is 0, so the masonry weighs nothing",
+        ),
+        (
+            &["--intrados", "in.obj", "--extrados", "in.obj"],
+            "--intrados, --extrados: has no thickness at any face",
         ),
         (
             &["--thickness", "density", "--unit-weight", "0"],

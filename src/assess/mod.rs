@@ -64,8 +64,9 @@ pub struct AssessSettings {
     /// How a face's weight is shared among its corners (on the middle surface). Default
     /// barycentric.
     pub load_rule: LoadRule,
-    /// Downward load per vertex for [`Objective::MaxLoad`], multiplied by λ (every entry
-    /// >= 0, one at least > 0); ignored otherwise. Default none.
+    /// Downward load per vertex for [`Objective::MaxLoad`], multiplied by λ (every entry at
+    /// least 0 and at most [`crate::MAX_MEAN_LOAD`], one at least > 0); ignored otherwise.
+    /// Default none.
     pub load_pattern: Option<Vec<f64>>,
     /// Lower bound on the force densities (compression only: 0). Default `Absolute(0)`.
     pub q_min: QBound,
@@ -92,15 +93,25 @@ impl Default for AssessSettings {
     }
 }
 
-/// A live load pattern pushes down (>= 0 at every vertex) and somewhere: λ multiplies it.
+/// A live load pattern pushes down (>= 0 at every vertex) and somewhere: λ multiplies it. Its
+/// loads are at most the largest mean load a stress step accepts, so that sums of them stay
+/// finite; λ scales inversely with the pattern, so a smaller one loses nothing.
 fn downward(pattern: &[f64]) -> Result<()> {
-    let reason = match pattern.iter().position(|&p| p < 0.0) {
-        Some(v) => format!(
+    use crate::stress::MAX_MEAN_LOAD;
+    let upward = pattern.iter().position(|&p| p < 0.0);
+    let huge = pattern.iter().position(|&p| p > MAX_MEAN_LOAD);
+    let reason = match (upward, huge) {
+        (Some(v), _) => format!(
             "vertex {v}: {} is upward; the pattern's loads push down (>= 0)",
             pattern[v]
         ),
-        None if pattern.iter().all(|&p| p == 0.0) => "every load is 0: nothing to multiply".into(),
-        None => return Ok(()),
+        (None, Some(v)) => format!(
+            "vertex {v}: {:e} is beyond {MAX_MEAN_LOAD:e}, where sums of loads overflow; scale \
+             the pattern down (λ scales up as much)",
+            pattern[v]
+        ),
+        _ if pattern.iter().all(|&p| p == 0.0) => "every load is 0: nothing to multiply".into(),
+        _ => return Ok(()),
     };
     Err(crate::Error::InvalidArgument {
         name: "load_pattern",

@@ -123,7 +123,7 @@ impl<'a> Model<'a> {
         );
         let live_physical = live_pattern(problem, settings)?;
         let residual = crate::stress::non_anchored(mesh);
-        let p_bar = mean_load(&dead_physical, &residual)?;
+        let p_bar = mean_load(&dead_physical, &residual, envelope, settings)?;
         let live_mean = (residual.iter())
             .map(|&v| live_physical[v as usize])
             .sum::<f64>()
@@ -575,7 +575,15 @@ fn live_pattern(problem: &Problem, settings: &AssessSettings) -> Result<Vec<f64>
     }
 }
 
-fn mean_load(load: &[f64], free: &[u32]) -> Result<f64> {
+/// p̄, the mean of the self-weight and extra loads over the non-anchored vertices; where it
+/// is not positive, the error names what weighs nothing (`unit_weight` 0, an envelope without
+/// thickness), else the loads.
+fn mean_load(
+    load: &[f64],
+    free: &[u32],
+    envelope: &Envelope,
+    settings: &AssessSettings,
+) -> Result<f64> {
     if free.is_empty() {
         return Err(Error::InvalidArgument {
             name: "supports",
@@ -583,16 +591,31 @@ fn mean_load(load: &[f64], free: &[u32]) -> Result<f64> {
         });
     }
     let mean = free.iter().map(|&v| load[v as usize]).sum::<f64>() / free.len() as f64;
-    if !(mean.is_finite() && mean > 0.0) {
-        return Err(Error::InvalidArgument {
-            name: "loads",
-            reason: format!(
-                "the self-weight and extra loads on the non-anchored vertices average {mean:e}: \
-                 a masonry vault stands under a positive downward load"
-            ),
-        });
+    if mean.is_finite() && mean > 0.0 {
+        return Ok(mean);
     }
-    Ok(mean)
+    let positive = "a masonry vault stands under a positive downward load";
+    let (name, reason) = if settings.unit_weight == 0.0 {
+        let reason = format!(
+            "is 0, so the masonry weighs nothing, and the extra loads on the non-anchored \
+             vertices average {mean:e}: {positive}"
+        );
+        ("unit_weight", reason)
+    } else if envelope.face_thickness.iter().all(|&t| t == 0.0) {
+        let reason = format!(
+            "has no thickness at any face (intrados and extrados coincide), so the masonry \
+             weighs nothing, and the extra loads on the non-anchored vertices average \
+             {mean:e}: {positive}"
+        );
+        ("envelope", reason)
+    } else {
+        let reason = format!(
+            "the self-weight and extra loads on the non-anchored vertices average {mean:e}: \
+             {positive}"
+        );
+        ("loads", reason)
+    };
+    Err(Error::InvalidArgument { name, reason })
 }
 
 fn support_edges(problem: &Problem, stress: &LinearStress) -> Vec<(usize, u32, u32)> {

@@ -11,10 +11,15 @@ use std::process::ExitCode;
 use crate::{bad_input, failed, output, pictures, Failure, Outputs, Paths, NOT_CONVERGED};
 use voussoir::{Objective, Termination};
 
-/// Errors of the solver are about the input unless numerical.
-fn solver_failure(e: voussoir::Error) -> Failure {
+/// Errors of the solver are about the input unless numerical; the envelope is the one of
+/// `--intrados` and `--extrados` where they gave it.
+fn solver_failure(e: voussoir::Error, o: &crate::args::Options) -> Failure {
     match e {
         voussoir::Error::Numerical { .. } | voussoir::Error::Io { .. } => failed(e),
+        voussoir::Error::InvalidArgument {
+            name: "envelope",
+            reason,
+        } if o.assess.intrados.is_some() => bad_input(format!("--intrados, --extrados: {reason}")),
         e => bad_input(run::message(&e, "--assess")),
     }
 }
@@ -39,7 +44,7 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
     )
     .map_err(bad_input)?;
 
-    let a = run::run(model, envelope, settings, o).map_err(solver_failure)?;
+    let a = run::run(model, envelope, settings, o).map_err(|e| solver_failure(e, o))?;
     let report = serde_json::to_value(report::build(o, &a)).map_err(failed)?;
     let pictures = pictures::assessment(&a, section);
     let outputs = Outputs {
