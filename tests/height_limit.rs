@@ -115,6 +115,27 @@ fn no_answer_moves_beyond_the_height_limit() {
     );
 }
 
+/// A limit near or below the heights' resolution (1e-15 of the diagonal is below one ulp of
+/// this vault's heights) still holds: the clamp at the limit rounds towards the input height
+/// (it rounded outwards, moving vertices up to 2% beyond 1e-15).
+#[test]
+fn a_limit_below_the_heights_resolution_holds() {
+    let problem = Problem::new(walled_vault(1, 0.02));
+    for limit in [1e-15, 1e-12, 1e-9] {
+        for (method, max_iterations) in [(FormMethod::Nearest, 12), (FormMethod::Paper, 6)] {
+            let settings = FormFindSettings::default()
+                .with_method(method)
+                .with_max_height_change(limit)
+                .with_max_iterations(max_iterations);
+            let r = form_find(&problem, &settings, None).unwrap();
+            let moved = largest_change(&problem.mesh, &r.positions);
+            let case = format!("limit {limit}, {method:?}");
+            assert!(moved <= limit * (1.0 + 1e-12), "{case}: moved {moved}");
+            assert!(moved > 0.0 || limit < 1e-12, "{case}: nothing moved");
+        }
+    }
+}
+
 /// A 15 × 15 grid over the unit square, its boundary anchored at height 0, its interior
 /// vertices moved in plan by up to a quarter of the grid step and lifted onto
 /// sin(πx) sin(πy): ODT moves them back towards the grid and resamples their heights on that

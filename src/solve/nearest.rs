@@ -14,7 +14,7 @@
 //! the nearest stress step's state in equilibrium (ε∞ < tolerance, certified by recomputed
 //! residuals), taken once a further one is no nearer.
 
-use super::paper::{paper_within, sweep_within, HeightLimit};
+use super::paper::{paper_within, sweep_within, within_limit, HeightLimit};
 use super::warm::{faces_fingerprint, Continuation};
 use super::{
     area_shares, blocked_region, blocking_vertices, certified, finish, infeasibility_hint,
@@ -310,7 +310,7 @@ impl<'a, 'p> Nearest<'a, 'p> {
         for &v in self.shape.vertices() {
             let v = v as usize;
             let (z, base) = (previous.positions[v][2], self.z_limit[v]);
-            self.positions[v][2] = z.clamp(base - self.limit, base + self.limit);
+            self.positions[v][2] = within_limit(z, base, self.limit);
         }
         self.previous_forces = (previous.stress.status.is_solved())
             .then(|| previous.stress.clone())
@@ -857,8 +857,9 @@ impl<'a, 'p> Nearest<'a, 'p> {
         let current = self.merit(&self.positions, &self.held);
         let mut moved = false;
         for _ in 0..=BACKTRACKS {
-            let partial: Vec<f64> = (z.iter().zip(&target))
-                .map(|(a, b)| a + step * (b - a))
+            // The step to the limit may round past it.
+            let partial: Vec<f64> = (z.iter().zip(&target).zip(&self.z_limit))
+                .map(|((a, b), &base)| within_limit(a + step * (b - a), base, self.limit))
                 .collect();
             let trial = self.with_heights(&partial);
             let certified = self.held.at_heights(self.problem, &trial, &settings);

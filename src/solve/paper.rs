@@ -51,7 +51,7 @@ impl<'a> HeightLimit<'a> {
             self.is_held[v] = true;
             self.held.push(v as u32);
         }
-        reference + self.limit.copysign(z - reference)
+        within_limit(z, reference, self.limit)
     }
 
     /// How a loop held by this limit ended: one that did not converge with heights held back
@@ -71,6 +71,29 @@ impl<'a> HeightLimit<'a> {
             }
             t => t,
         }
+    }
+}
+
+/// `z` brought back within `limit` of `reference`, and then by ulps towards it where
+/// `reference ± limit` rounds outward (a limit below the heights' resolution keeps the
+/// reference): |result − reference| <= limit as computed.
+pub(super) fn within_limit(z: f64, reference: f64, limit: f64) -> f64 {
+    let mut h = z.clamp(reference - limit, reference + limit);
+    while (h - reference).abs() > limit {
+        h = one_ulp_towards(h, reference);
+    }
+    h
+}
+
+/// The double next to `h` on the side of `target` (both finite, different).
+fn one_ulp_towards(h: f64, target: f64) -> f64 {
+    let smallest = f64::from_bits(1);
+    let bits = h.to_bits();
+    match (h == 0.0, target > h, h > 0.0) {
+        (true, up, _) => smallest.copysign(if up { 1.0 } else { -1.0 }),
+        // Away from zero the magnitude, and so the bits, grow.
+        (false, up, positive) if up == positive => f64::from_bits(bits + 1),
+        _ => f64::from_bits(bits - 1),
     }
 }
 
@@ -348,5 +371,43 @@ fn failure(
             what: "stress QP failed".into(),
         }),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{one_ulp_towards, within_limit};
+
+    #[test]
+    fn one_ulp_steps_towards_the_target_on_either_side_of_zero() {
+        let (eps, tiny) = (f64::EPSILON, f64::from_bits(1));
+        assert_eq!(one_ulp_towards(1.0, 2.0), 1.0 + eps);
+        assert_eq!(one_ulp_towards(1.0, 0.0), 1.0 - eps / 2.0);
+        assert_eq!(one_ulp_towards(-1.0, 0.0), -1.0 + eps / 2.0);
+        assert_eq!(one_ulp_towards(-1.0, -2.0), -1.0 - eps);
+        assert_eq!(one_ulp_towards(0.0, 1.0), tiny);
+        assert_eq!(one_ulp_towards(0.0, -1.0), -tiny);
+        assert_eq!(one_ulp_towards(tiny, -1.0), 0.0);
+    }
+
+    #[test]
+    fn a_height_held_at_the_limit_is_within_it_as_computed() {
+        for reference in [1.6218379944259198, -0.3, 1e-300, 7.0] {
+            for limit in [0.0, 1e-17, 1e-15, 3e-13, 0.1] {
+                for z in [reference + 1.0, reference - 1.0, reference] {
+                    let h = within_limit(z, reference, limit);
+                    assert!(
+                        (h - reference).abs() <= limit,
+                        "{reference} {limit} {z}: {h}"
+                    );
+                    // At most an ulp inside the limit (or the reference itself).
+                    let back = one_ulp_towards(h, z);
+                    assert!(
+                        h == z || (back - reference).abs() > limit,
+                        "{reference} {limit} {z}"
+                    );
+                }
+            }
+        }
     }
 }
