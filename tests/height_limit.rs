@@ -3,7 +3,9 @@
 //! loop that continues from its best state when it finds no balanced one, or the paper's
 //! loop asked for).
 
-use voussoir::{form_find, FormFindSettings, FormMethod, Mesh, Problem, Termination};
+use voussoir::{
+    form_find, FormFindResult, FormFindSettings, FormMethod, Mesh, Problem, Termination,
+};
 
 /// A 15 × 15 grid vault with a steep outer wall (issue 48): interior heights 1 to 1.3 plus
 /// `noise` × seeded noise, the anchored outer ring at height 0 at the plan position of the
@@ -72,6 +74,20 @@ fn largest_change(mesh: &Mesh, positions: &[[f64; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// `problem` form-found by `method` with the height limit and step budget given.
+fn limited(
+    problem: &Problem,
+    method: FormMethod,
+    limit: f64,
+    max_iterations: usize,
+) -> FormFindResult {
+    let settings = FormFindSettings::default()
+        .with_method(method)
+        .with_max_height_change(limit)
+        .with_max_iterations(max_iterations);
+    form_find(problem, &settings, None).unwrap()
+}
+
 /// Where the limit binds hard (the answer moved 9 diagonals before the paper's loop held it),
 /// every answer stays within it: with the default budget (the nearest loop, then the paper's
 /// loop from its best state) and with a short one, for several seeds and limits; and the
@@ -87,11 +103,7 @@ fn no_answer_moves_beyond_the_height_limit() {
                 (FormMethod::Nearest, 30),
                 (FormMethod::Paper, 100),
             ] {
-                let settings = FormFindSettings::default()
-                    .with_method(method)
-                    .with_max_height_change(limit)
-                    .with_max_iterations(max_iterations);
-                let r = form_find(&problem, &settings, None).unwrap();
+                let r = limited(&problem, method, limit, max_iterations);
                 let moved = largest_change(&problem.mesh, &r.positions);
                 let case =
                     format!("seed {seed}, limit {limit}, {method:?}, {max_iterations} steps");
@@ -123,11 +135,7 @@ fn a_limit_below_the_heights_resolution_holds() {
     let problem = Problem::new(walled_vault(1, 0.02));
     for limit in [1e-15, 1e-12, 1e-9] {
         for (method, max_iterations) in [(FormMethod::Nearest, 12), (FormMethod::Paper, 6)] {
-            let settings = FormFindSettings::default()
-                .with_method(method)
-                .with_max_height_change(limit)
-                .with_max_iterations(max_iterations);
-            let r = form_find(&problem, &settings, None).unwrap();
+            let r = limited(&problem, method, limit, max_iterations);
             let moved = largest_change(&problem.mesh, &r.positions);
             let case = format!("limit {limit}, {method:?}");
             assert!(moved <= limit * (1.0 + 1e-12), "{case}: moved {moved}");
