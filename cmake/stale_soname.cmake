@@ -5,6 +5,8 @@
 #   cmake -DSONAME=libvoussoir.so.<ABI> -DDIR=<target>/<profile> -P stale_soname.cmake
 find_program(READELF readelf)
 if(NOT READELF)
+  message(WARNING "readelf not found (Debian: binutils): a library that a plain cargo build "
+                  "left without the SONAME ${SONAME} is not relinked")
   return()
 endif()
 foreach(lib "${DIR}/libvoussoir.so" "${DIR}/deps/libvoussoir.so")

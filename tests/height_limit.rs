@@ -140,6 +140,9 @@ fn a_limit_below_the_heights_resolution_holds() {
             let case = format!("limit {limit}, {method:?}");
             assert!(moved <= limit * (1.0 + 1e-12), "{case}: moved {moved}");
             assert!(moved > 0.0 || limit < 1e-12, "{case}: nothing moved");
+            // The vertices held there are named, however small the limit.
+            let blocked = matches!(r.termination, Termination::Blocked { .. });
+            assert!(blocked, "{case}: {:?}", r.termination);
         }
     }
 }

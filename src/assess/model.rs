@@ -598,7 +598,7 @@ fn mean_load(
     let (name, reason) = if settings.unit_weight == 0.0 {
         let reason = format!(
             "is 0, so the masonry weighs nothing, and the extra loads on the non-anchored \
-             vertices average {mean:e}: {positive}"
+             vertices (max-load's pattern aside) average {mean:e}: {positive}"
         );
         ("unit_weight", reason)
     } else if envelope.face_thickness.iter().all(|&t| t == 0.0) {

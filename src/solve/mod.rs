@@ -554,7 +554,10 @@ fn meets_bounds(
         match crate::stress::force_density_bounds(problem, st, e, unit, length) {
             None => true,
             Some(_) if fresh => q >= -slack(0.0),
-            Some((lo, hi)) => q >= lo - slack(lo) && q <= hi + slack(hi),
+            Some((lo, hi)) => {
+                let (lo, hi) = (lo * unit, hi * unit);
+                q >= lo - slack(lo) && q <= hi + slack(hi)
+            }
         }
     })
 }

@@ -14,7 +14,7 @@
 //! the nearest stress step's state in equilibrium (ε∞ < tolerance, certified by recomputed
 //! residuals), taken once a further one is no nearer.
 
-use super::paper::{paper_within, sweep_within, within_limit, HeightLimit};
+use super::paper::{one_ulp_towards, paper_within, sweep_within, within_limit, HeightLimit};
 use super::warm::{faces_fingerprint, Continuation};
 use super::{
     area_shares, blocked_region, blocking_vertices, certified, finish, infeasibility_hint,
@@ -925,12 +925,15 @@ impl<'a, 'p> Nearest<'a, 'p> {
         step
     }
 
-    /// The vertices whose height change is at the limit (within a millionth of it).
+    /// The vertices whose height change is at the limit: within a millionth of it, or one ulp
+    /// further out would pass it (`within_limit` may stop that ulp short).
     fn at_limit(&self) -> Vec<u32> {
         (self.shape.vertices().iter().copied())
             .filter(|&v| {
-                let v = v as usize;
-                (self.positions[v][2] - self.z_limit[v]).abs() >= self.limit * (1.0 - 1e-6)
+                let (z, base) = (self.positions[v as usize][2], self.z_limit[v as usize]);
+                let outwards = one_ulp_towards(z, f64::INFINITY.copysign(z - base));
+                (z - base).abs() >= self.limit * (1.0 - 1e-6)
+                    || (outwards - base).abs() > self.limit
             })
             .collect()
     }

@@ -85,8 +85,8 @@ pub(super) fn within_limit(z: f64, reference: f64, limit: f64) -> f64 {
     h
 }
 
-/// The double next to `h` on the side of `target` (both finite, different).
-fn one_ulp_towards(h: f64, target: f64) -> f64 {
+/// The double next to `h` on the side of `target` (`h` finite, `target` different).
+pub(super) fn one_ulp_towards(h: f64, target: f64) -> f64 {
     let smallest = f64::from_bits(1);
     let bits = h.to_bits();
     match (h == 0.0, target > h, h > 0.0) {

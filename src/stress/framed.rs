@@ -151,17 +151,14 @@ pub(super) fn edge_bounds(
     unit: f64,
 ) -> Vec<Option<(f64, f64)>> {
     (0..problem.mesh.edges.len())
-        .map(|e| {
-            force_density_bounds(problem, settings, e, unit, plan.length[e])
-                .map(|(lo, hi)| (lo / unit, hi / unit))
-        })
+        .map(|e| force_density_bounds(problem, settings, e, unit, plan.length[e]))
         .collect()
 }
 
 /// None for edge `e` without force (boundary, both ends anchored), else its bounds (lower,
-/// upper) on q, physical: q_min on the edges of its scope but polygon diagonals, q_max, and
-/// the dual length bounds of interior edges. `unit` is p̄/L₀ and `length` the edge's plan
-/// length over L₀.
+/// upper) on q in frame units (multiples of `unit`, p̄/L₀): q_min on the edges of its scope
+/// but polygon diagonals, q_max, and the dual length bounds of interior edges. `length` is
+/// the edge's plan length over L₀.
 pub(crate) fn force_density_bounds(
     problem: &Problem,
     settings: &StressSettings,
@@ -171,8 +168,10 @@ pub(crate) fn force_density_bounds(
 ) -> Option<(f64, f64)> {
     let mesh = &problem.mesh;
     carries_force(mesh, e).then(|| {
-        let q_min = settings.q_min.physical(unit);
-        let q_max = settings.q_max.map_or(f64::INFINITY, |b| b.physical(unit));
+        let q_min = settings.q_min.physical(unit) / unit;
+        let q_max = settings
+            .q_max
+            .map_or(f64::INFINITY, |b| b.physical(unit) / unit);
         let (mut lo, mut hi) = (
             if floored(problem, settings, e) {
                 q_min
@@ -185,8 +184,8 @@ pub(crate) fn force_density_bounds(
         if let (Some((d_lo, d_hi)), false) =
             (settings.dual_length_bounds, mesh.edges[e].is_boundary())
         {
-            lo = lo.max(d_lo * unit / length);
-            hi = hi.min(d_hi * unit / length);
+            lo = lo.max(d_lo / length);
+            hi = hi.min(d_hi / length);
         }
         (lo, hi)
     })
