@@ -152,11 +152,12 @@ impl Problem {
     /// non-anchored vertices: p̄, the unit of ε∞ and of relative force-density bounds (with
     /// L₀). 1 when there is no such vertex or the mean is not positive, as the solver takes it.
     pub fn mean_load(&self, loads: &[f64]) -> f64 {
-        let free: Vec<f64> = (0..self.mesh.n_vertices())
+        // One pass without a buffer: the form-finding loop asks for it on every merit.
+        let (sum, count) = (0..self.mesh.n_vertices())
             .filter(|&v| self.mesh.is_non_anchored(v))
-            .filter_map(|v| loads.get(v).copied())
-            .collect();
-        let mean = free.iter().sum::<f64>() / free.len().max(1) as f64;
+            .filter_map(|v| loads.get(v))
+            .fold((0.0, 0usize), |(sum, count), &p| (sum + p, count + 1));
+        let mean = sum / count.max(1) as f64;
         if mean > 0.0 {
             mean
         } else {
