@@ -279,7 +279,7 @@ fn fields<'py>(
     d.set_item("objective", r.objective.as_str())?;
     d.set_item("feasible", r.feasible)?;
     d.set_item("termination", name)?;
-    d.set_item("termination_message", r.termination.to_string())?;
+    d.set_item("termination_message", r.termination_message())?;
     d.set_item("termination_vertices", PyArray1::from_vec(py, vertices))?;
     d.set_item("termination_detail", detail)?;
     d.set_item("iterations", r.iterations)?;

@@ -264,6 +264,25 @@ pub struct AssessResult {
     pub seconds: f64,
 }
 
+impl AssessResult {
+    /// The termination as a sentence, in an assessment's words: a stalled search lists the
+    /// vertices with the largest residuals of its least infeasible state (its retries put a
+    /// floor on q themselves, so form finding's advice to raise q_min does not apply).
+    pub fn termination_message(&self) -> String {
+        match &self.termination {
+            Termination::Stalled { vertices } if !vertices.is_empty() => {
+                let ids: Vec<String> = vertices.iter().map(|v| v.to_string()).collect();
+                format!(
+                    "stalled: no step lowers the infeasibility; the largest residuals at \
+                     vertices {}",
+                    ids.join(", ")
+                )
+            }
+            other => other.to_string(),
+        }
+    }
+}
+
 /// Finds a certified thrust surface inside `envelope` for `settings.objective`.
 ///
 /// `problem` gives the mesh (its plan is the form diagram; with fixed supports its anchored

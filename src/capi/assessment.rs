@@ -200,7 +200,7 @@ pub unsafe extern "C" fn vsr_assessment_termination_message(
         // SAFETY: forwarded caller's contract.
         unsafe {
             copy("assessment", assessment, out, len, needed, |a| {
-                Ok(c_string(&a.result.termination.to_string()))
+                Ok(c_string(&a.result.termination_message()))
             })
         }
     })

@@ -258,7 +258,10 @@ fn figures(
     AssessmentFigures {
         objective: r.objective.as_str(),
         feasible: r.feasible,
-        ending: Ending::of(&r.termination),
+        ending: Ending {
+            termination_message: r.termination_message(),
+            ..Ending::of(&r.termination)
+        },
         iterations: r.iterations,
         seconds: r.seconds,
         thickness,

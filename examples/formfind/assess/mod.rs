@@ -81,7 +81,7 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
     } else if r.feasible {
         format!(
             "{}: the thrust surface written is certified, its {} not proven optimal",
-            ending(&r.termination),
+            r.termination_message(),
             r.objective.as_str()
         )
     } else if let Termination::Infeasible { constraint } = &r.termination {
@@ -93,27 +93,11 @@ pub fn main(o: &crate::args::Options, model: crate::model::Model) -> Result<Exit
         format!(
             "no thrust surface found inside the envelope ({}): the outputs hold the least \
              infeasible state",
-            ending(&r.termination)
+            r.termination_message()
         )
     };
     eprintln!("formfind: {why}");
     Ok(ExitCode::from(NOT_CONVERGED))
-}
-
-/// The termination in an assessment's words: a stalled search lists the vertices with the
-/// largest residuals of its least infeasible state (retries with a floor on q included, so
-/// form finding's advice to raise q_min does not apply).
-fn ending(termination: &Termination) -> String {
-    match termination {
-        Termination::Stalled { vertices } if !vertices.is_empty() => {
-            let ids: Vec<String> = vertices.iter().map(|v| v.to_string()).collect();
-            format!(
-                "stalled: no step lowers the infeasibility; the largest residuals at vertices {}",
-                ids.join(", ")
-            )
-        }
-        other => other.to_string(),
-    }
 }
 
 fn summary(a: &run::Assessed) {
