@@ -8,9 +8,12 @@
 //!
 //! Both share KᵀK's pattern (the two-ring of the mesh), analysed once per mesh.
 
+mod dense;
+
 use crate::error::{Error, Result};
 use crate::geometry::loads::LoadJacobian;
 use crate::mesh::Mesh;
+use dense::{DenseRow, Lower, Woodbury};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
@@ -67,11 +70,15 @@ crate::setters::with_setters!(Schedule {
 });
 
 /// The height step with its sparsity pattern analysed once: KᵀK has the two-ring pattern of
-/// the mesh restricted to non-anchored vertices, whatever the force densities.
+/// the mesh restricted to non-anchored vertices, whatever the force densities, but for K's
+/// dense rows (`dense`).
 pub struct ShapeStep {
     /// The non-anchored vertices, in the order of the system's rows.
     vertices: Vec<u32>,
     k: KStructure,
+    /// Per row of K: more columns than `dense_row_limit` (a fan's hub), so kept out of KᵀK's
+    /// pattern and solved apart (`dense.rs`).
+    dense: Vec<bool>,
     /// KᵀK's lower triangle (row ≥ col), column by column: `col_ptr`, `row_idx`.
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
@@ -111,7 +118,14 @@ impl ShapeStep {
         }
         let m = vertices.len();
         let k = KStructure::new(mesh, &row, m);
-        let k_rows: Vec<&[usize]> = (0..m).map(|i| k.columns(i)).collect();
+        let limit = crate::stress::sparse::dense_row_limit(m);
+        let dense: Vec<bool> = (0..m)
+            .map(|i| dense::distinct(k.columns(i)) > limit)
+            .collect();
+        // A dense row's products are left out of the pattern, and so of `product_slot`.
+        let k_rows: Vec<&[usize]> = (0..m)
+            .map(|i| if dense[i] { &[][..] } else { k.columns(i) })
+            .collect();
         // The lower triangle's (col, row) pairs, sorted: column-major order. The diagonal is
         // always in it (the proximal term), whatever the products.
         let mut pairs: Vec<(usize, usize)> = (0..m).map(|i| (i, i)).collect();
@@ -179,6 +193,7 @@ impl ShapeStep {
         Ok(ShapeStep {
             vertices,
             k,
+            dense,
             col_ptr,
             row_idx,
             product_slot,
@@ -335,7 +350,13 @@ impl ShapeStep {
         let mut ktk = vec![0.0; self.row_idx.len()];
         let mut ktb = vec![0.0; m];
         let mut slots = self.product_slot.iter();
+        let mut dense = Vec::new();
         for (i, (cols, vals)) in k_rows.iter().enumerate() {
+            if self.dense[i] {
+                (cols.iter().zip(*vals)).for_each(|(&a, &va)| ktb[a] += va * b[i]);
+                dense.push(dense::merged(cols, vals));
+                continue;
+            }
             for (&a, &va) in cols.iter().zip(*vals) {
                 ktb[a] += va * b[i];
                 for (&c, &vc) in cols.iter().zip(*vals) {
@@ -345,10 +366,13 @@ impl ShapeStep {
                 }
             }
         }
-        let mean_diag = self.diag_slot.iter().map(|&k| ktk[k]).sum::<f64>() / m.max(1) as f64;
+        let dense_diag: f64 = dense.iter().flatten().map(|(_, v)| v * v).sum();
+        let mean_diag =
+            (self.diag_slot.iter().map(|&k| ktk[k]).sum::<f64>() + dense_diag) / m.max(1) as f64;
         Normal {
             ktk,
             ktb,
+            dense,
             r,
             scale: if mean_diag > 0.0 { mean_diag } else { 1.0 },
         }
@@ -396,7 +420,12 @@ impl ShapeStep {
         z: &[f64],
     ) -> Result<Vec<f64>> {
         let m = self.vertices.len();
-        let Normal { mut ktk, ktb, .. } = normal;
+        let Normal {
+            mut ktk,
+            ktb,
+            dense,
+            ..
+        } = normal;
         let mut rhs = Mat::from_fn(m, 1, |i, _| ktb[i] + pull[i].1);
         for (i, &k) in self.diag_slot.iter().enumerate() {
             ktk[k] += pull[i].0;
@@ -420,10 +449,23 @@ impl ShapeStep {
         );
         let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower)
             .map_err(|e| crate::error::factorisation_failure("the height system", &e))?;
-        llt.solve_in_place(rhs.as_mut());
+        let solution: Vec<f64> = if dense.is_empty() {
+            llt.solve_in_place(rhs.as_mut());
+            (0..m).map(|i| rhs[(i, 0)]).collect()
+        } else {
+            let lower = Lower {
+                col_ptr: &self.col_ptr,
+                row_idx: &self.row_idx,
+                values: &ktk,
+            };
+            let woodbury = Woodbury::new(&llt, lower, &dense).ok_or_else(|| Error::Numerical {
+                what: "the height system's dense rows: not positive definite".into(),
+            })?;
+            woodbury.solve(&(0..m).map(|i| rhs[(i, 0)]).collect::<Vec<f64>>())
+        };
         let mut out = z.to_vec();
         for (i, &v) in self.vertices.iter().enumerate() {
-            out[v as usize] = rhs[(i, 0)];
+            out[v as usize] = solution[i];
         }
         if out.iter().any(|x| !x.is_finite()) {
             return Err(Error::Numerical {
@@ -436,8 +478,11 @@ impl ShapeStep {
 
 /// The normal equations of one height step before any pull is added.
 struct Normal {
+    /// KᵀK without the dense rows' products.
     ktk: Vec<f64>,
     ktb: Vec<f64>,
+    /// K's dense rows, their columns merged.
+    dense: Vec<DenseRow>,
     /// r = K z − b at the current heights, per row.
     r: Vec<f64>,
     /// Mean diagonal of KᵀK (1 when zero): the unit of the proximal weights.
@@ -558,9 +603,52 @@ mod tests {
         (j_val, grad)
     }
 
+    /// A wheel: a hub joined to every vertex of the first of three rings (`spokes` each),
+    /// quads split alternately, the outer ring anchored; the hub's row of K has a column per
+    /// spoke.
+    fn wheel(spokes: usize) -> Mesh {
+        let rings = [0.35, 0.7, 1.0];
+        let mut positions = vec![[0.0, 0.0, 1.0]];
+        for r in rings {
+            for k in 0..spokes {
+                let a = std::f64::consts::TAU * k as f64 / spokes as f64;
+                positions.push([r * a.cos(), r * a.sin(), 1.0 - r * r]);
+            }
+        }
+        let at = |ring: usize, k: usize| (1 + ring * spokes + k % spokes) as u32;
+        let mut faces: Vec<[u32; 3]> = (0..spokes).map(|k| [0, at(0, k), at(0, k + 1)]).collect();
+        for ring in 0..rings.len() - 1 {
+            for k in 0..spokes {
+                let (a, b) = (at(ring, k), at(ring, k + 1));
+                let (c, d) = (at(ring + 1, k), at(ring + 1, k + 1));
+                faces.extend(if k % 2 == 0 {
+                    [[a, c, b], [b, c, d]]
+                } else {
+                    [[a, c, d], [a, d, b]]
+                });
+            }
+        }
+        let anchored: Vec<u32> = (0..spokes).map(|k| at(rings.len() - 1, k)).collect();
+        Mesh::new(positions, faces, &anchored).unwrap()
+    }
+
+    /// On a dome, and on a wheel whose hub's row of K is solved apart (`dense.rs`).
     #[test]
     fn the_nearest_step_minimises_its_objective() {
-        let mesh = crate::generate::cap_dome(0.9, 300).unwrap();
+        let dome = crate::generate::cap_dome(0.9, 300).unwrap();
+        let hub = wheel(300);
+        let split = ShapeStep::new(&hub).unwrap();
+        assert!(split.dense.iter().any(|&d| d));
+        // The hub's 300 × 300 couplings are not in KᵀK's pattern: a few per vertex remain.
+        let per_vertex = split.row_idx.len() as f64 / split.vertices.len() as f64;
+        assert!(per_vertex < 12.0, "{per_vertex} entries per row of KᵀK");
+        assert!(!ShapeStep::new(&dome).unwrap().dense.iter().any(|&d| d));
+        for mesh in [dome, hub] {
+            minimises_its_objective(&mesh);
+        }
+    }
+
+    fn minimises_its_objective(mesh: &Mesh) {
         let n = mesh.positions.len();
         let wave = |k: usize, f: f64| ((k as f64 * f).sin() + 1.5) / 2.5;
         let q: Vec<f64> = (0..mesh.edges.len()).map(|e| 50.0 * wave(e, 0.7)).collect();
@@ -579,7 +667,7 @@ mod tests {
             })
             .collect();
         let area: Vec<f64> = (0..n).map(|v| wave(v, 0.9) / n as f64).collect();
-        let step = ShapeStep::new(&mesh).unwrap();
+        let step = ShapeStep::new(mesh).unwrap();
         let rows: Vec<f64> = step.vertices().iter().map(|&v| area[v as usize]).collect();
         for (rho, gamma) in [(1e3, 0.0), (1e3, 0.5), (1e-2, 2.0)] {
             let terms = (rho, &area[..], gamma, &c[..]);
@@ -587,8 +675,8 @@ mod tests {
             let zs = step
                 .nearest(&q, &p, &z, &z0, rho, &rows, fair, None)
                 .unwrap();
-            let (_, g0) = objective(&mesh, &q, &p, &z, &z0, terms);
-            let (j, g) = objective(&mesh, &q, &p, &zs, &z0, terms);
+            let (_, g0) = objective(mesh, &q, &p, &z, &z0, terms);
+            let (j, g) = objective(mesh, &q, &p, &zs, &z0, terms);
             let norm = |g: &[f64]| g.iter().map(|x| x * x).sum::<f64>().sqrt();
             assert!(
                 norm(&g) < 1e-8 * norm(&g0),
@@ -611,7 +699,7 @@ mod tests {
                                 }
                         })
                         .collect();
-                    assert!(objective(&mesh, &q, &p, &moved, &z0, terms).0 >= j);
+                    assert!(objective(mesh, &q, &p, &moved, &z0, terms).0 >= j);
                 }
             }
             // Anchored heights are kept.

@@ -122,6 +122,17 @@ pub(crate) fn bucketed<I: Iterator<Item = (usize, usize)>>(
     (ptr, idx)
 }
 
+/// A row of a least-squares system is dense beyond max(`DENSE_FROM`, `DENSE_SQRT` √n) entries
+/// (n unknowns): its k entries add a k × k block to the normal matrix. Below the limit that
+/// block costs less than handling the row apart (a block of 2√n columns costs about as much
+/// work as factoring a planar mesh's n unknowns); above it, a fan's hub would make the normal
+/// matrix dense.
+pub(crate) fn dense_row_limit(n: usize) -> usize {
+    const DENSE_FROM: usize = 64;
+    const DENSE_SQRT: f64 = 2.0;
+    DENSE_FROM.max((DENSE_SQRT * (n as f64).sqrt()) as usize)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

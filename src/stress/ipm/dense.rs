@@ -14,13 +14,7 @@
 //! rounding where M_s is nearly singular along M_s⁻¹ aᵀ, the refinement against the exact
 //! system recovers.
 
-use crate::stress::sparse::{bucketed, Csr};
-
-/// A row is dense beyond max(`DENSE_FROM`, `DENSE_SQRT` √n) entries (n unknowns): below, its
-/// k × k block costs less than an unknown that may couple to all n (a block of 2√n columns
-/// costs about as much work as factoring a planar mesh's n unknowns).
-const DENSE_FROM: usize = 64;
-const DENSE_SQRT: f64 = 2.0;
+use crate::stress::sparse::{bucketed, dense_row_limit, Csr};
 
 /// Marks a row that is not split.
 const KEPT: usize = usize::MAX;
@@ -55,7 +49,7 @@ impl DenseRows {
     /// The rows of `quad` and `cons` (over n unknowns) with too many entries to be kept.
     pub(super) fn find(quad: &Csr, cons: &Csr) -> DenseRows {
         let n = cons.ncols;
-        let limit = DENSE_FROM.max((DENSE_SQRT * (n as f64).sqrt()) as usize);
+        let limit = dense_row_limit(n);
         let mut rows = Vec::new();
         let mut mark = |m: &Csr, source: Source| -> Vec<usize> {
             (0..m.nrows())
